@@ -1,0 +1,73 @@
+#pragma once
+/// The Device interface: what a servo thread reads from and writes to a force-feedback device.
+
+#include "hapto/scenes/Geometry.h"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace hapto {
+
+/// The outcome of a device call, as a value: the servo path never sees an exception.
+enum class DeviceStatus : std::uint8_t {
+    Ok,           ///< The call did what it says.
+    NotOpen,      ///< open() has not succeeded (or close() was called).
+    Stalled,      ///< No fresh data within the device's timeout.
+    Disconnected, ///< The device went away (unplugged, library shut down).
+    BadData,      ///< The device answered with data that cannot be decoded or is not finite.
+    Error,        ///< Any other failure; errorMessage() says more on the control thread.
+};
+
+/// A short lower-case name for a status ("ok", "stalled", ...). [any thread]
+std::string_view statusName(DeviceStatus status);
+
+/// One reading of a device, in the device's own frame.
+struct DeviceState {
+    Vec3 position{0.0};          ///< End-effector position (m), device frame.
+    Vec3 velocity{0.0};          ///< End-effector velocity (m/s), device frame, if hasVelocity.
+    bool hasVelocity = false;    ///< True when the device measured or estimated velocity.
+    std::uint32_t buttons = 0;   ///< Bit i set while button i is pressed.
+    std::uint64_t sequence = 0;  ///< Increases with every fresh sample from the device.
+};
+
+/// What a device can do, each with its unit.
+struct DeviceCapabilities {
+    std::string model;             ///< Human-readable model ("simulated hand", "Novint Falcon").
+    Aabb workspace;                ///< Reachable positions (m), device frame.
+    double maxForceN = 0.0;        ///< Largest continuous force it may be sent (N).
+    double maxStiffness = 0.0;     ///< Largest stable rendering stiffness (N/m); 0 = unknown.
+    double nominalRateHz = 1000.0; ///< The servo rate it is designed for (Hz).
+    int buttonCount = 0;           ///< Number of buttons.
+};
+
+/// A force-feedback device. open/close and capabilities run on the control thread; read and
+/// write run on the device's own servo thread and never allocate, lock (beyond the device's
+/// own I/O), log or throw.
+class Device {
+public:
+    virtual ~Device() = default;
+
+    /// The name from the configuration ("left", "right"). [any thread]
+    virtual std::string_view name() const = 0;
+    /// The configuration kind ("sim", "replay", "falcon", "phantom"). [any thread]
+    virtual std::string_view kind() const = 0;
+    /// Workspace, limits, rate. [control]
+    virtual DeviceCapabilities capabilities() const = 0;
+
+    /// Opens and prepares the device (homing, firmware) with zero force. On failure returns
+    /// the status and errorMessage() says what and what to do. [control]
+    virtual DeviceStatus open() = 0;
+    /// Commands zero force and releases the device. Safe to call twice. [control]
+    virtual void close() = 0;
+
+    /// Reads the newest sample. [servo]
+    virtual DeviceStatus read(DeviceState& state) = 0;
+    /// Commands a force (N), device frame. [servo]
+    virtual DeviceStatus write(const Vec3& forceN) = 0;
+
+    /// What went wrong last, for people. [control]
+    virtual std::string errorMessage() const = 0;
+};
+
+} // namespace hapto

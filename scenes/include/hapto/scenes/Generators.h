@@ -1,0 +1,52 @@
+#pragma once
+/// Seeded, reproducible scene generators for the paper's experiments and beyond.
+
+#include "hapto/scenes/Scene.h"
+
+#include <cstddef>
+#include <cstdint>
+
+namespace hapto {
+
+/// The material generated scenes use: default stiffness, mu_s 0.3, mu_d 0.2.
+Material generatedMaterial();
+
+/// Experiment 1: K x K x K cubes on a regular lattice centred on the origin.
+struct LatticeOptions {
+    int perSide = 3;         ///< K, cubes per lattice side (>= 1).
+    double cubeSize = 0.05;  ///< Cube edge (m); the paper's e-Touch boxes are 5 cm.
+    double gap = 0.01;       ///< Free space between neighbouring cubes (m).
+};
+/// Bounds are the lattice padded by half a gap on every side. [control]
+Scene makeLatticeScene(const LatticeOptions& options);
+
+/// Experiment 2: cubes placed uniformly at random in a work cube centred on the origin.
+struct RandomOptions {
+    std::size_t count = 200;   ///< Number of cubes.
+    std::uint64_t seed = 1;    ///< Same seed and options, same scene.
+    double workspace = 0.25;   ///< Edge of the work cube (m); cube centres stay inside it.
+    double cubeSize = 0.05;    ///< Cube edge (m).
+    bool rotate = false;       ///< Give each cube a uniformly random orientation.
+    double keepClear = 0.0;    ///< No object within this distance of the centre (m).
+};
+/// Bounds are the work cube. Throws InputError when keepClear leaves no room. [control]
+Scene makeRandomScene(const RandomOptions& options);
+
+/// A strongly non-uniform scene: cubes in Gaussian clusters.
+struct ClusterOptions {
+    std::size_t count = 1000;  ///< Number of cubes.
+    int clusters = 8;          ///< Number of Gaussian clusters (>= 1).
+    std::uint64_t seed = 1;    ///< Same seed and options, same scene.
+    double workspace = 0.25;   ///< Edge of the work cube (m); centres are clamped into it.
+    double cubeSize = 0.005;   ///< Cube edge (m).
+    double spread = 0.01;      ///< Standard deviation of each cluster (m).
+    bool rotate = false;       ///< Random orientations.
+};
+/// Bounds are the work cube. [control]
+Scene makeClusterScene(const ClusterOptions& options);
+
+/// The embedded default scene: the paper's experiment 2 set-up, 200 random 5 cm cubes in a
+/// 25 cm cube (seed 2004), with a 4 cm clear region around the centre where cursors start.
+Scene makeDefaultScene();
+
+} // namespace hapto

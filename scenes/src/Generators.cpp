@@ -1,0 +1,140 @@
+#include "hapto/scenes/Generators.h"
+
+#include "hapto/scenes/InputError.h"
+#include "hapto/scenes/Random.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+namespace hapto {
+namespace {
+
+// Generated coordinates are rounded to 1 micrometre: far below anything a hand feels, and it
+// keeps scene files short and exact when read back.
+double quantise(double metres) { return std::round(metres * 1e6) / 1e6; }
+
+Vec3 quantise(const Vec3& v) { return {quantise(v.x), quantise(v.y), quantise(v.z)}; }
+
+// A uniformly distributed rotation (Shoemake's subgroup algorithm).
+Quat randomRotation(Random& rng) {
+    const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+    const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
+    const double t2 = 2.0 * std::numbers::pi * u2, t3 = 2.0 * std::numbers::pi * u3;
+    return glm::normalize(Quat(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3)));
+}
+
+// Half extent of the cube's world AABB: how far its centre must stay from a wall.
+double aabbHalf(const SceneObject& o) {
+    const Vec3 h = o.aabb().halfExtents();
+    return std::max({h.x, h.y, h.z});
+}
+
+// Distance from p to the object's solid (0 inside).
+double distanceTo(const SceneObject& o, const Vec3& p) {
+    const Vec3 local = glm::abs(o.obb().toLocal(p));
+    return glm::length(glm::max(local - o.halfExtents, Vec3(0.0)));
+}
+
+} // namespace
+
+Material generatedMaterial() {
+    Material m;
+    m.staticFriction = 0.3;
+    m.dynamicFriction = 0.2;
+    return m;
+}
+
+Scene makeLatticeScene(const LatticeOptions& opt) {
+    if (opt.perSide < 1 || !(opt.cubeSize > 0.0) || !(opt.gap >= 0.0)) {
+        throw InputError("lattice scene: need per-side >= 1, size > 0 and gap >= 0");
+    }
+    const double pitch = opt.cubeSize + opt.gap;
+    const int k = opt.perSide;
+    std::vector<SceneObject> objects;
+    objects.reserve(static_cast<std::size_t>(k) * k * k);
+    const double offset = 0.5 * (k - 1) * pitch;
+    ObjectId id = 0;
+    for (int z = 0; z < k; ++z) {
+        for (int y = 0; y < k; ++y) {
+            for (int x = 0; x < k; ++x) {
+                const Vec3 c = quantise(Vec3(x * pitch - offset, y * pitch - offset, z * pitch - offset));
+                objects.push_back(makeBox(id++, c, Vec3(0.5 * opt.cubeSize), Quat(1, 0, 0, 0),
+                                          generatedMaterial()));
+            }
+        }
+    }
+    const double half = quantise(0.5 * k * pitch);
+    return Scene({Vec3(-half), Vec3(half)}, std::move(objects));
+}
+
+Scene makeRandomScene(const RandomOptions& opt) {
+    if (!(opt.workspace > 0.0) || !(opt.cubeSize > 0.0) || opt.cubeSize >= opt.workspace) {
+        throw InputError("random scene: need 0 < size < workspace");
+    }
+    Random rng(opt.seed);
+    std::vector<SceneObject> objects;
+    objects.reserve(opt.count);
+    const double w = 0.5 * opt.workspace;
+    for (std::size_t i = 0; i < opt.count; ++i) {
+        int attempts = 0;
+        for (;;) {
+            SceneObject o = makeBox(static_cast<ObjectId>(i), Vec3(0.0), Vec3(0.5 * opt.cubeSize),
+                                    opt.rotate ? randomRotation(rng) : Quat(1, 0, 0, 0),
+                                    generatedMaterial());
+            const double inset = std::min(aabbHalf(o), w);
+            o.center = quantise(Vec3(rng.uniform(-w + inset, w - inset), rng.uniform(-w + inset, w - inset),
+                                     rng.uniform(-w + inset, w - inset)));
+            if (opt.keepClear <= 0.0 || distanceTo(o, Vec3(0.0)) > opt.keepClear) {
+                objects.push_back(o);
+                break;
+            }
+            if (++attempts == 10000) {
+                throw InputError("random scene: --keep-clear " + std::to_string(opt.keepClear) +
+                                 " m leaves no room for a cube of " + std::to_string(opt.cubeSize) +
+                                 " m in a " + std::to_string(opt.workspace) + " m workspace");
+            }
+        }
+    }
+    return Scene({Vec3(-w), Vec3(w)}, std::move(objects));
+}
+
+Scene makeClusterScene(const ClusterOptions& opt) {
+    if (opt.clusters < 1 || !(opt.workspace > 0.0) || !(opt.cubeSize > 0.0) ||
+        opt.cubeSize >= opt.workspace || !(opt.spread >= 0.0)) {
+        throw InputError("cluster scene: need clusters >= 1, 0 < size < workspace, spread >= 0");
+    }
+    Random rng(opt.seed);
+    const double w = 0.5 * opt.workspace;
+    std::vector<Vec3> centres;
+    for (int c = 0; c < opt.clusters; ++c) {
+        const double inset = 0.5 * opt.cubeSize;
+        centres.emplace_back(rng.uniform(-w + inset, w - inset), rng.uniform(-w + inset, w - inset),
+                             rng.uniform(-w + inset, w - inset));
+    }
+    std::vector<SceneObject> objects;
+    objects.reserve(opt.count);
+    for (std::size_t i = 0; i < opt.count; ++i) {
+        SceneObject o = makeBox(static_cast<ObjectId>(i), Vec3(0.0), Vec3(0.5 * opt.cubeSize),
+                                opt.rotate ? randomRotation(rng) : Quat(1, 0, 0, 0),
+                                generatedMaterial());
+        const Vec3& cc = centres[rng.below(centres.size())];
+        const double inset = std::min(aabbHalf(o), w);
+        Vec3 c = cc + opt.spread * Vec3(rng.normal(), rng.normal(), rng.normal());
+        c = glm::clamp(c, Vec3(-w + inset), Vec3(w - inset));
+        o.center = quantise(c);
+        objects.push_back(o);
+    }
+    return Scene({Vec3(-w), Vec3(w)}, std::move(objects));
+}
+
+Scene makeDefaultScene() {
+    RandomOptions opt;
+    opt.count = 200;
+    opt.seed = 2004;
+    opt.keepClear = 0.04;
+    return makeRandomScene(opt);
+}
+
+} // namespace hapto

@@ -1,0 +1,154 @@
+#include "hapto/scenes/Generators.h"
+#include "hapto/scenes/InputError.h"
+#include "hapto/scenes/SceneFile.h"
+
+#include "TestSupport.h"
+
+#include <catch2/catch.hpp>
+
+#include <regex>
+
+using namespace hapto;
+
+namespace {
+
+// The exact example from README.md and the issue.
+const char* kReadmeExample = R"({"format": "hapto-scene", "version": 1,
+ "bounds": {"min": [-0.125, -0.125, -0.125], "max": [0.125, 0.125, 0.125]},
+ "objects": [
+  {"id": 0, "shape": "box", "center": [0, 0, 0], "half_extents": [0.025, 0.025, 0.025],
+   "rotation": [1, 0, 0, 0], "stiffness": 800, "friction": [0.3, 0.2]},
+  {"id": 1, "shape": "sphere", "center": [0.05, 0, 0], "radius": 0.01}]})";
+
+std::string errorOf(const std::string& text) {
+    try {
+        parseScene(text, "bad.json");
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+std::string withObject(const std::string& object) {
+    return R"({"format": "hapto-scene", "version": 1, "objects": [)"
+           R"({"id": 0, "shape": "box", "center": [0,0,0], "half_extents": [1,1,1]}, )" +
+           object + "]}";
+}
+
+} // namespace
+
+TEST_CASE("the README example loads with its defaults applied") {
+    const Scene s = parseScene(kReadmeExample, "example.json");
+    REQUIRE(s.size() == 2);
+    CHECK(s.bounds().min == Vec3(-0.125));
+    CHECK(s.bounds().max == Vec3(0.125));
+    const SceneObject& box = s.object(0);
+    CHECK(box.shape == Shape::Box);
+    CHECK(box.halfExtents == Vec3(0.025));
+    CHECK(box.material.stiffness == 800.0);
+    CHECK(box.material.staticFriction == 0.3);
+    CHECK(box.material.dynamicFriction == 0.2);
+    const SceneObject& sphere = s.object(1);
+    CHECK(sphere.shape == Shape::Sphere);
+    CHECK(sphere.radius() == 0.01);
+    CHECK(sphere.center == Vec3(0.05, 0, 0));
+    CHECK(sphere.material == Material{});
+    CHECK(sphere.rotation == Quat(1, 0, 0, 0));
+}
+
+TEST_CASE("the README shows the same example the tests load") {
+    const std::string readme = test::readFile(std::string(HAPTO_SOURCE_DIR) + "/README.md");
+    // Compare ignoring white space.
+    auto squash = [](std::string s) {
+        s.erase(std::remove_if(s.begin(), s.end(), ::isspace), s.end());
+        return s;
+    };
+    CHECK(squash(readme).find(squash(kReadmeExample)) != std::string::npos);
+}
+
+TEST_CASE("bounds default to the objects' union, padded") {
+    const Scene s = parseScene(withObject(R"({"id": 5, "shape": "sphere", "center": [3,0,0], "radius": 0.5})"),
+                               "x.json");
+    CHECK(s.bounds().min.x < -1.0);
+    CHECK(s.bounds().max.x > 3.5);
+    CHECK(s.bounds().max.x < 3.5 + 0.5);
+}
+
+TEST_CASE("save then load gives the same scene, and ids need not be dense") {
+    test::TempDir dir;
+    std::vector<SceneObject> objects{
+        makeBox(1000, Vec3(0.01, -0.02, 0.03), Vec3(0.01, 0.02, 0.005),
+                glm::normalize(Quat(0.9, 0.1, -0.3, 0.2)), Material{1200, 0.5, 0.25}),
+        makeSphere(3, Vec3(-0.05, 0, 0.1), 0.0125, Material{300, 0, 0}),
+        makeBox(4000000000u, Vec3(0), Vec3(0.001))};
+    const Scene original(Aabb{Vec3(-0.2), Vec3(0.3)}, objects);
+    saveSceneFile(original, dir / "s.json");
+    const Scene loaded = loadSceneFile(dir / "s.json");
+    CHECK(loaded == original);
+    CHECK(loaded.slotOf(4000000000u) == 2u);
+}
+
+TEST_CASE("generated scenes round-trip through files bit for bit") {
+    test::TempDir dir;
+    RandomOptions opt;
+    opt.count = 500;
+    opt.seed = 9;
+    opt.rotate = true;
+    const Scene original = makeRandomScene(opt);
+    saveSceneFile(original, dir / "r.json");
+    const Scene loaded = loadSceneFile(dir / "r.json");
+    CHECK(loaded == original);
+    CHECK(sceneToJson(loaded) == test::readFile(dir / "r.json"));
+}
+
+TEST_CASE("every class of bad file is refused with the file, the JSON path and the reason") {
+    struct Case {
+        const char* name;
+        std::string text;
+        const char* expected; // a regex the message must match
+    };
+    const std::vector<Case> cases{
+        {"syntax error", R"({"format": "hapto-scene", "version": 1, "objects": [})", R"(bad\.json:1:\d+: not valid JSON)"},
+        {"syntax error on a later line", "{\"format\": \"hapto-scene\",\n \"version\": 1,\n \"objects\": [,]}", R"(bad\.json:3:\d+: not valid JSON)"},
+        {"not an object", "[1, 2]", "bad.json: \\(top level\\): expected a JSON object"},
+        {"wrong format", R"({"format": "obj", "version": 1, "objects": []})", "bad.json: format: expected \"hapto-scene\""},
+        {"missing format", R"({"version": 1, "objects": []})", "missing required field 'format'"},
+        {"unknown version", R"({"format": "hapto-scene", "version": 2, "objects": []})", "bad.json: version: this build reads version 1, got 2"},
+        {"missing objects", R"({"format": "hapto-scene", "version": 1})", "missing required field 'objects'"},
+        {"objects not an array", R"({"format": "hapto-scene", "version": 1, "objects": {}})", "bad.json: objects: expected an array"},
+        {"unknown top-level field", R"({"format": "hapto-scene", "version": 1, "objects": [], "lights": []})", "unknown field 'lights'"},
+        {"object not an object", withObject("42"), R"(objects\[1\]: expected an object)"},
+        {"missing id", withObject(R"({"shape": "box", "center": [0,0,0], "half_extents": [1,1,1]})"), R"(objects\[1\]: missing required field 'id')"},
+        {"negative id", withObject(R"({"id": -1, "shape": "box", "center": [0,0,0], "half_extents": [1,1,1]})"), R"(objects\[1\]\.id: must be in 0\.\.)"},
+        {"fractional id", withObject(R"({"id": 1.5, "shape": "box", "center": [0,0,0], "half_extents": [1,1,1]})"), R"(objects\[1\]\.id: expected a non-negative integer)"},
+        {"duplicate id", withObject(R"({"id": 0, "shape": "box", "center": [0,0,0], "half_extents": [1,1,1]})"), R"(objects\[1\]\.id: duplicate id 0 \(also at objects\[0\]\))"},
+        {"unknown shape", withObject(R"({"id": 1, "shape": "cone", "center": [0,0,0]})"), R"(objects\[1\]\.shape: unknown shape 'cone')"},
+        {"mistyped shape", withObject(R"({"id": 1, "shape": 3, "center": [0,0,0]})"), R"(objects\[1\]\.shape: expected a string)"},
+        {"missing center", withObject(R"({"id": 1, "shape": "sphere", "radius": 1})"), R"(objects\[1\]: missing required field 'center')"},
+        {"mistyped center", withObject(R"({"id": 1, "shape": "sphere", "center": "here", "radius": 1})"), R"(objects\[1\]\.center: expected an array of 3 numbers, got a string)"},
+        {"short center", withObject(R"({"id": 1, "shape": "sphere", "center": [0, 1], "radius": 1})"), R"(objects\[1\]\.center: expected an array of 3 numbers, got an array of 2)"},
+        {"string in center", withObject(R"({"id": 1, "shape": "sphere", "center": [0, "1", 2], "radius": 1})"), R"(objects\[1\]\.center\[1\]: expected a number, got a string)"},
+        {"non-finite number", withObject(R"({"id": 1, "shape": "sphere", "center": [0, 1e999, 2], "radius": 1})"), R"(bad\.json)"},
+        {"zero size", withObject(R"({"id": 1, "shape": "box", "center": [0,0,0], "half_extents": [1, 0, 1]})"), R"(objects\[1\]\.half_extents\[1\]: a half extent must be > 0 \(got 0\))"},
+        {"negative size", withObject(R"({"id": 1, "shape": "box", "center": [0,0,0], "half_extents": [1, 1, -2]})"), R"(objects\[1\]\.half_extents\[2\]: a half extent must be > 0)"},
+        {"zero radius", withObject(R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 0})"), R"(objects\[1\]\.radius: the radius must be > 0)"},
+        {"quaternion far from unit", withObject(R"({"id": 1, "shape": "box", "center": [0,0,0], "half_extents": [1,1,1], "rotation": [1, 1, 0, 0]})"), R"(objects\[1\]\.rotation: must be a unit quaternion)"},
+        {"negative stiffness", withObject(R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "stiffness": -5})"), R"(objects\[1\]\.stiffness: stiffness \(N/m\) must be > 0)"},
+        {"friction out of order", withObject(R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "friction": [0.1, 0.5]})"), R"(objects\[1\]\.friction: the dynamic coefficient)"},
+        {"radius on a box", withObject(R"({"id": 1, "shape": "box", "center": [0,0,0], "radius": 1})"), R"(objects\[1\]: unknown field 'radius')"},
+        {"typo in a field", withObject(R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "stifness": 5})"), R"(objects\[1\]: unknown field 'stifness')"},
+        {"inverted bounds", R"({"format": "hapto-scene", "version": 1, "bounds": {"min": [0,0,0], "max": [1,-1,1]}, "objects": []})", R"(bad\.json: bounds: min must be < max)"},
+        {"bounds missing max", R"({"format": "hapto-scene", "version": 1, "bounds": {"min": [0,0,0]}, "objects": []})", R"(bounds: missing required field 'max')"},
+    };
+    for (const Case& c : cases) {
+        INFO(c.name);
+        const std::string message = errorOf(c.text);
+        INFO(message);
+        CHECK(std::regex_search(message, std::regex(c.expected)));
+    }
+}
+
+TEST_CASE("a missing file is named in the message") {
+    CHECK_THROWS_WITH(loadSceneFile("/nonexistent/scene.json"),
+                      Catch::Contains("/nonexistent/scene.json") && Catch::Contains("cannot open"));
+}

@@ -1,0 +1,73 @@
+#pragma once
+/// Helpers shared by the tests: temporary files and running the `hapto` command.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace hapto::test {
+
+/// A fresh directory under the system temp dir, removed when the object dies.
+class TempDir {
+public:
+    TempDir() {
+        std::random_device rd;
+        mPath = std::filesystem::temp_directory_path() /
+                ("hapto-test-" + std::to_string(rd()) + std::to_string(rd()));
+        std::filesystem::create_directories(mPath);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(mPath, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::filesystem::path& path() const { return mPath; }
+    std::filesystem::path operator/(const std::string& name) const { return mPath / name; }
+
+private:
+    std::filesystem::path mPath;
+};
+
+/// Writes text to a file.
+inline void writeFile(const std::filesystem::path& p, const std::string& text) {
+    std::ofstream(p, std::ios::binary) << text;
+}
+
+/// Reads a whole file.
+inline std::string readFile(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+/// The result of running a command.
+struct CommandResult {
+    int exitCode = -1;
+    std::string output; ///< stdout and stderr, interleaved.
+};
+
+/// Runs `hapto ARGS` (a shell fragment) from the build tree, capturing its output.
+inline CommandResult runHapto(const std::string& args) {
+    const std::string cmd = std::string(HAPTO_BINARY_DIR) + "/tools/hapto " + args + " 2>&1";
+    CommandResult r;
+    FILE* pipe = popen(cmd.c_str(), "r");
+    if (!pipe) {
+        return r;
+    }
+    char buf[4096];
+    std::size_t n;
+    while ((n = fread(buf, 1, sizeof buf, pipe)) > 0) {
+        r.output.append(buf, n);
+    }
+    const int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+} // namespace hapto::test

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# hapto's one set-up script. On a fresh Debian 12 machine (root, apt reachable) it installs
+# what is missing, builds, and then:
+#   tools/setup.sh main   runs the main job: a two-device simulated session over the
+#                         embedded default scene, printing each device's haptic load;
+#   tools/setup.sh test   runs the whole test suite through ctest.
+# Both are idempotent: a second run installs nothing and rebuilds only what changed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mode=${1:-}
+case "$mode" in
+  main|test) shift ;;
+  *) echo "usage: tools/setup.sh main|test [extra arguments for hapto run]" >&2; exit 2 ;;
+esac
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libtbb-dev libglm-dev libeigen3-dev catch2 libusb-1.0-0-dev libcli11-dev nlohmann-json3-dev
+  gnuplot-nox libbenchmark-dev libbullet-dev libfcl-dev libboost-dev
+  umockdev libumockdev-dev libglib2.0-dev
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'ok installed' || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=(); [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+jobs=$(nproc)
+build() {
+  local preset=$1
+  cmake --preset "$preset" >/dev/null
+  cmake --build --preset "$preset" -j "$jobs"
+}
+
+case "$mode" in
+  main)
+    build release
+    exec build/release/tools/hapto scene info "$@"
+    ;;
+  test)
+    build release
+    ctest --preset release -j "$jobs"
+    ;;
+esac

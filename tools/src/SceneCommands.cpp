@@ -1,0 +1,169 @@
+// `hapto scene grid|random|cluster|default|info`.
+
+#include "Commands.h"
+
+#include "hapto/scenes/Generators.h"
+#include "hapto/scenes/InputError.h"
+#include "hapto/scenes/SceneFile.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+namespace hapto::cli {
+
+std::size_t parseCount(const std::string& text, const std::string& option) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+        value = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || !(value >= 0.0) || value > 4.0e9 || std::floor(value) != value) {
+        throw InputError(option + ": expected a whole number >= 0 such as 1000 or 1e6, got '" +
+                         text + "'");
+    }
+    return static_cast<std::size_t>(value);
+}
+
+Scene loadSceneOrDefault(const std::string& path) {
+    return path.empty() ? makeDefaultScene() : loadSceneFile(path);
+}
+
+namespace {
+
+void writeScene(const Scene& scene, const std::string& out) {
+    if (out == "-") {
+        std::cout << sceneToJson(scene);
+    } else {
+        saveSceneFile(scene, out);
+        std::cerr << "wrote " << scene.size() << " objects to " << out << "\n";
+    }
+}
+
+void printInfo(const Scene& scene, const std::string& source, double loadSeconds) {
+    std::size_t boxes = 0, rotated = 0;
+    ObjectId minId = kMaxObjectId, maxId = 0;
+    for (const SceneObject& o : scene.objects()) {
+        boxes += o.shape == Shape::Box;
+        rotated += o.shape == Shape::Box && o.rotation != Quat(1, 0, 0, 0);
+        minId = std::min(minId, o.id);
+        maxId = std::max(maxId, o.id);
+    }
+    const Aabb& b = scene.bounds();
+    std::printf("scene:    %s\n", source.c_str());
+    std::printf("objects:  %u (%zu boxes, %zu of them rotated; %zu spheres)\n", scene.size(), boxes,
+                rotated, scene.size() - boxes);
+    if (scene.size() > 0) {
+        std::printf("ids:      %u .. %u\n", minId, maxId);
+    }
+    std::printf("bounds:   [%.4f, %.4f, %.4f] .. [%.4f, %.4f, %.4f] m\n", b.min.x, b.min.y,
+                b.min.z, b.max.x, b.max.y, b.max.z);
+    std::printf("loaded in %.3f s\n", loadSeconds);
+}
+
+} // namespace
+
+void addSceneCommands(CLI::App& app) {
+    CLI::App* scene = app.add_subcommand("scene", "Generate scene files, or describe one");
+    scene->require_subcommand(1);
+
+    // grid
+    {
+        auto* cmd = scene->add_subcommand(
+            "grid", "Experiment 1: K x K x K cubes on a regular lattice with gaps, bounds a little "
+                    "larger than the lattice");
+        auto opt = std::make_shared<LatticeOptions>();
+        auto out = std::make_shared<std::string>();
+        cmd->add_option("--per-side", opt->perSide, "K, cubes per lattice side")->required()
+            ->check(CLI::Range(1, 100000));
+        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")->capture_default_str()
+            ->check(CLI::PositiveNumber);
+        cmd->add_option("--gap", opt->gap, "Free space between neighbouring cubes (m)")
+            ->capture_default_str()->check(CLI::NonNegativeNumber);
+        cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
+            ->required();
+        cmd->callback([opt, out] { writeScene(makeLatticeScene(*opt), *out); });
+    }
+    // random
+    {
+        auto* cmd = scene->add_subcommand(
+            "random", "Experiment 2: N cubes placed uniformly at random in a work cube centred on "
+                      "the origin; bounds are the work cube");
+        auto opt = std::make_shared<RandomOptions>();
+        auto count = std::make_shared<std::string>();
+        auto out = std::make_shared<std::string>();
+        cmd->add_option("--count", *count, "Number of cubes (e.g. 200 or 1e6)")->required();
+        cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
+            ->capture_default_str();
+        cmd->add_option("--workspace", opt->workspace, "Edge of the work cube (m)")
+            ->capture_default_str()->check(CLI::PositiveNumber);
+        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")->capture_default_str()
+            ->check(CLI::PositiveNumber);
+        cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
+        cmd->add_option("--keep-clear", opt->keepClear,
+                        "No object within this distance of the centre, where cursors start (m)")
+            ->capture_default_str()->check(CLI::NonNegativeNumber);
+        cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
+            ->required();
+        cmd->callback([opt, count, out] {
+            opt->count = parseCount(*count, "--count");
+            writeScene(makeRandomScene(*opt), *out);
+        });
+    }
+    // cluster
+    {
+        auto* cmd = scene->add_subcommand(
+            "cluster", "A strongly non-uniform scene: N cubes in C Gaussian clusters (a uniform "
+                       "grid does badly here)");
+        auto opt = std::make_shared<ClusterOptions>();
+        auto count = std::make_shared<std::string>();
+        auto out = std::make_shared<std::string>();
+        cmd->add_option("--count", *count, "Number of cubes (e.g. 1e5)")->required();
+        cmd->add_option("--clusters", opt->clusters, "Number of clusters")->capture_default_str()
+            ->check(CLI::Range(1, 1000000));
+        cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
+            ->capture_default_str();
+        cmd->add_option("--workspace", opt->workspace, "Edge of the work cube (m)")
+            ->capture_default_str()->check(CLI::PositiveNumber);
+        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")->capture_default_str()
+            ->check(CLI::PositiveNumber);
+        cmd->add_option("--spread", opt->spread, "Standard deviation of each cluster (m)")
+            ->capture_default_str()->check(CLI::NonNegativeNumber);
+        cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
+        cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
+            ->required();
+        cmd->callback([opt, count, out] {
+            opt->count = parseCount(*count, "--count");
+            writeScene(makeClusterScene(*opt), *out);
+        });
+    }
+    // default
+    {
+        auto* cmd = scene->add_subcommand(
+            "default", "Write the embedded default scene (200 random 5 cm cubes, seed 2004, 4 cm "
+                       "clear around the centre)");
+        auto out = std::make_shared<std::string>();
+        cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
+            ->required();
+        cmd->callback([out] { writeScene(makeDefaultScene(), *out); });
+    }
+    // info
+    {
+        auto* cmd = scene->add_subcommand("info", "Load a scene (or the default) and describe it");
+        auto path = std::make_shared<std::string>();
+        cmd->add_option("--scene", *path, "Scene file (default: the embedded default scene)");
+        cmd->callback([path] {
+            const auto t0 = std::chrono::steady_clock::now();
+            const Scene s = loadSceneOrDefault(*path);
+            const double secs =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            printInfo(s, path->empty() ? "(embedded default scene)" : *path, secs);
+        });
+    }
+}
+
+} // namespace hapto::cli

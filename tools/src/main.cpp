@@ -1,0 +1,38 @@
+// The `hapto` command: one executable, one subcommand per task.
+
+#include "Commands.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+int main(int argc, char** argv) {
+    CLI::App app{"hapto: a multi-device haptic runtime over one shared spatial index.\n"
+                 "Units are SI throughout: metres, seconds, newtons, N/m.",
+                 "hapto"};
+    app.require_subcommand(1);
+    app.set_help_all_flag("--help-all", "Print help for every subcommand and exit");
+
+    hapto::cli::addSceneCommands(app);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == 0) { // --help, --help-all
+            return app.exit(e);
+        }
+        std::cerr << "hapto: " << e.what() << "\n(run with --help for the options)\n";
+        return 2;
+    } catch (const hapto::InputError& e) {
+        std::cerr << "hapto: " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "hapto: error: " << e.what() << "\n";
+        return 1;
+    }
+    return 0;
+}
