@@ -13,16 +13,21 @@ namespace {
 
 // Generated coordinates are rounded to 1 micrometre: far below anything a hand feels, and it
 // keeps scene files short and exact when read back.
-double quantise(double metres) { return std::round(metres * 1e6) / 1e6; }
+double quantise(double metres) {
+    return std::round(metres * 1e6) / 1e6;
+}
 
-Vec3 quantise(const Vec3& v) { return {quantise(v.x), quantise(v.y), quantise(v.z)}; }
+Vec3 quantise(const Vec3& v) {
+    return {quantise(v.x), quantise(v.y), quantise(v.z)};
+}
 
 // A uniformly distributed rotation (Shoemake's subgroup algorithm).
 Quat randomRotation(Random& rng) {
     const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
     const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
     const double t2 = 2.0 * std::numbers::pi * u2, t3 = 2.0 * std::numbers::pi * u3;
-    return glm::normalize(Quat(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3)));
+    return glm::normalize(
+        Quat(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3)));
 }
 
 // Half extent of the cube's world AABB: how far its centre must stay from a wall.
@@ -59,7 +64,8 @@ Scene makeLatticeScene(const LatticeOptions& opt) {
     for (int z = 0; z < k; ++z) {
         for (int y = 0; y < k; ++y) {
             for (int x = 0; x < k; ++x) {
-                const Vec3 c = quantise(Vec3(x * pitch - offset, y * pitch - offset, z * pitch - offset));
+                const Vec3 c =
+                    quantise(Vec3(x * pitch - offset, y * pitch - offset, z * pitch - offset));
                 objects.push_back(makeBox(id++, c, Vec3(0.5 * opt.cubeSize), Quat(1, 0, 0, 0),
                                           generatedMaterial()));
             }
@@ -80,11 +86,12 @@ Scene makeRandomScene(const RandomOptions& opt) {
     for (std::size_t i = 0; i < opt.count; ++i) {
         int attempts = 0;
         for (;;) {
-            SceneObject o = makeBox(static_cast<ObjectId>(i), Vec3(0.0), Vec3(0.5 * opt.cubeSize),
-                                    opt.rotate ? randomRotation(rng) : Quat(1, 0, 0, 0),
-                                    generatedMaterial());
+            SceneObject o =
+                makeBox(static_cast<ObjectId>(i), Vec3(0.0), Vec3(0.5 * opt.cubeSize),
+                        opt.rotate ? randomRotation(rng) : Quat(1, 0, 0, 0), generatedMaterial());
             const double inset = std::min(aabbHalf(o), w);
-            o.center = quantise(Vec3(rng.uniform(-w + inset, w - inset), rng.uniform(-w + inset, w - inset),
+            o.center = quantise(Vec3(rng.uniform(-w + inset, w - inset),
+                                     rng.uniform(-w + inset, w - inset),
                                      rng.uniform(-w + inset, w - inset)));
             if (opt.keepClear <= 0.0 || distanceTo(o, Vec3(0.0)) > opt.keepClear) {
                 objects.push_back(o);
@@ -116,9 +123,9 @@ Scene makeClusterScene(const ClusterOptions& opt) {
     std::vector<SceneObject> objects;
     objects.reserve(opt.count);
     for (std::size_t i = 0; i < opt.count; ++i) {
-        SceneObject o = makeBox(static_cast<ObjectId>(i), Vec3(0.0), Vec3(0.5 * opt.cubeSize),
-                                opt.rotate ? randomRotation(rng) : Quat(1, 0, 0, 0),
-                                generatedMaterial());
+        SceneObject o =
+            makeBox(static_cast<ObjectId>(i), Vec3(0.0), Vec3(0.5 * opt.cubeSize),
+                    opt.rotate ? randomRotation(rng) : Quat(1, 0, 0, 0), generatedMaterial());
         const Vec3& cc = centres[rng.below(centres.size())];
         const double inset = std::min(aabbHalf(o), w);
         Vec3 c = cc + opt.spread * Vec3(rng.normal(), rng.normal(), rng.normal());

@@ -20,13 +20,34 @@ namespace {
 
 using Json = nlohmann::json;
 
+// A JSON path built only when a message needs it: each level points at its parent on the stack.
+struct Path {
+    const Path* parent = nullptr;
+    const char* key = nullptr; // a field name, or
+    long index = -1;           // an array index
+
+    Path operator/(const char* k) const { return {this, k, -1}; }
+    Path operator[](std::size_t i) const { return {this, nullptr, static_cast<long>(i)}; }
+    std::string str() const {
+        std::string head = parent ? parent->str() : std::string();
+        if (key) {
+            return head.empty() ? std::string(key) : head + "." + key;
+        }
+        if (index >= 0) {
+            return head + "[" + std::to_string(index) + "]";
+        }
+        return head;
+    }
+};
+
 // Builds "file: path: what" messages.
 class Where {
 public:
     explicit Where(std::string_view source) : mSource(source) {}
-    [[noreturn]] void fail(const std::string& path, const std::string& what) const {
-        throw InputError(std::string(mSource) + ": " + (path.empty() ? "(top level)" : path) +
-                         ": " + what);
+    [[noreturn]] void fail(const Path& path, const std::string& what) const {
+        const std::string p = path.str();
+        throw InputError(std::string(mSource) + ": " + (p.empty() ? "(top level)" : p) + ": " +
+                         what);
     }
 
 private:
@@ -45,7 +66,7 @@ std::string typeName(const Json& j) {
                : std::string("a ") + j.type_name();
 }
 
-double number(const Where& w, const Json& j, const std::string& path) {
+double number(const Where& w, const Json& j, const Path& path) {
     if (!j.is_number()) {
         w.fail(path, "expected a number, got " + typeName(j));
     }
@@ -57,25 +78,24 @@ double number(const Where& w, const Json& j, const std::string& path) {
 }
 
 template <std::size_t N>
-std::array<double, N> numbers(const Where& w, const Json& j, const std::string& path) {
+std::array<double, N> numbers(const Where& w, const Json& j, const Path& path) {
     if (!j.is_array() || j.size() != N) {
         w.fail(path, "expected an array of " + std::to_string(N) + " numbers, got " +
-                         (j.is_array() ? "an array of " + std::to_string(j.size())
-                                       : typeName(j)));
+                         (j.is_array() ? "an array of " + std::to_string(j.size()) : typeName(j)));
     }
     std::array<double, N> out{};
     for (std::size_t i = 0; i < N; ++i) {
-        out[i] = number(w, j[i], path + "[" + std::to_string(i) + "]");
+        out[i] = number(w, j[i], path[i]);
     }
     return out;
 }
 
-Vec3 vec3(const Where& w, const Json& j, const std::string& path) {
+Vec3 vec3(const Where& w, const Json& j, const Path& path) {
     const auto a = numbers<3>(w, j, path);
     return {a[0], a[1], a[2]};
 }
 
-void positive(const Where& w, double v, const std::string& path, const char* what) {
+void positive(const Where& w, double v, const Path& path, const char* what) {
     if (!(v > 0.0)) {
         std::ostringstream s;
         s << what << " must be > 0 (got " << v << ")";
@@ -83,7 +103,7 @@ void positive(const Where& w, double v, const std::string& path, const char* wha
     }
 }
 
-void checkKeys(const Where& w, const Json& obj, const std::string& path,
+void checkKeys(const Where& w, const Json& obj, const Path& path,
                std::initializer_list<std::string_view> allowed, std::string_view hint = {}) {
     for (auto it = obj.begin(); it != obj.end(); ++it) {
         if (std::find(allowed.begin(), allowed.end(), std::string_view(it.key())) ==
@@ -97,7 +117,7 @@ void checkKeys(const Where& w, const Json& obj, const std::string& path,
     }
 }
 
-const Json& required(const Where& w, const Json& obj, const std::string& path, const char* key) {
+const Json& required(const Where& w, const Json& obj, const Path& path, const char* key) {
     const auto it = obj.find(key);
     if (it == obj.end()) {
         w.fail(path, std::string("missing required field '") + key + "'");
@@ -105,26 +125,25 @@ const Json& required(const Where& w, const Json& obj, const std::string& path, c
     return *it;
 }
 
-SceneObject parseObject(const Where& w, const Json& j, const std::string& path) {
+SceneObject parseObject(const Where& w, const Json& j, const Path& path) {
     if (!j.is_object()) {
         w.fail(path, "expected an object, got " + typeName(j));
     }
     SceneObject o;
     const Json& id = required(w, j, path, "id");
     if (!id.is_number_integer()) {
-        w.fail(path + ".id", "expected a non-negative integer, got " + typeName(id));
+        w.fail(path / "id", "expected a non-negative integer, got " + typeName(id));
     }
     if (id.is_number_unsigned() ? id.get<std::uint64_t>() > kMaxObjectId
                                 : id.get<std::int64_t>() < 0) {
-        w.fail(path + ".id", "must be in 0.." + std::to_string(kMaxObjectId) + " (got " +
-                                 id.dump() + ")");
+        w.fail(path / "id",
+               "must be in 0.." + std::to_string(kMaxObjectId) + " (got " + id.dump() + ")");
     }
     o.id = static_cast<ObjectId>(id.get<std::uint64_t>());
 
     const Json& shape = required(w, j, path, "shape");
     if (!shape.is_string()) {
-        w.fail(path + ".shape", "expected a string (\"box\" or \"sphere\"), got " +
-                                    typeName(shape));
+        w.fail(path / "shape", "expected a string (\"box\" or \"sphere\"), got " + typeName(shape));
     }
     const auto& shapeText = shape.get_ref<const std::string&>();
     if (shapeText == "box") {
@@ -132,49 +151,50 @@ SceneObject parseObject(const Where& w, const Json& j, const std::string& path) 
         checkKeys(w, j, path,
                   {"id", "shape", "center", "half_extents", "rotation", "stiffness", "friction"},
                   "a box takes id, shape, center, half_extents, rotation, stiffness, friction");
-        o.halfExtents = vec3(w, required(w, j, path, "half_extents"), path + ".half_extents");
-        for (int i = 0; i < 3; ++i) {
-            positive(w, o.halfExtents[i], path + ".half_extents[" + std::to_string(i) + "]",
-                     "a half extent");
+        const Path he = path / "half_extents";
+        o.halfExtents = vec3(w, required(w, j, path, "half_extents"), he);
+        for (std::size_t i = 0; i < 3; ++i) {
+            positive(w, o.halfExtents[static_cast<int>(i)], he[i], "a half extent");
         }
     } else if (shapeText == "sphere") {
         o.shape = Shape::Sphere;
-        checkKeys(w, j, path, {"id", "shape", "center", "radius", "rotation", "stiffness", "friction"},
+        checkKeys(w, j, path,
+                  {"id", "shape", "center", "radius", "rotation", "stiffness", "friction"},
                   "a sphere takes id, shape, center, radius, rotation, stiffness, friction");
-        const double r = number(w, required(w, j, path, "radius"), path + ".radius");
-        positive(w, r, path + ".radius", "the radius");
+        const double r = number(w, required(w, j, path, "radius"), path / "radius");
+        positive(w, r, path / "radius", "the radius");
         o.halfExtents = Vec3(r);
     } else {
-        w.fail(path + ".shape", "unknown shape '" + shapeText + "' (expected \"box\" or \"sphere\")");
+        w.fail(path / "shape",
+               "unknown shape '" + shapeText + "' (expected \"box\" or \"sphere\")");
     }
-    o.center = vec3(w, required(w, j, path, "center"), path + ".center");
+    o.center = vec3(w, required(w, j, path, "center"), path / "center");
 
     if (const auto it = j.find("rotation"); it != j.end()) {
-        const auto q = numbers<4>(w, *it, path + ".rotation");
+        const auto q = numbers<4>(w, *it, path / "rotation");
         const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
         if (std::abs(len - 1.0) > 1e-3) {
             std::ostringstream s;
             s << "must be a unit quaternion (w, x, y, z); its length is " << len;
-            w.fail(path + ".rotation", s.str());
+            w.fail(path / "rotation", s.str());
         }
         // A quaternion written from a normalised one reads back bit for bit.
         const double scale = std::abs(len - 1.0) < 1e-9 ? 1.0 : 1.0 / len;
         o.rotation = Quat(q[0] * scale, q[1] * scale, q[2] * scale, q[3] * scale);
     }
     if (const auto it = j.find("stiffness"); it != j.end()) {
-        o.material.stiffness = number(w, *it, path + ".stiffness");
-        positive(w, o.material.stiffness, path + ".stiffness", "stiffness (N/m)");
+        o.material.stiffness = number(w, *it, path / "stiffness");
+        positive(w, o.material.stiffness, path / "stiffness", "stiffness (N/m)");
     }
     if (const auto it = j.find("friction"); it != j.end()) {
-        const auto f = numbers<2>(w, *it, path + ".friction");
-        for (int i = 0; i < 2; ++i) {
+        const auto f = numbers<2>(w, *it, path / "friction");
+        for (std::size_t i = 0; i < 2; ++i) {
             if (f[i] < 0.0) {
-                w.fail(path + ".friction[" + std::to_string(i) + "]",
-                       "a friction coefficient must be >= 0");
+                w.fail((path / "friction")[i], "a friction coefficient must be >= 0");
             }
         }
         if (f[1] > f[0]) {
-            w.fail(path + ".friction",
+            w.fail(path / "friction",
                    "the dynamic coefficient (second) must not exceed the static one (first)");
         }
         o.material.staticFriction = f[0];
@@ -184,16 +204,17 @@ SceneObject parseObject(const Where& w, const Json& j, const std::string& path) 
 }
 
 Aabb parseBounds(const Where& w, const Json& j) {
+    const Path top;
+    const Path path = top / "bounds";
     if (!j.is_object()) {
-        w.fail("bounds", "expected an object {\"min\": [x,y,z], \"max\": [x,y,z]}, got " +
-                             typeName(j));
+        w.fail(path, "expected an object {\"min\": [x,y,z], \"max\": [x,y,z]}, got " + typeName(j));
     }
-    checkKeys(w, j, "bounds", {"min", "max"});
-    Aabb b{vec3(w, required(w, j, "bounds", "min"), "bounds.min"),
-           vec3(w, required(w, j, "bounds", "max"), "bounds.max")};
+    checkKeys(w, j, path, {"min", "max"});
+    Aabb b{vec3(w, required(w, j, path, "min"), path / "min"),
+           vec3(w, required(w, j, path, "max"), path / "max")};
     for (int i = 0; i < 3; ++i) {
         if (!(b.min[i] < b.max[i])) {
-            w.fail("bounds", "min must be < max on every axis (axis " + std::to_string(i) + ")");
+            w.fail(path, "min must be < max on every axis (axis " + std::to_string(i) + ")");
         }
     }
     return b;
@@ -235,6 +256,8 @@ void appendVec(std::string& out, const double* v, int n) {
 
 Scene parseScene(std::string_view text, std::string_view sourceName) {
     const Where w(sourceName);
+    const Path top;
+    const Path objectsPath = top / "objects";
     std::vector<SceneObject> objects;
     std::string topKey;
     bool inObjects = false;
@@ -261,8 +284,7 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
         case Json::parse_event_t::object_end:
         case Json::parse_event_t::value:
             if (inObjects && depth == 2) {
-                objects.push_back(
-                    parseObject(w, parsed, "objects[" + std::to_string(objects.size()) + "]"));
+                objects.push_back(parseObject(w, parsed, objectsPath[objects.size()]));
                 return false; // converted; drop the JSON
             }
             return true;
@@ -288,24 +310,25 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
     }
 
     if (!root.is_object()) {
-        w.fail("", "expected a JSON object with \"format\": \"hapto-scene\", got " + typeName(root));
+        w.fail(top,
+               "expected a JSON object with \"format\": \"hapto-scene\", got " + typeName(root));
     }
-    checkKeys(w, root, "", {"format", "version", "bounds", "objects"});
-    const Json& format = required(w, root, "", "format");
+    checkKeys(w, root, top, {"format", "version", "bounds", "objects"});
+    const Json& format = required(w, root, top, "format");
     if (!format.is_string() || format.get<std::string>() != "hapto-scene") {
-        w.fail("format", "expected \"hapto-scene\", got " + format.dump());
+        w.fail(top / "format", "expected \"hapto-scene\", got " + format.dump());
     }
-    const Json& version = required(w, root, "", "version");
+    const Json& version = required(w, root, top, "version");
     if (!version.is_number_integer() || version.get<std::int64_t>() != kSceneFormatVersion) {
-        w.fail("version", "this build reads version " + std::to_string(kSceneFormatVersion) +
-                              ", got " + version.dump());
+        w.fail(top / "version", "this build reads version " + std::to_string(kSceneFormatVersion) +
+                                    ", got " + version.dump());
     }
     const auto objectsIt = root.find("objects");
     if (objectsIt == root.end()) {
-        w.fail("", "missing required field 'objects' (an array, possibly empty)");
+        w.fail(top, "missing required field 'objects' (an array, possibly empty)");
     }
     if (!objectsIt->is_array()) {
-        w.fail("objects", "expected an array, got " + typeName(*objectsIt));
+        w.fail(objectsPath, "expected an array, got " + typeName(*objectsIt));
     }
 
     // Duplicate ids, named by both places.
@@ -318,7 +341,7 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
         std::sort(ids.begin(), ids.end());
         for (std::size_t i = 1; i < ids.size(); ++i) {
             if (ids[i].first == ids[i - 1].first) {
-                w.fail("objects[" + std::to_string(ids[i].second) + "].id",
+                w.fail(objectsPath[ids[i].second] / "id",
                        "duplicate id " + std::to_string(ids[i].first) + " (also at objects[" +
                            std::to_string(ids[i - 1].second) + "])");
             }

@@ -60,8 +60,8 @@ void printInfo(const Scene& scene, const std::string& source, double loadSeconds
     if (scene.size() > 0) {
         std::printf("ids:      %u .. %u\n", minId, maxId);
     }
-    std::printf("bounds:   [%.4f, %.4f, %.4f] .. [%.4f, %.4f, %.4f] m\n", b.min.x, b.min.y,
-                b.min.z, b.max.x, b.max.y, b.max.z);
+    std::printf("bounds:   [%.4f, %.4f, %.4f] .. [%.4f, %.4f, %.4f] m\n", b.min.x, b.min.y, b.min.z,
+                b.max.x, b.max.y, b.max.z);
     std::printf("loaded in %.3f s\n", loadSeconds);
 }
 
@@ -78,12 +78,15 @@ void addSceneCommands(CLI::App& app) {
                     "larger than the lattice");
         auto opt = std::make_shared<LatticeOptions>();
         auto out = std::make_shared<std::string>();
-        cmd->add_option("--per-side", opt->perSide, "K, cubes per lattice side")->required()
+        cmd->add_option("--per-side", opt->perSide, "K, cubes per lattice side")
+            ->required()
             ->check(CLI::Range(1, 100000));
-        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")->capture_default_str()
+        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
+            ->capture_default_str()
             ->check(CLI::PositiveNumber);
         cmd->add_option("--gap", opt->gap, "Free space between neighbouring cubes (m)")
-            ->capture_default_str()->check(CLI::NonNegativeNumber);
+            ->capture_default_str()
+            ->check(CLI::NonNegativeNumber);
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();
         cmd->callback([opt, out] { writeScene(makeLatticeScene(*opt), *out); });
@@ -100,13 +103,16 @@ void addSceneCommands(CLI::App& app) {
         cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
             ->capture_default_str();
         cmd->add_option("--workspace", opt->workspace, "Edge of the work cube (m)")
-            ->capture_default_str()->check(CLI::PositiveNumber);
-        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")->capture_default_str()
+            ->capture_default_str()
+            ->check(CLI::PositiveNumber);
+        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
+            ->capture_default_str()
             ->check(CLI::PositiveNumber);
         cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
         cmd->add_option("--keep-clear", opt->keepClear,
                         "No object within this distance of the centre, where cursors start (m)")
-            ->capture_default_str()->check(CLI::NonNegativeNumber);
+            ->capture_default_str()
+            ->check(CLI::NonNegativeNumber);
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();
         cmd->callback([opt, count, out] {
@@ -123,16 +129,20 @@ void addSceneCommands(CLI::App& app) {
         auto count = std::make_shared<std::string>();
         auto out = std::make_shared<std::string>();
         cmd->add_option("--count", *count, "Number of cubes (e.g. 1e5)")->required();
-        cmd->add_option("--clusters", opt->clusters, "Number of clusters")->capture_default_str()
+        cmd->add_option("--clusters", opt->clusters, "Number of clusters")
+            ->capture_default_str()
             ->check(CLI::Range(1, 1000000));
         cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
             ->capture_default_str();
         cmd->add_option("--workspace", opt->workspace, "Edge of the work cube (m)")
-            ->capture_default_str()->check(CLI::PositiveNumber);
-        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")->capture_default_str()
+            ->capture_default_str()
+            ->check(CLI::PositiveNumber);
+        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
+            ->capture_default_str()
             ->check(CLI::PositiveNumber);
         cmd->add_option("--spread", opt->spread, "Standard deviation of each cluster (m)")
-            ->capture_default_str()->check(CLI::NonNegativeNumber);
+            ->capture_default_str()
+            ->check(CLI::NonNegativeNumber);
         cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();

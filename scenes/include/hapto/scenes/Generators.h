@@ -13,34 +13,34 @@ Material generatedMaterial();
 
 /// Experiment 1: K x K x K cubes on a regular lattice centred on the origin.
 struct LatticeOptions {
-    int perSide = 3;         ///< K, cubes per lattice side (>= 1).
-    double cubeSize = 0.05;  ///< Cube edge (m); the paper's e-Touch boxes are 5 cm.
-    double gap = 0.01;       ///< Free space between neighbouring cubes (m).
+    int perSide = 3;        ///< K, cubes per lattice side (>= 1).
+    double cubeSize = 0.05; ///< Cube edge (m); the paper's e-Touch boxes are 5 cm.
+    double gap = 0.01;      ///< Free space between neighbouring cubes (m).
 };
 /// Bounds are the lattice padded by half a gap on every side. [control]
 Scene makeLatticeScene(const LatticeOptions& options);
 
 /// Experiment 2: cubes placed uniformly at random in a work cube centred on the origin.
 struct RandomOptions {
-    std::size_t count = 200;   ///< Number of cubes.
-    std::uint64_t seed = 1;    ///< Same seed and options, same scene.
-    double workspace = 0.25;   ///< Edge of the work cube (m); cube centres stay inside it.
-    double cubeSize = 0.05;    ///< Cube edge (m).
-    bool rotate = false;       ///< Give each cube a uniformly random orientation.
-    double keepClear = 0.0;    ///< No object within this distance of the centre (m).
+    std::size_t count = 200; ///< Number of cubes.
+    std::uint64_t seed = 1;  ///< Same seed and options, same scene.
+    double workspace = 0.25; ///< Edge of the work cube (m); cube centres stay inside it.
+    double cubeSize = 0.05;  ///< Cube edge (m).
+    bool rotate = false;     ///< Give each cube a uniformly random orientation.
+    double keepClear = 0.0;  ///< No object within this distance of the centre (m).
 };
 /// Bounds are the work cube. Throws InputError when keepClear leaves no room. [control]
 Scene makeRandomScene(const RandomOptions& options);
 
 /// A strongly non-uniform scene: cubes in Gaussian clusters.
 struct ClusterOptions {
-    std::size_t count = 1000;  ///< Number of cubes.
-    int clusters = 8;          ///< Number of Gaussian clusters (>= 1).
-    std::uint64_t seed = 1;    ///< Same seed and options, same scene.
-    double workspace = 0.25;   ///< Edge of the work cube (m); centres are clamped into it.
-    double cubeSize = 0.005;   ///< Cube edge (m).
-    double spread = 0.01;      ///< Standard deviation of each cluster (m).
-    bool rotate = false;       ///< Random orientations.
+    std::size_t count = 1000; ///< Number of cubes.
+    int clusters = 8;         ///< Number of Gaussian clusters (>= 1).
+    std::uint64_t seed = 1;   ///< Same seed and options, same scene.
+    double workspace = 0.25;  ///< Edge of the work cube (m); centres are clamped into it.
+    double cubeSize = 0.005;  ///< Cube edge (m).
+    double spread = 0.01;     ///< Standard deviation of each cluster (m).
+    bool rotate = false;      ///< Random orientations.
 };
 /// Bounds are the work cube. [control]
 Scene makeClusterScene(const ClusterOptions& options);

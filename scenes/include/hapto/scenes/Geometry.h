@@ -8,8 +8,10 @@
 
 namespace hapto {
 
-using Vec3 = glm::dvec3; ///< A point or vector in metres (or N for forces), world frame unless named.
-using Quat = glm::dquat; ///< A unit quaternion; GLM stores it (x, y, z, w), constructs it (w, x, y, z).
+using Vec3 =
+    glm::dvec3; ///< A point or vector in metres (or N for forces), world frame unless named.
+using Quat =
+    glm::dquat; ///< A unit quaternion; GLM stores it (x, y, z, w), constructs it (w, x, y, z).
 using Mat3 = glm::dmat3; ///< A 3x3 matrix, column-major (GLM).
 
 /// An axis-aligned box [min, max] in metres. An empty box has min > max.

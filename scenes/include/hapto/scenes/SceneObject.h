@@ -34,12 +34,12 @@ struct Material {
 
 /// An oriented box or a sphere, in world coordinates (m).
 struct SceneObject {
-    ObjectId id = 0;               ///< Unique id within the scene.
-    Shape shape = Shape::Box;      ///< Box or sphere.
-    Vec3 center{0.0};              ///< Centre (m).
-    Vec3 halfExtents{0.0};         ///< Box: half size per own axis (m). Sphere: radius, thrice.
-    Quat rotation{1, 0, 0, 0};     ///< Orientation, unit quaternion (w, x, y, z).
-    Material material{};           ///< Stiffness and friction.
+    ObjectId id = 0;           ///< Unique id within the scene.
+    Shape shape = Shape::Box;  ///< Box or sphere.
+    Vec3 center{0.0};          ///< Centre (m).
+    Vec3 halfExtents{0.0};     ///< Box: half size per own axis (m). Sphere: radius, thrice.
+    Quat rotation{1, 0, 0, 0}; ///< Orientation, unit quaternion (w, x, y, z).
+    Material material{};       ///< Stiffness and friction.
 
     /// Sphere radius (m); for a box, the radius of its bounding sphere. [any thread]
     double radius() const;
