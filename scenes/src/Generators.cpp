@@ -136,6 +136,22 @@ Scene makeClusterScene(const ClusterOptions& opt) {
     return Scene({Vec3(-w), Vec3(w)}, std::move(objects));
 }
 
+Scene makeGraspScene() {
+    Material rubbery = generatedMaterial();
+    rubbery.staticFriction = 0.6;
+    rubbery.dynamicFriction = 0.5;
+    const Material m = generatedMaterial();
+    std::vector<SceneObject> objects{
+        makeBox(0, Vec3(-0.05, -0.075, 0.0), Vec3(0.025), Quat(1, 0, 0, 0), rubbery),
+        makeBox(1, Vec3(0.0, -0.09, 0.0), Vec3(0.005, 0.01, 0.04), Quat(1, 0, 0, 0), m),
+        makeBox(2, Vec3(-0.05, -0.075, 0.08), Vec3(0.025), Quat(1, 0, 0, 0), m),
+        makeBox(3, Vec3(-0.05, -0.075, -0.08), Vec3(0.025), Quat(1, 0, 0, 0), m),
+        makeSphere(4, Vec3(0.10, -0.08, -0.08), 0.02, m),
+        makeBox(5, Vec3(0.12, -0.05, 0.06), Vec3(0.02, 0.05, 0.02), Quat(1, 0, 0, 0), m),
+    };
+    return Scene({Vec3(-0.15, -0.10, -0.15), Vec3(0.15, 0.15, 0.15)}, std::move(objects));
+}
+
 Scene makeDefaultScene() {
     RandomOptions opt;
     opt.count = 200;

@@ -45,6 +45,11 @@ struct ClusterOptions {
 /// Bounds are the work cube. [control]
 Scene makeClusterScene(const ClusterOptions& options);
 
+/// The two-handed grasp demo (y is up; the floor is the bounds' lowest y, -0.10 m): a rubbery
+/// 5 cm cube (id 0, mu_s 0.6, mu_d 0.5) resting on the floor at x = -0.05 m, a low bar (id 1,
+/// 2 cm high) in the path of a 10 cm carry along +x, and four more objects around (ids 2-5).
+Scene makeGraspScene();
+
 /// The embedded default scene: the paper's experiment 2 set-up, 200 random 5 cm cubes in a
 /// 25 cm cube (seed 2004), with a 4 cm clear region around the centre where cursors start.
 Scene makeDefaultScene();

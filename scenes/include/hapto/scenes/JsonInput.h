@@ -1,0 +1,109 @@
+#pragma once
+/// Reading hapto's JSON input files (scenes, device configurations) with messages that name the
+/// file and the JSON path of every bad value. For hapto's own loaders; all [control].
+
+#include "hapto/scenes/Geometry.h"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <initializer_list>
+#include <limits>
+#include <string>
+#include <string_view>
+
+namespace hapto::json {
+
+using Json = nlohmann::json;
+
+/// A JSON path such as `objects[12].half_extents[1]`, built only when a message needs it: each
+/// level points at its parent on the stack, so a valid file costs no string work.
+struct Path {
+    const Path* parent = nullptr; ///< The enclosing level, or none at the top.
+    const char* key = nullptr;    ///< A field name (must outlive the Path), or
+    long index = -1;              ///< an array index.
+
+    /// The field `k` of this level.
+    Path operator/(const char* k) const { return {this, k, -1}; }
+    /// The element `i` of this level.
+    Path operator[](std::size_t i) const { return {this, nullptr, static_cast<long>(i)}; }
+    /// The path as text ("" at the top).
+    std::string str() const;
+};
+
+/// Where input comes from: every failure becomes an InputError "source: path: what".
+class Source {
+public:
+    /// `name` names the file (or stream) in messages; it must outlive the Source.
+    explicit Source(std::string_view name) : mName(name) {}
+    /// Throws InputError "name: path: what" ("(top level)" for the empty path).
+    [[noreturn]] void fail(const Path& path, const std::string& what) const;
+    /// The source's name.
+    std::string_view name() const { return mName; }
+
+private:
+    std::string_view mName;
+};
+
+/// Parses JSON text; a syntax error becomes "name:line:column: not valid JSON: ...".
+/// `callback` is nlohmann's parser callback (may be empty). [control]
+Json parseText(std::string_view text, const Source& source,
+               const Json::parser_callback_t& callback = nullptr);
+/// Reads a whole file; throws InputError naming it when it cannot be opened or read. [control]
+std::string readFile(const std::filesystem::path& path, std::string_view what);
+
+/// "a number", "an integer", "a string", "an array", ... for messages.
+std::string typeName(const Json& j);
+/// A number in shortest form for messages.
+std::string show(double v);
+
+/// A finite number.
+double number(const Source& s, const Json& j, const Path& path);
+/// A finite number with lo < v (strictLow) or lo <= v, and v <= hi; `what` names it.
+double ranged(const Source& s, const Json& j, const Path& path, double lo, double hi,
+              bool strictLow, const char* what);
+/// Checks an already read value the same way.
+void checkRange(const Source& s, double v, const Path& path, double lo, double hi, bool strictLow,
+                const char* what);
+/// An integer in lo..hi.
+std::int64_t integer(const Source& s, const Json& j, const Path& path, std::int64_t lo,
+                     std::int64_t hi);
+/// A string.
+std::string string(const Source& s, const Json& j, const Path& path);
+/// true or false.
+bool boolean(const Source& s, const Json& j, const Path& path);
+/// An array of exactly N finite numbers.
+template <std::size_t N>
+std::array<double, N> numbers(const Source& s, const Json& j, const Path& path) {
+    if (!j.is_array() || j.size() != N) {
+        s.fail(path, "expected an array of " + std::to_string(N) + " numbers, got " +
+                         (j.is_array() ? "an array of " + std::to_string(j.size()) : typeName(j)));
+    }
+    std::array<double, N> out{};
+    for (std::size_t i = 0; i < N; ++i) {
+        out[i] = number(s, j[i], path[i]);
+    }
+    return out;
+}
+/// [x, y, z].
+Vec3 vec3(const Source& s, const Json& j, const Path& path);
+/// A unit quaternion [w, x, y, z], within 1e-3 of unit length; normalised (a quaternion
+/// written from a normalised one reads back bit for bit).
+Quat quaternion(const Source& s, const Json& j, const Path& path);
+
+/// Checks that `j` is an object.
+const Json& object(const Source& s, const Json& j, const Path& path);
+/// Refuses fields not in `allowed`, listing the allowed ones.
+void checkKeys(const Source& s, const Json& obj, const Path& path,
+               std::initializer_list<std::string_view> allowed);
+/// The field, or a "missing required field" failure.
+const Json& required(const Source& s, const Json& obj, const Path& path, const char* key);
+/// The field, or nullptr.
+const Json* optional(const Json& obj, const char* key);
+
+/// +infinity, for open upper ranges.
+inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+
+} // namespace hapto::json

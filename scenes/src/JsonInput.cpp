@@ -1,0 +1,209 @@
+#include "hapto/scenes/JsonInput.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace hapto::json {
+
+std::string Path::str() const {
+    std::string head = parent ? parent->str() : std::string();
+    if (key) {
+        return head.empty() ? std::string(key) : head + "." + key;
+    }
+    if (index >= 0) {
+        return head + "[" + std::to_string(index) + "]";
+    }
+    return head;
+}
+
+void Source::fail(const Path& path, const std::string& what) const {
+    const std::string p = path.str();
+    throw InputError(std::string(mName) + ": " + (p.empty() ? "(top level)" : p) + ": " + what);
+}
+
+namespace {
+
+// Line and column (1-based) of a byte offset, for syntax errors.
+std::pair<std::size_t, std::size_t> lineColumn(std::string_view text, std::size_t byte) {
+    byte = std::min(byte, text.size());
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i < byte; ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            col = 1;
+        } else {
+            ++col;
+        }
+    }
+    return {line, col};
+}
+
+} // namespace
+
+Json parseText(std::string_view text, const Source& source,
+               const Json::parser_callback_t& callback) {
+    try {
+        return Json::parse(text.begin(), text.end(), callback);
+    } catch (const Json::parse_error& e) {
+        const auto [line, col] = lineColumn(text, e.byte == 0 ? 0 : e.byte - 1);
+        std::string what = e.what();
+        // Drop nlohmann's "[json.exception.parse_error.101] parse error at line 1, column 2: ".
+        if (const auto p = what.find(": "); p != std::string::npos && what.rfind("[json", 0) == 0) {
+            what = what.substr(p + 2);
+        }
+        throw InputError(std::string(source.name()) + ":" + std::to_string(line) + ":" +
+                         std::to_string(col) + ": not valid JSON: " + what);
+    } catch (const Json::exception& e) {
+        throw InputError(std::string(source.name()) + ": not valid JSON: " + e.what());
+    }
+}
+
+std::string readFile(const std::filesystem::path& path, std::string_view what) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        throw InputError(path.string() + ": cannot open the " + std::string(what) +
+                         " (does it exist?)");
+    }
+    std::string text;
+    in.seekg(0, std::ios::end);
+    const auto size = in.tellg();
+    if (size < 0) {
+        throw InputError(path.string() + ": cannot read the " + std::string(what));
+    }
+    text.resize(static_cast<std::size_t>(size));
+    in.seekg(0);
+    in.read(text.data(), size);
+    if (!in) {
+        throw InputError(path.string() + ": cannot read the " + std::string(what));
+    }
+    return text;
+}
+
+std::string typeName(const Json& j) {
+    if (j.is_number_float()) {
+        return "a number";
+    }
+    if (j.is_number()) {
+        return "an integer";
+    }
+    const std::string t = j.type_name();
+    return (t == "array" || t == "object") ? "an " + t : "a " + t;
+}
+
+std::string show(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+double number(const Source& s, const Json& j, const Path& path) {
+    if (!j.is_number()) {
+        s.fail(path, "expected a number, got " + typeName(j));
+    }
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) {
+        s.fail(path, "expected a finite number");
+    }
+    return v;
+}
+
+void checkRange(const Source& s, double v, const Path& path, double lo, double hi, bool strictLow,
+                const char* what) {
+    if (strictLow ? !(v > lo) : !(v >= lo)) {
+        s.fail(path, std::string(what) + " must be " + (strictLow ? "> " : ">= ") + show(lo) +
+                         " (got " + show(v) + ")");
+    }
+    if (v > hi) {
+        s.fail(path, std::string(what) + " must be <= " + show(hi) + " (got " + show(v) + ")");
+    }
+}
+
+double ranged(const Source& s, const Json& j, const Path& path, double lo, double hi,
+              bool strictLow, const char* what) {
+    const double v = number(s, j, path);
+    checkRange(s, v, path, lo, hi, strictLow, what);
+    return v;
+}
+
+std::int64_t integer(const Source& s, const Json& j, const Path& path, std::int64_t lo,
+                     std::int64_t hi) {
+    if (!j.is_number_integer()) {
+        s.fail(path, "expected an integer, got " + typeName(j));
+    }
+    const bool tooBig =
+        j.is_number_unsigned() && j.get<std::uint64_t>() > static_cast<std::uint64_t>(hi);
+    if (tooBig || j.get<std::int64_t>() < lo || j.get<std::int64_t>() > hi) {
+        s.fail(path, "must be in " + std::to_string(lo) + ".." + std::to_string(hi) + " (got " +
+                         j.dump() + ")");
+    }
+    return j.get<std::int64_t>();
+}
+
+std::string string(const Source& s, const Json& j, const Path& path) {
+    if (!j.is_string()) {
+        s.fail(path, "expected a string, got " + typeName(j));
+    }
+    return j.get<std::string>();
+}
+
+bool boolean(const Source& s, const Json& j, const Path& path) {
+    if (!j.is_boolean()) {
+        s.fail(path, "expected true or false, got " + typeName(j));
+    }
+    return j.get<bool>();
+}
+
+Vec3 vec3(const Source& s, const Json& j, const Path& path) {
+    const auto a = numbers<3>(s, j, path);
+    return {a[0], a[1], a[2]};
+}
+
+Quat quaternion(const Source& s, const Json& j, const Path& path) {
+    const auto q = numbers<4>(s, j, path);
+    const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (std::abs(len - 1.0) > 1e-3) {
+        s.fail(path, "must be a unit quaternion (w, x, y, z); its length is " + show(len));
+    }
+    const double scale = std::abs(len - 1.0) < 1e-9 ? 1.0 : 1.0 / len;
+    return Quat(q[0] * scale, q[1] * scale, q[2] * scale, q[3] * scale);
+}
+
+const Json& object(const Source& s, const Json& j, const Path& path) {
+    if (!j.is_object()) {
+        s.fail(path, "expected an object, got " + typeName(j));
+    }
+    return j;
+}
+
+void checkKeys(const Source& s, const Json& obj, const Path& path,
+               std::initializer_list<std::string_view> allowed) {
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+        if (std::find(allowed.begin(), allowed.end(), std::string_view(it.key())) ==
+            allowed.end()) {
+            std::string list;
+            for (const auto a : allowed) {
+                list += (list.empty() ? "" : ", ") + std::string(a);
+            }
+            s.fail(path, "unknown field '" + it.key() + "' (expected one of: " + list + ")");
+        }
+    }
+}
+
+const Json& required(const Source& s, const Json& obj, const Path& path, const char* key) {
+    const auto it = obj.find(key);
+    if (it == obj.end()) {
+        s.fail(path, std::string("missing required field '") + key + "'");
+    }
+    return *it;
+}
+
+const Json* optional(const Json& obj, const char* key) {
+    const auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+}
+
+} // namespace hapto::json
