@@ -1,0 +1,62 @@
+#pragma once
+/// A per-thread cursor into a spatial index that remembers the leaf it found last.
+///
+/// Design note. The idea: a haptic pointer moves at most a millimetre or so per servo tick,
+/// so it nearly always stays in the leaf it was in, and otherwise moves to a neighbour. The
+/// cursor keeps that leaf's box (lo, hiOpen) in its own cache line: the common case is six
+/// compares. When the point has left, the index is asked to walk from the old leaf
+/// (`SpatialIndex::locateFrom`): through neighbour links across faces, then down to a leaf.
+/// Invariant: after every locate, the cached leaf is exactly the leaf a fresh locate from the
+/// root gives (same half-open convention: ties on a shared face go to the upper leaf).
+/// Cost: O(1) while inside the leaf; O(1) links plus the descent into a finer neighbour when
+/// crossing a face; never more steps than climbing to the common ancestor. Why: crossing a
+/// faces (one per axis on which the point is in the next leaf-sized cell) lands on a node N
+/// that holds the point but not the old leaf A, so N lies strictly below the common ancestor
+/// C, and links cost a + depth(B) - depth(N) <= a - 1 + depth(B) - depth(C) while climbing
+/// costs k + depth(B) - depth(C) with k = depth(A) - depth(C) >= 1. So links win for a <= 2,
+/// and for a = 3 when k >= 2; otherwise (or for longer jumps) the octree climbs.
+
+#include "hapto/index/SpatialIndex.h"
+
+#include <cstdint>
+
+namespace hapto {
+
+/// A per-thread, heap-free cursor caching its current leaf (one 64-byte cache line).
+class alignas(64) Cursor {
+public:
+    /// An unbound cursor: locate returns "outside". [any thread]
+    Cursor() noexcept;
+    /// A cursor over an index (which must outlive it). [any thread]
+    explicit Cursor(const SpatialIndex& index,
+                    CursorStrategy strategy = CursorStrategy::NeighbourLinks) noexcept;
+
+    /// Rebinds to another index (the world snapshot changed) and forgets the leaf; keeps the
+    /// strategy. No allocation. [servo]
+    void reset(const SpatialIndex& index) noexcept;
+    /// The leaf holding the point and its candidates; "outside" (no candidates) for a point
+    /// outside the bounds, after which the cursor recovers when the point comes back. [servo]
+    LocateResult locate(const Vec3& point) noexcept;
+
+    /// Changes the strategy used when the point leaves the cached leaf. [servo]
+    void setStrategy(CursorStrategy strategy) noexcept { mStrategy = strategy; }
+    /// The strategy. [servo]
+    CursorStrategy strategy() const noexcept { return mStrategy; }
+    /// The cached leaf, or kNoLeaf. [servo]
+    std::uint32_t leaf() const noexcept { return mLeaf; }
+    /// The index it is bound to, or nullptr. [servo]
+    const SpatialIndex* index() const noexcept { return mIndex; }
+
+private:
+    void forget() noexcept;
+
+    Vec3 mLo;     // cached leaf box, lower corner (inclusive)
+    Vec3 mHiOpen; // upper corner (exclusive; nudged up on the bounds' faces)
+    const SpatialIndex* mIndex = nullptr;
+    std::uint32_t mLeaf = kNoLeaf;
+    CursorStrategy mStrategy = CursorStrategy::NeighbourLinks;
+};
+
+static_assert(sizeof(Cursor) == 64, "a cursor is exactly one cache line");
+
+} // namespace hapto

@@ -1,0 +1,45 @@
+#pragma once
+/// Which index to build, parsed from a short text such as "grid:5" or "octree:2:0.005:aabb".
+
+#include "hapto/index/Overlap.h"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace hapto {
+
+/// Which index and with which parameters: `brute`, `grid:N` or `octree:M:MIN` (MIN in metres),
+/// each optionally followed by `:aabb` (place objects by their AABB instead of their OBB).
+struct IndexSpec {
+    /// The three indices.
+    enum class Kind : std::uint8_t { BruteForce, Grid, Octree };
+
+    static constexpr int kMaxGridCells = 256;       ///< Largest n of an n^3 grid.
+    static constexpr int kMaxLeafObjects = 1 << 20; ///< Largest M of an octree.
+
+    Kind kind = Kind::BruteForce; ///< Which index.
+    int gridCells = 0;            ///< Grid only: n, cells per side (1..kMaxGridCells).
+    int maxObjects = 0;           ///< Octree only: M, objects a leaf may hold above min size.
+    double minLeafSize = 0.0;     ///< Octree only: minimum leaf edge (m), > 0.
+    OverlapMode mode = OverlapMode::Obb; ///< How objects are placed into cells.
+
+    /// The brute-force "index" (every object is a candidate). [any thread]
+    static IndexSpec brute();
+    /// An n x n x n grid. [any thread]
+    static IndexSpec grid(int cells, OverlapMode mode = OverlapMode::Obb);
+    /// The paper's modified octree: at most M objects per leaf unless at minimum size (m).
+    /// [any thread]
+    static IndexSpec octree(int maxObjects, double minLeafSize,
+                            OverlapMode mode = OverlapMode::Obb);
+
+    /// Parses "brute", "grid:5", "octree:2:0.005", each optionally with ":aabb" (or ":obb").
+    /// Throws InputError saying what is wrong and what is expected. [any thread]
+    static IndexSpec parse(std::string_view text);
+    /// The text form; parse(toString()) gives this spec back. [any thread]
+    std::string toString() const;
+
+    bool operator==(const IndexSpec&) const = default;
+};
+
+} // namespace hapto

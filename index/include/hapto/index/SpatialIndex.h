@@ -1,0 +1,88 @@
+#pragma once
+/// The query interface shared by every spatial index, and the function that builds one.
+///
+/// An index is built once on a control thread and never changes afterwards: every query is
+/// `const`, allocates nothing, and is safe from any number of threads at once. Queries hand
+/// back candidate *slots* (positions in `scene.objects()`), never copies.
+
+#include "hapto/index/IndexSpec.h"
+#include "hapto/index/IndexStats.h"
+#include "hapto/scenes/Scene.h"
+
+#include <cstdint>
+#include <memory>
+#include <span>
+
+namespace hapto {
+
+/// How a cursor finds the leaf of a point that left its cached leaf.
+enum class CursorStrategy : std::uint8_t {
+    FromRoot,      ///< Descend from the root every time (no cache).
+    Climb,         ///< Climb from the cached leaf to the first ancestor holding the point.
+    NeighbourLinks ///< Cross faces through neighbour links (falls back to Climb when that is
+                   ///< no shorter); the default.
+};
+
+/// "No leaf": the result of a point outside the bounds, or an unbound cursor.
+inline constexpr std::uint32_t kNoLeaf = 0xFFFFFFFFu;
+
+/// The answer to "which objects may touch this point".
+struct LocateResult {
+    std::span<const std::uint32_t> candidates; ///< Slots of the leaf's objects, ascending.
+    std::uint32_t leaf = kNoLeaf;              ///< Octree node, grid cell, or 0 (brute force).
+    std::uint32_t steps = 0; ///< Links followed (parent, child, neighbour) to get there.
+    bool outside = true;     ///< The point is outside the bounds: no candidates, except from
+                             ///< BruteForce, whose candidates are every object everywhere.
+};
+
+/// A spatial index over a static scene: immutable after build, all queries const.
+class SpatialIndex {
+public:
+    virtual ~SpatialIndex();
+    SpatialIndex(const SpatialIndex&) = delete;
+    SpatialIndex& operator=(const SpatialIndex&) = delete;
+
+    /// What was built. [any thread]
+    const IndexSpec& spec() const noexcept { return mSpec; }
+    /// Size, shape and build time. [any thread]
+    const IndexStats& stats() const noexcept { return mStats; }
+    /// The partitioned box, closed: the scene bounds, upper faces moved out by at most a few
+    /// ulps so that cell boundaries are exact (m). [any thread]
+    const Aabb& bounds() const noexcept { return mBounds; }
+    /// Number of objects in the scene it was built for. [any thread]
+    std::uint32_t objectCount() const noexcept { return mObjectCount; }
+    /// True when the point lies in the closed bounds (false for NaN). [servo]
+    bool inBounds(const Vec3& point) const noexcept;
+
+    /// The leaf holding the point, found from the root. [servo]
+    virtual LocateResult locate(const Vec3& point) const noexcept = 0;
+    /// The leaf holding the point, found from a previous leaf with a strategy. [servo]
+    virtual LocateResult locateFrom(std::uint32_t leaf, const Vec3& point,
+                                    CursorStrategy strategy) const noexcept = 0;
+    /// The objects of a leaf (slots, ascending). [servo]
+    virtual std::span<const std::uint32_t> leafObjects(std::uint32_t leaf) const noexcept = 0;
+    /// The closed box of a leaf (m). A point belongs to the leaf whose box holds it, with
+    /// ties on shared faces going to the upper leaf. [servo]
+    virtual Aabb leafBounds(std::uint32_t leaf) const noexcept = 0;
+
+protected:
+    /// Sets the spec, the bounds and the object count. [control]
+    SpatialIndex(const IndexSpec& spec, const Aabb& bounds, std::uint32_t objectCount);
+
+    IndexStats mStats; ///< Filled by the builder.
+
+private:
+    IndexSpec mSpec;
+    Aabb mBounds;
+    std::uint32_t mObjectCount;
+};
+
+/// Builds the index a spec asks for (in parallel, with TBB). Throws InputError for a spec
+/// that cannot be built (e.g. an octree that would need too many nodes). [control]
+std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec);
+
+/// The bounds an index partitions: the scene's, each upper face moved out by the few ulps
+/// needed so that min + (max - min) >= max in floating point. [any thread]
+Aabb partitionBounds(const Aabb& sceneBounds);
+
+} // namespace hapto

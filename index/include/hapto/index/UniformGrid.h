@@ -1,0 +1,54 @@
+#pragma once
+/// The paper's uniform n x n x n grid (section 2.1): O(1) lookup, each cell's objects one run.
+
+#include "hapto/index/SpatialIndex.h"
+
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace hapto {
+
+/// n^3 equal cells over the bounds; each object is listed in every cell its bounds overlap.
+/// Cell (ix, iy, iz) has id (iz * n + iy) * n + ix and spans [min + i * step, min + (i+1) *
+/// step] per axis, computed by that one formula everywhere, so shared faces are exact.
+class UniformGrid final : public SpatialIndex {
+public:
+    /// Builds the grid (TBB inside). [control]
+    static std::unique_ptr<UniformGrid> build(const Scene& scene, const IndexSpec& spec);
+
+    /// The cell holding the point, O(1). [servo]
+    LocateResult locate(const Vec3& point) const noexcept override;
+    /// Same as locate (the grid needs no walk). [servo]
+    LocateResult locateFrom(std::uint32_t leaf, const Vec3& point,
+                            CursorStrategy strategy) const noexcept override;
+    /// The objects of a cell (slots, ascending). [servo]
+    std::span<const std::uint32_t> leafObjects(std::uint32_t cell) const noexcept override;
+    /// The closed box of a cell (m). [servo]
+    Aabb leafBounds(std::uint32_t cell) const noexcept override;
+
+    /// n, cells per side. [any thread]
+    int cellsPerSide() const noexcept { return mN; }
+    /// n^3. [any thread]
+    std::uint32_t cellCount() const noexcept { return mN * mN * mN; }
+    /// The id of cell (ix, iy, iz). [any thread]
+    std::uint32_t cellId(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const noexcept {
+        return (iz * mN + iy) * mN + ix;
+    }
+    /// The cell index along one axis holding coordinate v (clamped into 0..n-1). [servo]
+    std::uint32_t cellIndex(double v, int axis) const noexcept;
+
+private:
+    UniformGrid(const IndexSpec& spec, const Aabb& bounds, const Vec3& step, std::uint32_t objects);
+    double coord(std::uint32_t i, int axis) const noexcept {
+        return bounds().min[axis] + static_cast<double>(i) * mStep[axis];
+    }
+
+    std::uint32_t mN;
+    Vec3 mStep;
+    Vec3 mInvStep;
+    std::vector<std::uint32_t> mCellStart; // n^3 + 1 offsets into mSlots (CSR)
+    std::vector<std::uint32_t> mSlots;
+};
+
+} // namespace hapto

@@ -1,0 +1,171 @@
+#include "hapto/index/UniformGrid.h"
+
+#include "BuildTimer.h"
+#include "Parallel.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace hapto {
+
+UniformGrid::UniformGrid(const IndexSpec& spec, const Aabb& bounds, const Vec3& step,
+                         std::uint32_t objects)
+    : SpatialIndex(spec, bounds, objects), mN(static_cast<std::uint32_t>(spec.gridCells)),
+      mStep(step), mInvStep(1.0 / step) {}
+
+std::uint32_t UniformGrid::cellIndex(double v, int axis) const noexcept {
+    const double t = std::floor((v - bounds().min[axis]) * mInvStep[axis]);
+    const double last = static_cast<double>(mN - 1);
+    std::uint32_t i = static_cast<std::uint32_t>(t < 0.0 ? 0.0 : t > last ? last : t);
+    // The multiplication may be off by an ulp; settle on the formula the cell boxes use.
+    if (i > 0 && v < coord(i, axis)) {
+        --i;
+    } else if (i + 1 < mN && v >= coord(i + 1, axis)) {
+        ++i;
+    }
+    return i;
+}
+
+std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexSpec& spec) {
+    if (spec.kind != IndexSpec::Kind::Grid || spec.gridCells < 1 ||
+        spec.gridCells > IndexSpec::kMaxGridCells) {
+        throw InputError("grid index: need 1 <= n <= " + std::to_string(IndexSpec::kMaxGridCells) +
+                         ", got " + spec.toString());
+    }
+    const BuildTimer timer;
+    const std::uint32_t n = static_cast<std::uint32_t>(spec.gridCells);
+    // Cell i spans [min + i * step, min + (i + 1) * step]; the step is nudged up until cell
+    // n - 1 reaches the scene's upper face, and the index's bounds end exactly there.
+    const Aabb& sb = scene.bounds();
+    Aabb bounds = sb;
+    Vec3 step;
+    for (int a = 0; a < 3; ++a) {
+        step[a] = (sb.max[a] - sb.min[a]) / n;
+        while (sb.min[a] + static_cast<double>(n) * step[a] < sb.max[a]) {
+            step[a] = std::nextafter(step[a], std::numeric_limits<double>::infinity());
+        }
+        bounds.max[a] = sb.min[a] + static_cast<double>(n) * step[a];
+    }
+    std::unique_ptr<UniformGrid> grid(new UniformGrid(spec, bounds, step, scene.size()));
+    const UniformGrid& g = *grid;
+
+    const std::uint32_t count = scene.size();
+    std::vector<OverlapShape> shapes(count);
+    parallel::forEach(0, count, 4096, [&](std::size_t i) {
+        shapes[i] = OverlapShape::of(scene.object(static_cast<std::uint32_t>(i)));
+    });
+
+    // The candidate cell range of an object: the cells its AABB reaches, widened by the
+    // overlap tolerance, plus the lower neighbour when that touches a cell's lower face
+    // exactly (closed cells share faces); overlaps() then decides cell by cell.
+    struct Range {
+        std::uint32_t lo[3], hi[3];
+        bool empty;
+    };
+    const auto rangeOf = [&](const OverlapShape& s) {
+        Range r{};
+        r.empty = !overlapsAabbAabb(s.aabb, g.bounds());
+        const double tol = overlapTolerance(s, OverlapCell::of(g.bounds()));
+        for (int a = 0; a < 3 && !r.empty; ++a) {
+            const double lo = s.aabb.min[a] - tol, hi = s.aabb.max[a] + tol;
+            r.lo[a] = g.cellIndex(lo, a);
+            if (r.lo[a] > 0 && lo <= g.coord(r.lo[a], a)) {
+                --r.lo[a];
+            }
+            r.hi[a] = g.cellIndex(hi, a);
+        }
+        return r;
+    };
+    const auto forEachCell = [&](std::uint32_t slot, auto&& visit) {
+        const OverlapShape& s = shapes[slot];
+        const Range r = rangeOf(s);
+        if (r.empty) {
+            return;
+        }
+        for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z) {
+            for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
+                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
+                    const std::uint32_t id = g.cellId(x, y, z);
+                    if (overlaps(s, g.leafBounds(id), spec.mode)) {
+                        visit(id);
+                    }
+                }
+            }
+        }
+    };
+
+    // Count, then write (cell, slot) pairs, sort them by cell, and cut them into runs.
+    std::vector<std::uint64_t> pairStart(std::size_t(count) + 1, 0);
+    parallel::forEach(0, count, 256, [&](std::size_t i) {
+        std::uint64_t c = 0;
+        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t) { ++c; });
+        pairStart[i + 1] = c;
+    });
+    for (std::size_t i = 0; i < count; ++i) {
+        pairStart[i + 1] += pairStart[i];
+    }
+    const std::uint64_t pairs = pairStart[count];
+    if (pairs >= std::numeric_limits<std::uint32_t>::max()) {
+        throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
+                         " object-cell pairs do not fit 32-bit offsets; use fewer cells");
+    }
+    std::vector<std::uint64_t> keys(pairs);
+    parallel::forEach(0, count, 256, [&](std::size_t i) {
+        std::uint64_t k = pairStart[i];
+        forEachCell(static_cast<std::uint32_t>(i),
+                    [&](std::uint32_t cell) { keys[k++] = (std::uint64_t(cell) << 32) | i; });
+    });
+    parallel::sort(keys.begin(), keys.end());
+    grid->mSlots.resize(pairs);
+    grid->mCellStart.assign(std::size_t(g.cellCount()) + 1, 0);
+    for (const std::uint64_t k : keys) {
+        ++grid->mCellStart[(k >> 32) + 1];
+    }
+    for (std::size_t c = 0; c < g.cellCount(); ++c) {
+        grid->mCellStart[c + 1] += grid->mCellStart[c];
+    }
+    parallel::forEach(0, pairs, 65536, [&](std::size_t i) {
+        grid->mSlots[i] = static_cast<std::uint32_t>(keys[i]);
+    });
+
+    IndexStats& st = grid->mStats;
+    st.nodes = g.cellCount();
+    std::vector<std::uint32_t> perCell(g.cellCount());
+    for (std::size_t c = 0; c < perCell.size(); ++c) {
+        perCell[c] = grid->mCellStart[c + 1] - grid->mCellStart[c];
+    }
+    st.recordLeaves(perCell);
+    st.bytes = (grid->mCellStart.size() + grid->mSlots.size()) * sizeof(std::uint32_t);
+    st.bytesPerObject = count == 0 ? 0.0 : static_cast<double>(st.bytes) / count;
+    timer.finish(st);
+    return grid;
+}
+
+LocateResult UniformGrid::locate(const Vec3& p) const noexcept {
+    if (!inBounds(p)) {
+        return {};
+    }
+    const std::uint32_t id = cellId(cellIndex(p.x, 0), cellIndex(p.y, 1), cellIndex(p.z, 2));
+    return {leafObjects(id), id, 0, false};
+}
+
+LocateResult UniformGrid::locateFrom(std::uint32_t, const Vec3& p, CursorStrategy) const noexcept {
+    return locate(p);
+}
+
+std::span<const std::uint32_t> UniformGrid::leafObjects(std::uint32_t cell) const noexcept {
+    return {mSlots.data() + mCellStart[cell], mCellStart[cell + 1] - mCellStart[cell]};
+}
+
+Aabb UniformGrid::leafBounds(std::uint32_t cell) const noexcept {
+    const std::uint32_t x = cell % mN, y = (cell / mN) % mN, z = cell / (mN * mN);
+    return {{coord(x, 0), coord(y, 1), coord(z, 2)},
+            {coord(x + 1, 0), coord(y + 1, 1), coord(z + 1, 2)}};
+}
+
+} // namespace hapto

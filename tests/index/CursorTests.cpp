@@ -1,0 +1,129 @@
+#include "IndexTestScenes.h"
+
+#include "hapto/index/Cursor.h"
+#include "hapto/index/Octree.h"
+
+#include <catch2/catch.hpp>
+
+using namespace hapto;
+using namespace hapto::test;
+
+namespace {
+
+// A hand-speed random walk: steps up to `maxStep` (m) in random directions, wandering out of
+// the bounds now and then; every `snapEvery` steps the point is snapped onto a cell plane of
+// the octree so faces, edges and corners are crossed exactly.
+std::vector<Vec3> randomWalk(const Aabb& b, std::uint64_t seed, int steps, double maxStep) {
+    Random rng(seed);
+    std::vector<Vec3> walk;
+    Vec3 p = b.center() +
+             0.3 * b.size() * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    Vec3 drift(0.0);
+    for (int i = 0; i < steps; ++i) {
+        const Vec3 d(rng.normal(), rng.normal(), rng.normal());
+        drift = 0.9 * drift + 0.1 * glm::normalize(d);
+        const Vec3 dir = glm::length(drift) > 1e-12 ? glm::normalize(drift) : Vec3(1, 0, 0);
+        p += dir * rng.uniform(0.0, maxStep);
+        for (int a = 0; a < 3; ++a) { // wander up to 2 cm outside, then come back
+            if (p[a] > b.max[a] + 0.02 || p[a] < b.min[a] - 0.02) {
+                drift[a] = -drift[a];
+                p[a] = std::clamp(p[a], b.min[a] - 0.02, b.max[a] + 0.02);
+            }
+        }
+        Vec3 q = p;
+        if (i % 7 == 0) {
+            const int a = static_cast<int>(rng.below(3));
+            const double cell = b.size()[a] / 64;
+            q[a] = b.min[a] + std::round((q[a] - b.min[a]) / cell) * cell;
+        }
+        walk.push_back(q);
+    }
+    return walk;
+}
+
+} // namespace
+
+TEST_CASE("a cursor on a long hand-speed walk lands where a fresh locate does; links never "
+          "take more steps than climbing") {
+    for (const auto& [name, scene] : testScenes()) {
+        for (const IndexSpec& spec :
+             {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001), IndexSpec::grid(5),
+              IndexSpec::octree(3, 0.002, OverlapMode::Aabb), IndexSpec::brute()}) {
+            INFO(name << " " << spec.toString());
+            const auto index = buildIndex(scene, spec);
+            Cursor links(*index, CursorStrategy::NeighbourLinks);
+            Cursor climb(*index, CursorStrategy::Climb);
+            Cursor root(*index, CursorStrategy::FromRoot);
+            std::uint64_t linkSteps = 0, climbSteps = 0, rootSteps = 0, moves = 0, outside = 0;
+            std::size_t wrong = 0, worse = 0;
+            for (const Vec3& p : randomWalk(scene.bounds(), 17, 20000, 0.001)) {
+                const LocateResult fresh = index->locate(p);
+                const LocateResult a = links.locate(p), b = climb.locate(p), c = root.locate(p);
+                wrong += a.leaf != fresh.leaf || b.leaf != fresh.leaf || c.leaf != fresh.leaf ||
+                         a.outside != fresh.outside ||
+                         a.candidates.data() != fresh.candidates.data() ||
+                         a.candidates.size() != fresh.candidates.size();
+                worse += a.steps > b.steps;
+                linkSteps += a.steps;
+                climbSteps += b.steps;
+                rootSteps += c.steps;
+                moves += a.steps > 0;
+                outside += fresh.outside;
+            }
+            CHECK(wrong == 0);
+            CHECK(worse == 0);
+            CHECK(linkSteps <= climbSteps);
+            CHECK(outside > 0); // the walk did leave the bounds, and came back
+            if (spec.kind == IndexSpec::Kind::Octree) {
+                CHECK(moves > 0);
+                CHECK(climbSteps < rootSteps);
+            } else {
+                CHECK(linkSteps == 0);
+            }
+        }
+    }
+}
+
+TEST_CASE("cursor: unbound, outside and back, reset to another index, FromRoot steps = depth") {
+    Cursor unbound;
+    CHECK(unbound.locate(Vec3(0.0)).outside);
+    CHECK(unbound.locate(Vec3(0.0)).candidates.empty());
+
+    const Scene scene = makeDegenerateScene();
+    const auto tree = Octree::build(scene, IndexSpec::octree(2, 0.005));
+    Cursor cursor(*tree);
+    CHECK(cursor.strategy() == CursorStrategy::NeighbourLinks);
+    const LocateResult first = cursor.locate({0.01, 0.01, 0.01});
+    CHECK_FALSE(first.outside);
+    CHECK(cursor.leaf() == first.leaf);
+    const LocateResult same = cursor.locate({0.01, 0.01, 0.01});
+    CHECK(same.steps == 0);
+    const LocateResult out = cursor.locate({1.0, 0.0, 0.0});
+    CHECK(out.outside);
+    CHECK(out.candidates.empty());
+    CHECK(out.leaf == kNoLeaf);
+    const LocateResult back = cursor.locate({0.0101, 0.01, 0.01});
+    CHECK_FALSE(back.outside);
+    CHECK(back.leaf == tree->locate({0.0101, 0.01, 0.01}).leaf);
+
+    const auto grid = buildIndex(scene, IndexSpec::grid(4));
+    cursor.reset(*grid);
+    CHECK(cursor.leaf() == kNoLeaf);
+    CHECK(cursor.index() == grid.get());
+    CHECK(cursor.locate({0.01, 0.01, 0.01}).leaf == grid->locate({0.01, 0.01, 0.01}).leaf);
+
+    Cursor fromRoot(*tree, CursorStrategy::FromRoot);
+    for (const Vec3& p : queryPoints(scene, 4, 200)) {
+        const LocateResult r = fromRoot.locate(p);
+        if (!r.outside) {
+            CHECK(r.steps == tree->nodes()[r.leaf].level);
+        }
+    }
+    // The upper faces of the bounds are inside (closed), one ulp beyond is not.
+    const Vec3 top = tree->bounds().max;
+    CHECK_FALSE(cursor.locate(top).outside);
+    CHECK(cursor.locate({std::nextafter(top.x, 1.0), top.y, top.z}).outside);
+    CHECK_FALSE(cursor.locate(top).outside);
+    CHECK(cursor.locate({-0.125, -0.125, -0.125}).leaf ==
+          grid->locate({-0.125, -0.125, -0.125}).leaf);
+}
