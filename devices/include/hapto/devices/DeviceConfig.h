@@ -26,54 +26,85 @@ struct WorkspaceTransform {
     Vec3 positionToDevice(const Vec3& p) const {
         return glm::conjugate(rotation) * ((p - translation) / scale);
     }
+    /// A device-frame force (N) in the world. [servo]
+    Vec3 forceToWorld(const Vec3& f) const { return rotation * f; }
     /// A device-frame velocity (m/s) in the world. [servo]
     Vec3 velocityToWorld(const Vec3& v) const { return scale * (rotation * v); }
     /// A world force (N) in the device frame. [servo]
     Vec3 forceToDevice(const Vec3& f) const { return glm::conjugate(rotation) * f; }
 };
 
-/// Simulated hand (`"kind": "sim"`).
+/// Simulated hand (`"kind": "sim"`): a scripted target pulls a mass-spring-damper hand that
+/// holds the device; see SimDevice. Scripts work in the world frame (m); the hand lives in the
+/// device frame. Every default below is what a missing JSON field gives.
 struct SimConfig {
     std::string script = "walk"; ///< free, touch, slide, walk, grasp-left, grasp-right.
-    std::uint64_t seed = 1;      ///< Same seed and scene, same motion.
+    std::uint64_t seed = 1;      ///< Same seed, scene and configuration, same motion, bit for bit.
+    Vec3 start{0.0};             ///< Where the hand starts, device frame (m). JSON `start`.
+    std::optional<std::uint32_t> object; ///< Object id to touch, slide on or grasp; none = the
+                                         ///< nearest (touch, slide) or the one nearest `near`
+                                         ///< (grasp). JSON `object`.
+    Vec3 near{0.0};               ///< Grasp scripts pick the object nearest this world point (m)
+                                  ///< when `object` is not given, so two hands agree. JSON `near`.
+    double pressForceN = 1.5;     ///< How hard touch, slide and grasp press (N), >= 0. `press_n`.
+    double maxSpeedMPerS = 0.5;   ///< Speed cap of scripted motion (m/s), > 0. `max_speed_m_per_s`.
+    Vec3 lift{0.0, 0.05, 0.0};    ///< Grasp: lift of the object, world (m); +y is up. `lift`.
+    Vec3 carry{0.10, 0.0, 0.0};   ///< Grasp: sideways carry after the lift, world (m). `carry`.
+    double handMassKg = 0.15;     ///< Moving mass of hand and handle (kg), > 0. `hand_mass_kg`.
+    double handStiffness = 300.0; ///< Hand stiffness (N/m), > 0: a force F moves the hand's
+                                  ///< equilibrium by F / handStiffness. `hand_stiffness_n_per_m`.
+    double handDampingRatio = 1.0; ///< Damping as a fraction of critical (unitless), >= 0.
+                                   ///< `hand_damping_ratio`.
+    double resolutionM = 1.0e-5;   ///< Encoder quantum (m), >= 0; 0 = continuous. `resolution_m`.
+    double noiseM = 2.0e-6;        ///< Uniform position noise per axis, |noise| <= noiseM (m),
+                                   ///< >= 0. `noise_m`.
 };
 
 /// Playback of a recorded trace (`"kind": "replay"`).
 struct ReplayConfig {
-    std::filesystem::path trace; ///< A trace file written by `hapto run --record`.
+    std::filesystem::path trace; ///< A trace file written by `hapto run --record`; a relative
+                                 ///< path in a file is relative to that file's folder.
     bool loop = false;           ///< Start over at the end instead of stalling.
 };
 
 /// A Novint Falcon over libusb (`"kind": "falcon"`).
 struct FalconConfig {
-    std::string serial;            ///< Pick by USB serial number; empty = any.
-    int bus = -1;                  ///< Pick by USB bus number; -1 = any.
-    int address = -1;              ///< Pick by USB device address; -1 = any.
+    std::string serial;             ///< Pick by USB serial number; empty = any.
+    int bus = -1;                   ///< Pick by USB bus number; -1 = any.
+    int address = -1;               ///< Pick by USB device address; -1 = any.
     std::filesystem::path firmware; ///< Firmware image to upload when none is loaded.
-    bool home = true;              ///< Run the homing procedure at open.
+    bool home = true;               ///< Run the homing procedure at open.
 };
 
 /// A PHANToM or Touch through OpenHaptics (`"kind": "phantom"`).
 struct PhantomConfig {
-    std::string deviceName;            ///< OpenHaptics device name; empty = the default device.
-    std::string library = "libHD.so";  ///< The HD library to dlopen.
+    std::string deviceName;           ///< OpenHaptics device name; empty = the default device.
+    std::string library = "libHD.so"; ///< The HD library to dlopen.
 };
+
+/// The device configuration file format version this build reads.
+inline constexpr int kDeviceConfigFormatVersion = 1;
 
 /// One configured device.
 struct DeviceConfig {
-    std::string name;             ///< Unique name ("left", "right").
+    std::string name;             ///< Unique name: 1..63 of [A-Za-z0-9_-] ("left", "right").
     std::string kind;             ///< "sim", "replay", "falcon" or "phantom".
     WorkspaceTransform transform; ///< Device frame into the world.
     double maxForceN = 0.0;       ///< Force clamp (N); 0 = the device's own maximum.
-    double rateHz = 1000.0;       ///< Servo rate (Hz).
+    double rateHz = 1000.0;       ///< Servo rate (Hz), 100..100000. A replay uses its trace's.
     std::variant<SimConfig, ReplayConfig, FalconConfig, PhantomConfig> params; ///< Per kind.
 };
 
-/// Loads a device configuration file; throws InputError naming the file and JSON path. [control]
+/// Loads a device configuration file (format "hapto-devices", devices/README-devices.md);
+/// relative trace and firmware paths are resolved against the file's folder. Throws InputError
+/// naming the file and the JSON path (e.g. `devices[1].transform.scale`). [control]
 std::vector<DeviceConfig> loadDeviceConfigFile(const std::filesystem::path& path);
-/// Parses device configuration JSON; `sourceName` names it in messages. [control]
+/// Parses device configuration JSON; `sourceName` names it in messages; paths are kept as
+/// written. Throws InputError. [control]
 std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_view sourceName);
-/// Two simulated hands, "left" and "right", 1 kHz, side by side. [control]
+/// Two simulated hands side by side at 1 kHz in the clear 4 cm around the origin of the default
+/// scene: "left" at x = -0.02 m sliding on its nearest surface (seed 1), "right" at x = +0.02 m
+/// touching its nearest surface (seed 2): the paper's "sliding" and "touch" cases. [control]
 std::vector<DeviceConfig> defaultDeviceConfigs();
 
 } // namespace hapto

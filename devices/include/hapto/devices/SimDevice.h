@@ -1,0 +1,83 @@
+#pragma once
+/// A simulated hand on a simulated device (`"kind": "sim"`): scripted, seeded, force-feeling.
+
+#include "hapto/devices/Device.h"
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/devices/HandModel.h"
+#include "hapto/devices/SimScript.h"
+#include "hapto/scenes/Random.h"
+#include "hapto/scenes/Scene.h"
+
+#include <optional>
+#include <string>
+
+namespace hapto {
+
+/// A device held by a simulated hand. At open() the script (SimConfig::script) is planned
+/// against the scene in the world frame. Every read() advances time by exactly 1 / rate: the
+/// script's target, converted into the device frame, pulls the HandModel, and the force last
+/// written acts on it, so a hand pressing on a surface feels the surface push back. Readings
+/// are quantised to SimConfig::resolutionM after uniform noise of at most SimConfig::noiseM per
+/// axis. Same configuration, scene and written forces, same readings, bit for bit; devices share
+/// nothing, so any number can run at once. Button 0 is held while a grasp squeezes and carries.
+class SimDevice final : public Device {
+public:
+    /// Keeps a reference to `scene`, which must outlive open(). Throws InputError when the
+    /// configuration is not of kind "sim" or names an object the scene lacks. [control]
+    SimDevice(const DeviceConfig& config, const Scene& scene);
+
+    std::string_view name() const override { return mConfig.name; }
+    std::string_view kind() const override { return "sim"; }
+    /// Workspace: the scene bounds, in the device frame, grown by 5 cm; max force: the
+    /// configured one, else 10 N. [control]
+    DeviceCapabilities capabilities() const override;
+    /// Plans the script and puts the hand at rest at SimConfig::start. [control]
+    DeviceStatus open() override;
+    /// Stops the device; read/write then return NotOpen. [control]
+    void close() override;
+    /// Advances one tick of 1 / rate and reports position and velocity (device frame). [servo]
+    DeviceStatus read(DeviceState& state) override;
+    /// The force (N, device frame) acting on the hand from the next read() on, clamped to the
+    /// max force; a non-finite force is refused with BadData and zero force is applied. [servo]
+    DeviceStatus write(const Vec3& forceN) override;
+    /// The last failure. [control]
+    std::string errorMessage() const override { return mError; }
+
+    /// The script's current phase. [servo]
+    ScriptPhase phase() const { return mPhase; }
+    /// The script's current target, world frame (m). [servo]
+    const Vec3& targetWorld() const { return mTargetWorld; }
+    /// The hand's exact position (before noise and quantisation), device frame (m). [servo]
+    const Vec3& handPosition() const { return mHand.position(); }
+    /// The hand's exact position in the world (m). [servo]
+    Vec3 handPositionWorld() const { return mConfig.transform.positionToWorld(mHand.position()); }
+    /// Ticks since open. [servo]
+    std::uint64_t tick() const { return mTick; }
+    /// Simulated time since open (s): tick / rate. [servo]
+    double timeS() const { return static_cast<double>(mTick) * mDtS; }
+    /// The plan, once open. [control]
+    const std::optional<SimScript>& script() const { return mScript; }
+    /// The hand model (mass, stiffness, damping). [any thread]
+    const HandModel& hand() const { return mHand; }
+    /// The simulation settings. [any thread]
+    const SimConfig& simConfig() const { return mSim; }
+
+private:
+    DeviceConfig mConfig;
+    SimConfig mSim;
+    const Scene* mScene;
+    double mDtS;
+    double mMaxForceN;
+    HandModel mHand;
+    Random mNoise;
+    std::optional<SimScript> mScript;
+    std::size_t mCursor = 0;
+    std::uint64_t mTick = 0;
+    Vec3 mForceN{0.0};
+    Vec3 mTargetWorld{0.0};
+    ScriptPhase mPhase = ScriptPhase::Move;
+    bool mOpen = false;
+    std::string mError;
+};
+
+} // namespace hapto

@@ -1,0 +1,49 @@
+#pragma once
+/// Reads and validates trace files (TraceFormat.h).
+
+#include "hapto/devices/TraceFormat.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <vector>
+
+namespace hapto {
+
+/// Reads a trace file sample by sample, checking everything: magic, version, sizes, rate, that
+/// the file holds exactly the samples its header announces, and per sample a known status,
+/// finite position and force, zero padding, strictly increasing ticks. Any problem is an
+/// InputError naming the file and the byte offset. A trace whose recorder was never closed (a
+/// crash) reads its whole records and ignores a partial last one. All [control].
+class TraceReader {
+public:
+    /// Opens `path` and checks the header against the file size. Throws InputError. [control]
+    explicit TraceReader(const std::filesystem::path& path);
+    ~TraceReader();
+    TraceReader(const TraceReader&) = delete;
+    TraceReader& operator=(const TraceReader&) = delete;
+
+    /// The header. [control]
+    const TraceHeader& header() const { return mHeader; }
+    /// Reads the next sample into `out`; false at the end. Throws InputError on a bad sample or
+    /// a read failure. [control]
+    bool next(TraceSample& out);
+    /// Reads every remaining sample. Throws InputError. [control]
+    std::vector<TraceSample> readAll();
+
+    /// Loads a whole trace: header and samples. Throws InputError. [control]
+    static std::vector<TraceSample> load(const std::filesystem::path& path,
+                                         TraceHeader* header = nullptr);
+
+private:
+    [[noreturn]] void fail(std::uint64_t offset, const std::string& what) const;
+
+    std::filesystem::path mPath;
+    std::FILE* mFile = nullptr;
+    TraceHeader mHeader;
+    std::uint64_t mIndex = 0;
+    bool mHaveTick = false;
+    std::uint64_t mLastTick = 0;
+    std::uint64_t mLastTimeNs = 0;
+};
+
+} // namespace hapto

@@ -1,0 +1,299 @@
+// Device configuration files ("hapto-devices", version 1). Same habits as scene files: every
+// field is checked, unknown fields are refused, and every message names the file and the JSON
+// path of the bad value (e.g. `devices[1].transform.scale`).
+
+#include "hapto/devices/DeviceConfig.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include "hapto/scenes/JsonInput.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace hapto {
+namespace {
+
+using namespace hapto::json;
+
+constexpr std::array<std::string_view, 6> kScripts = {"free", "touch",      "slide",
+                                                      "walk", "grasp-left", "grasp-right"};
+constexpr std::array<std::string_view, 4> kKinds = {"sim", "replay", "falcon", "phantom"};
+
+WorkspaceTransform parseTransform(const Source& w, const Json& j, const Path& path) {
+    object(w, j, path);
+    checkKeys(w, j, path, {"translation", "rotation", "scale"});
+    WorkspaceTransform t;
+    if (const Json* v = optional(j, "translation")) {
+        t.translation = vec3(w, *v, path / "translation");
+    }
+    if (const Json* v = optional(j, "rotation")) {
+        t.rotation = quaternion(w, *v, path / "rotation");
+    }
+    if (const Json* v = optional(j, "scale")) {
+        t.scale = ranged(w, *v, path / "scale", 0.0, 1e6, true, "the scale");
+    }
+    return t;
+}
+
+SimConfig parseSim(const Source& w, const Json& j, const Path& path) {
+    object(w, j, path);
+    checkKeys(w, j, path,
+              {"script", "seed", "start", "object", "near", "press_n", "max_speed_m_per_s", "lift",
+               "carry", "hand_mass_kg", "hand_stiffness_n_per_m", "hand_damping_ratio",
+               "resolution_m", "noise_m"});
+    SimConfig c;
+    if (const Json* v = optional(j, "script")) {
+        c.script = string(w, *v, path / "script");
+        if (std::find(kScripts.begin(), kScripts.end(), c.script) == kScripts.end()) {
+            w.fail(path / "script", "unknown script '" + c.script +
+                                        "' (expected free, touch, slide, walk, grasp-left or "
+                                        "grasp-right)");
+        }
+    }
+    if (const Json* v = optional(j, "seed")) {
+        if (!v->is_number_integer() || (!v->is_number_unsigned() && v->get<std::int64_t>() < 0)) {
+            w.fail(path / "seed", "expected a non-negative integer, got " +
+                                      (v->is_number_integer() ? v->dump() : typeName(*v)));
+        }
+        c.seed = v->get<std::uint64_t>();
+    }
+    if (const Json* v = optional(j, "start")) {
+        c.start = vec3(w, *v, path / "start");
+    }
+    if (const Json* v = optional(j, "object")) {
+        c.object = static_cast<std::uint32_t>(integer(w, *v, path / "object", 0, 0xFFFFFFFEll));
+    }
+    if (const Json* v = optional(j, "near")) {
+        c.near = vec3(w, *v, path / "near");
+    }
+    if (const Json* v = optional(j, "press_n")) {
+        c.pressForceN = ranged(w, *v, path / "press_n", 0.0, 100.0, false, "the press force (N)");
+    }
+    if (const Json* v = optional(j, "max_speed_m_per_s")) {
+        c.maxSpeedMPerS =
+            ranged(w, *v, path / "max_speed_m_per_s", 0.0, 10.0, true, "the speed cap (m/s)");
+    }
+    if (const Json* v = optional(j, "lift")) {
+        c.lift = vec3(w, *v, path / "lift");
+    }
+    if (const Json* v = optional(j, "carry")) {
+        c.carry = vec3(w, *v, path / "carry");
+    }
+    if (const Json* v = optional(j, "hand_mass_kg")) {
+        c.handMassKg = ranged(w, *v, path / "hand_mass_kg", 0.0, 100.0, true, "the hand mass (kg)");
+    }
+    if (const Json* v = optional(j, "hand_stiffness_n_per_m")) {
+        c.handStiffness = ranged(w, *v, path / "hand_stiffness_n_per_m", 0.0, 1e6, true,
+                                 "the hand stiffness (N/m)");
+    }
+    if (const Json* v = optional(j, "hand_damping_ratio")) {
+        c.handDampingRatio =
+            ranged(w, *v, path / "hand_damping_ratio", 0.0, 100.0, false, "the damping ratio");
+    }
+    if (const Json* v = optional(j, "resolution_m")) {
+        c.resolutionM =
+            ranged(w, *v, path / "resolution_m", 0.0, 0.01, false, "the resolution (m)");
+    }
+    if (const Json* v = optional(j, "noise_m")) {
+        c.noiseM = ranged(w, *v, path / "noise_m", 0.0, 0.01, false, "the noise (m)");
+    }
+    return c;
+}
+
+ReplayConfig parseReplay(const Source& w, const Json& j, const Path& path) {
+    object(w, j, path);
+    checkKeys(w, j, path, {"trace", "loop"});
+    ReplayConfig c;
+    c.trace = string(w, required(w, j, path, "trace"), path / "trace");
+    if (c.trace.empty()) {
+        w.fail(path / "trace", "the trace path must not be empty");
+    }
+    if (const Json* v = optional(j, "loop")) {
+        c.loop = boolean(w, *v, path / "loop");
+    }
+    return c;
+}
+
+FalconConfig parseFalcon(const Source& w, const Json& j, const Path& path) {
+    object(w, j, path);
+    checkKeys(w, j, path, {"serial", "bus", "address", "firmware", "home"});
+    FalconConfig c;
+    if (const Json* v = optional(j, "serial")) {
+        c.serial = string(w, *v, path / "serial");
+    }
+    if (const Json* v = optional(j, "bus")) {
+        c.bus = static_cast<int>(integer(w, *v, path / "bus", -1, 255));
+    }
+    if (const Json* v = optional(j, "address")) {
+        c.address = static_cast<int>(integer(w, *v, path / "address", -1, 255));
+    }
+    if (const Json* v = optional(j, "firmware")) {
+        c.firmware = string(w, *v, path / "firmware");
+    }
+    if (const Json* v = optional(j, "home")) {
+        c.home = boolean(w, *v, path / "home");
+    }
+    return c;
+}
+
+PhantomConfig parsePhantom(const Source& w, const Json& j, const Path& path) {
+    object(w, j, path);
+    checkKeys(w, j, path, {"device", "library"});
+    PhantomConfig c;
+    if (const Json* v = optional(j, "device")) {
+        c.deviceName = string(w, *v, path / "device");
+    }
+    if (const Json* v = optional(j, "library")) {
+        c.library = string(w, *v, path / "library");
+        if (c.library.empty()) {
+            w.fail(path / "library", "the library name must not be empty");
+        }
+    }
+    return c;
+}
+
+bool validName(const std::string& name) {
+    if (name.empty() || name.size() > 63) {
+        return false;
+    }
+    return std::all_of(name.begin(), name.end(), [](char ch) {
+        return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+               ch == '-' || ch == '_';
+    });
+}
+
+DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
+    object(w, j, path);
+    checkKeys(w, j, path,
+              {"name", "kind", "rate_hz", "max_force_n", "transform", "sim", "replay", "falcon",
+               "phantom"});
+    DeviceConfig d;
+    d.name = string(w, required(w, j, path, "name"), path / "name");
+    if (!validName(d.name)) {
+        w.fail(path / "name", "a device name is 1 to 63 letters, digits, '-' or '_' (got \"" +
+                                  d.name + "\"); it also names trace files");
+    }
+    d.kind = string(w, required(w, j, path, "kind"), path / "kind");
+    if (std::find(kKinds.begin(), kKinds.end(), d.kind) == kKinds.end()) {
+        w.fail(path / "kind",
+               "unknown kind '" + d.kind + "' (expected sim, replay, falcon or phantom)");
+    }
+    for (const auto other : kKinds) {
+        if (other != d.kind && j.contains(std::string(other))) {
+            w.fail(path / other.data(),
+                   "settings for kind '" + std::string(other) + "' on a device of kind '" + d.kind +
+                       "' (rename the field to '" + d.kind + "' or change the kind)");
+        }
+    }
+    if (const Json* v = optional(j, "rate_hz")) {
+        d.rateHz = ranged(w, *v, path / "rate_hz", 100.0, 100000.0, false, "the rate (Hz)");
+    }
+    if (const Json* v = optional(j, "max_force_n")) {
+        d.maxForceN =
+            ranged(w, *v, path / "max_force_n", 0.0, kUnbounded, false, "the max force (N)");
+    }
+    if (const Json* v = optional(j, "transform")) {
+        d.transform = parseTransform(w, *v, path / "transform");
+    }
+    const Json* params = optional(j, d.kind.c_str());
+    const Path ppath = path / d.kind.c_str();
+    if (d.kind == "sim") {
+        d.params = params ? parseSim(w, *params, ppath) : SimConfig{};
+    } else if (d.kind == "replay") {
+        if (!params) {
+            w.fail(path, "a replay device needs \"replay\": {\"trace\": \"FILE\"}");
+        }
+        d.params = parseReplay(w, *params, ppath);
+    } else if (d.kind == "falcon") {
+        d.params = params ? parseFalcon(w, *params, ppath) : FalconConfig{};
+    } else {
+        d.params = params ? parsePhantom(w, *params, ppath) : PhantomConfig{};
+    }
+    return d;
+}
+
+} // namespace
+
+std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_view sourceName) {
+    const Source w(sourceName);
+    const Path top;
+    const Json root = parseText(text, w);
+    if (!root.is_object()) {
+        w.fail(top,
+               "expected a JSON object with \"format\": \"hapto-devices\", got " + typeName(root));
+    }
+    checkKeys(w, root, top, {"format", "version", "devices"});
+    const Json& format = required(w, root, top, "format");
+    if (!format.is_string() || format.get<std::string>() != "hapto-devices") {
+        w.fail(top / "format", "expected \"hapto-devices\", got " + format.dump());
+    }
+    const Json& version = required(w, root, top, "version");
+    if (!version.is_number_integer() || version.get<std::int64_t>() != kDeviceConfigFormatVersion) {
+        w.fail(top / "version", "this build reads version " +
+                                    std::to_string(kDeviceConfigFormatVersion) + ", got " +
+                                    version.dump());
+    }
+    const Path devicesPath = top / "devices";
+    const Json& devices = required(w, root, top, "devices");
+    if (!devices.is_array()) {
+        w.fail(devicesPath, "expected an array of devices, got " + typeName(devices));
+    }
+    if (devices.empty()) {
+        w.fail(devicesPath, "list at least one device");
+    }
+    std::vector<DeviceConfig> out;
+    out.reserve(devices.size());
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+        const Path path = devicesPath[i];
+        out.push_back(parseDevice(w, devices[i], path));
+        for (std::size_t k = 0; k < i; ++k) {
+            if (out[k].name == out[i].name) {
+                w.fail(path / "name", "duplicate name '" + out[i].name + "' (also at devices[" +
+                                          std::to_string(k) + "]); names must be unique");
+            }
+        }
+    }
+    return out;
+}
+
+std::vector<DeviceConfig> loadDeviceConfigFile(const std::filesystem::path& path) {
+    const std::string text = readFile(path, "device configuration");
+    std::vector<DeviceConfig> configs = parseDeviceConfig(text, path.string());
+    const std::filesystem::path base = path.parent_path();
+    for (DeviceConfig& c : configs) {
+        if (auto* r = std::get_if<ReplayConfig>(&c.params); r && r->trace.is_relative()) {
+            r->trace = base / r->trace;
+        }
+        if (auto* f = std::get_if<FalconConfig>(&c.params);
+            f && !f->firmware.empty() && f->firmware.is_relative()) {
+            f->firmware = base / f->firmware;
+        }
+    }
+    return configs;
+}
+
+std::vector<DeviceConfig> defaultDeviceConfigs() {
+    std::vector<DeviceConfig> out(2);
+    out[0].name = "left";
+    out[0].kind = "sim";
+    out[0].transform.translation = Vec3(-0.02, 0.0, 0.0);
+    SimConfig left;
+    left.script = "slide";
+    left.seed = 1;
+    out[0].params = left;
+    out[1].name = "right";
+    out[1].kind = "sim";
+    out[1].transform.translation = Vec3(0.02, 0.0, 0.0);
+    SimConfig right;
+    right.script = "touch";
+    right.seed = 2;
+    out[1].params = right;
+    return out;
+}
+
+} // namespace hapto

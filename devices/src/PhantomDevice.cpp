@@ -1,0 +1,477 @@
+// PhantomDevice: OpenHaptics' HD scheduler on one side, a hapto servo thread on the other.
+//
+// Design note.
+// The idea: two real-time threads that never wait for each other. The HD scheduler thread owns
+// the device I/O (hdBeginFrame/hdEndFrame must run there); the hapto servo thread owns the force
+// computation. Between them sit two single-writer seqlock mailboxes per device:
+//   sample  HD thread -> servo   {position m, velocity m/s, buttons, time since open (ns)}
+//   force   servo -> HD thread   {force N}
+// plus atomics for faults (HD thread -> everyone), the zero-force request at close (control ->
+// HD thread) and its acknowledgement (HD thread -> control).
+// The invariants:
+//   - Only the HD callback writes `sample`; only write() (the servo thread) writes `force`.
+//     close() never writes `force`: it raises `zeroForce`, which the callback obeys before
+//     looking at `force`, so there is never a second writer.
+//   - Once `zeroForce` is raised or a fault is recorded, every later HD tick applies exactly zero.
+//   - The callback's user data (PhantomLink) outlives its scheduling: it is freed only after
+//     hdUnschedule returned (and PhantomDevice cannot move).
+//   - HD calls from control threads (init, enable, probe, schedule, start/stop) are serialised
+//     by one process-wide mutex; neither the servo nor the HD thread ever takes it.
+// The cost per tick: HD thread, 3 HD gets + 1 set + ~12 atomic stores + one clock read;
+// servo thread, ~12 atomic loads + one clock read. Latency: see PhantomDevice.h.
+
+#include "hapto/devices/PhantomDevice.h"
+
+#include "hapto/devices/Mailbox.h"
+
+#include "PhantomHdApi.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <thread>
+
+namespace hapto {
+
+namespace detail {
+
+/// Everything the HD callback and the servo thread share for one device, aligned so the HD
+/// thread's and the servo thread's hot words sit on separate cache lines.
+struct alignas(64) PhantomLink {
+    const hd::HdApi* api = nullptr;               ///< Set before scheduling.
+    hd::HHD handle = hd::kInvalidHandle;          ///< Set before scheduling.
+    std::chrono::steady_clock::time_point origin; ///< Sample times count from here.
+
+    /// {px, py, pz (m), vx, vy, vz (m/s), buttons, time since origin (ns)}.
+    alignas(64) Mailbox<std::array<double, 8>> sample;
+    /// {fx, fy, fz (N)}.
+    alignas(64) Mailbox<std::array<double, 3>> force;
+
+    alignas(64) std::atomic<bool> zeroForce{false};     ///< Control -> HD: apply zero from now on.
+    std::atomic<bool> zeroForceApplied{false};          ///< HD -> control: a zero was applied.
+    std::atomic<std::uint32_t> faultCode{hd::kSuccess}; ///< First HD error, or kSuccess.
+    std::atomic<int> faultInternal{0};                  ///< Its driver code.
+    std::atomic<std::uint64_t> ticks{0};                ///< Callback runs since open.
+    std::array<double, 3> heldForce{0.0, 0.0, 0.0};     ///< HD thread only: last force read.
+
+    alignas(64) std::atomic<std::uint64_t> staleReads{0}; ///< Servo writes, anyone reads.
+    std::uint64_t lastWrites = 0;                         ///< Servo only.
+    std::array<double, 8> lastSample{};                   ///< Servo only.
+
+    /// Back to "just opened": only while the callback is not scheduled. [control]
+    void reset() {
+        sample.reset();
+        force.reset();
+        zeroForce.store(false);
+        zeroForceApplied.store(false);
+        faultCode.store(hd::kSuccess);
+        faultInternal.store(0);
+        ticks.store(0);
+        heldForce = {0.0, 0.0, 0.0};
+        staleReads.store(0);
+        lastWrites = 0;
+        lastSample = {};
+        origin = std::chrono::steady_clock::now();
+    }
+};
+
+static_assert(alignof(PhantomLink) == 64, "HD-side and servo-side words on separate lines");
+
+} // namespace detail
+
+namespace {
+
+using detail::PhantomLink;
+constexpr double kMmToM = 1.0e-3;
+constexpr std::chrono::seconds kFirstSampleTimeout{2};
+constexpr std::chrono::milliseconds kZeroForceTimeout{200};
+
+/// The HD scheduler callback of one device. Runs on OpenHaptics' scheduler thread every tick.
+hd::HDCallbackCode phantomServoCallback(void* userData) {
+    PhantomLink& link = *static_cast<PhantomLink*>(userData);
+    const hd::HdApi& api = *link.api;
+
+    api.makeCurrentDevice(link.handle);
+    api.beginFrame(link.handle);
+    hd::HDdouble position[3] = {0.0, 0.0, 0.0};
+    hd::HDdouble velocity[3] = {0.0, 0.0, 0.0};
+    hd::HDint buttons = 0;
+    api.getDoublev(hd::kCurrentPosition, position);
+    api.getDoublev(hd::kCurrentVelocity, velocity);
+    api.getIntegerv(hd::kCurrentButtons, &buttons);
+
+    const bool zero = link.zeroForce.load(std::memory_order_acquire) ||
+                      link.faultCode.load(std::memory_order_relaxed) != hd::kSuccess;
+    hd::HDdouble force[3] = {0.0, 0.0, 0.0};
+    if (!zero) {
+        std::array<double, 3> f;
+        std::uint64_t writes = 0;
+        if (link.force.read(f, writes)) {
+            link.heldForce = f; // else keep the last force: the writer is mid-update
+        }
+        std::copy(link.heldForce.begin(), link.heldForce.end(), force);
+    }
+    api.setDoublev(hd::kCurrentForce, force);
+    api.endFrame(link.handle);
+
+    const hd::HDErrorInfo error = api.takeError();
+    if (error.errorCode != hd::kSuccess) {
+        if (link.faultCode.load(std::memory_order_relaxed) == hd::kSuccess) {
+            link.faultInternal.store(error.internalErrorCode, std::memory_order_relaxed);
+            link.faultCode.store(error.errorCode, std::memory_order_release);
+        }
+    } else {
+        const auto age = std::chrono::steady_clock::now() - link.origin;
+        link.sample.publish(
+            {position[0] * kMmToM, position[1] * kMmToM, position[2] * kMmToM, velocity[0] * kMmToM,
+             velocity[1] * kMmToM, velocity[2] * kMmToM,
+             static_cast<double>(static_cast<std::uint32_t>(buttons)),
+             static_cast<double>(
+                 std::chrono::duration_cast<std::chrono::nanoseconds>(age).count())});
+    }
+    if (zero) {
+        link.zeroForceApplied.store(true, std::memory_order_release);
+    }
+    link.ticks.fetch_add(1, std::memory_order_release);
+    return hd::kCallbackContinue;
+}
+
+DeviceStatus statusForHdError(std::uint32_t code) {
+    return (code == hd::kCommError || code == hd::kCommConfigError) ? DeviceStatus::Disconnected
+                                                                    : DeviceStatus::Error;
+}
+
+bool finite(const Vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+std::string stringParam(const hd::HdApi& api, hd::HDenum name) {
+    const hd::HDstring s = api.getString(name);
+    return s ? std::string(s) : std::string();
+}
+
+/// Reads the static HD properties of the current device (control thread, outside a frame).
+PhantomInfo queryCurrentDevice(const hd::HdApi& api, const std::string& deviceName) {
+    PhantomInfo info;
+    info.deviceName = deviceName;
+    info.model = stringParam(api, hd::kDeviceModelType);
+    info.vendor = stringParam(api, hd::kDeviceVendor);
+    info.serial = stringParam(api, hd::kDeviceSerialNumber);
+    hd::HDdouble d = 0.0;
+    api.getDoublev(hd::kNominalMaxForce, &d);
+    info.maxForceN = std::isfinite(d) && d > 0.0 ? d : 0.0;
+    d = 0.0;
+    api.getDoublev(hd::kNominalMaxStiffness, &d);
+    info.maxStiffness = std::isfinite(d) && d > 0.0 ? d * 1000.0 : 0.0; // N/mm -> N/m
+    hd::HDdouble ws[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    api.getDoublev(hd::kUsableWorkspaceDimensions, ws);
+    info.workspace = Aabb{Vec3(ws[0], ws[1], ws[2]) * kMmToM, Vec3(ws[3], ws[4], ws[5]) * kMmToM};
+    api.takeError(); // a device without some property must not poison later calls
+    return info;
+}
+
+} // namespace
+
+// ---- PhantomDevice ----------------------------------------------------------------------------
+
+PhantomDevice::PhantomDevice(std::string name, const PhantomConfig& config, double maxForceN)
+    : mName(std::move(name)), mConfig(config), mMaxForceN(maxForceN),
+      mLink(std::make_unique<PhantomLink>()) {
+    mCaps.model = "PHANToM / Touch (OpenHaptics, not open)";
+    mCaps.maxForceN = std::max(0.0, maxForceN);
+    mCaps.buttonCount = 2;
+}
+
+PhantomDevice::~PhantomDevice() {
+    close();
+}
+
+std::string PhantomDevice::hdDeviceLabel() const {
+    return mConfig.deviceName.empty() ? std::string("the default OpenHaptics device")
+                                      : "OpenHaptics device \"" + mConfig.deviceName + "\"";
+}
+
+DeviceCapabilities PhantomDevice::capabilities() const {
+    return mCaps;
+}
+
+DeviceStatus PhantomDevice::open() {
+    if (mRuntime) {
+        return DeviceStatus::Ok;
+    }
+    std::lock_guard lock(hd::hdRegistryMutex());
+    std::string why;
+    hd::HdRuntime* rt = hd::findOrLoadHdRuntime(mConfig.library, why);
+    const std::string who = "phantom \"" + mName + "\": ";
+    if (!rt) {
+        mError = who + why;
+        return DeviceStatus::Error;
+    }
+    const hd::HdApi& api = rt->api;
+
+    // OpenHaptics' examples initialise devices before the scheduler runs; do the same.
+    const bool wasRunning = rt->schedulerRunning;
+    if (wasRunning) {
+        api.stopScheduler();
+        rt->schedulerRunning = false;
+    }
+    auto restart = [&] {
+        if (wasRunning) {
+            api.startScheduler();
+            rt->schedulerRunning = true;
+        }
+    };
+
+    api.takeError(); // forget errors left by someone else on this thread
+    const hd::HHD handle =
+        api.initDevice(mConfig.deviceName.empty() ? nullptr : mConfig.deviceName.c_str());
+    hd::HDErrorInfo error = api.takeError();
+    if (error.errorCode != hd::kSuccess || handle == hd::kInvalidHandle) {
+        mError = who + "OpenHaptics could not initialise " + hdDeviceLabel() + ": " +
+                 api.describe(error) +
+                 ". Check that the name matches one in Touch_Setup (empty = the default device) "
+                 "and that the device is plugged in and powered.";
+        restart();
+        return DeviceStatus::Error;
+    }
+
+    api.makeCurrentDevice(handle);
+    const PhantomInfo info = queryCurrentDevice(api, mConfig.deviceName);
+    mCaps.model = info.model.empty() ? std::string("PHANToM / Touch") : info.model;
+    mCaps.workspace = info.workspace;
+    mCaps.maxStiffness = info.maxStiffness;
+    mCaps.nominalRateHz = mSchedulerRateHz > 0 ? static_cast<double>(mSchedulerRateHz) : 1000.0;
+    mCaps.buttonCount = 2;
+    mForceLimitN = mMaxForceN > 0.0 ? mMaxForceN : info.maxForceN;
+    if (info.maxForceN > 0.0) {
+        mForceLimitN = std::min(mForceLimitN, info.maxForceN);
+    }
+    mCaps.maxForceN = mForceLimitN;
+
+    PhantomLink& link = *mLink;
+    link.reset();
+    link.api = &api;
+    link.handle = handle;
+
+    api.enable(hd::kForceOutput);
+    const hd::HDSchedulerHandle scheduled =
+        api.scheduleAsynchronous(&phantomServoCallback, &link, hd::kMaxSchedulerPriority);
+    error = api.takeError();
+    if (error.errorCode != hd::kSuccess) {
+        mError = who + "OpenHaptics could not schedule the servo callback of " + hdDeviceLabel() +
+                 ": " + api.describe(error) + ".";
+        api.disable(hd::kForceOutput);
+        api.disableDevice(handle);
+        api.takeError();
+        restart();
+        return DeviceStatus::Error;
+    }
+    mScheduled = scheduled;
+    ++rt->scheduledDevices;
+    mRuntime = rt;
+    if (!wasRunning && rt->scheduledDevices == 1 && mSchedulerRateHz > 0) {
+        api.setSchedulerRate(mSchedulerRateHz);
+    }
+    api.startScheduler();
+    rt->schedulerRunning = true;
+    error = api.takeError();
+    if (error.errorCode != hd::kSuccess) {
+        mError = who + "OpenHaptics could not start its scheduler: " + api.describe(error) +
+                 ". Another program may be using the device.";
+        releaseLocked();
+        return DeviceStatus::Error;
+    }
+
+    // Wait (bounded) for the first sample so read() right after open() has data.
+    const auto deadline = std::chrono::steady_clock::now() + kFirstSampleTimeout;
+    for (;;) {
+        std::array<double, 8> s;
+        std::uint64_t writes = 0;
+        if (const std::uint32_t code = link.faultCode.load(std::memory_order_acquire);
+            code != hd::kSuccess) {
+            mError = who + "OpenHaptics reported an error on the first servo tick of " +
+                     hdDeviceLabel() + ": " +
+                     api.describe({code, link.faultInternal.load(), handle}) + ".";
+            releaseLocked();
+            return statusForHdError(code);
+        }
+        if (link.sample.read(s, writes) && writes > 0) {
+            break;
+        }
+        if (std::chrono::steady_clock::now() > deadline) {
+            mError = who + "the OpenHaptics scheduler gave no sample of " + hdDeviceLabel() +
+                     " within 2 s of starting. Check that no other program holds the device.";
+            releaseLocked();
+            return DeviceStatus::Stalled;
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+    mError.clear();
+    mOpen.store(true, std::memory_order_release);
+    return DeviceStatus::Ok;
+}
+
+void PhantomDevice::releaseLocked() {
+    hd::HdRuntime& rt = *mRuntime;
+    const hd::HdApi& api = rt.api;
+    const hd::HHD handle = mLink->handle;
+    --rt.scheduledDevices;
+    if (rt.scheduledDevices == 0 && rt.schedulerRunning) {
+        api.stopScheduler(); // the vendor's order: stop, unschedule, disable
+        rt.schedulerRunning = false;
+    }
+    api.unschedule(mScheduled); // returns once the callback cannot run again
+    api.makeCurrentDevice(handle);
+    api.disable(hd::kForceOutput);
+    api.disableDevice(handle);
+    api.takeError();
+    mScheduled = 0;
+    mRuntime = nullptr;
+}
+
+void PhantomDevice::close() {
+    if (!mRuntime) {
+        return;
+    }
+    mOpen.store(false, std::memory_order_release); // servo calls now answer NotOpen
+    PhantomLink& link = *mLink;
+    link.zeroForce.store(true, std::memory_order_release);
+    const auto deadline = std::chrono::steady_clock::now() + kZeroForceTimeout;
+    bool applied = false;
+    while (!(applied = link.zeroForceApplied.load(std::memory_order_acquire)) &&
+           std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    if (link.faultCode.load(std::memory_order_acquire) != hd::kSuccess) {
+        mError = errorMessage(); // keep the HD fault for people after close
+    }
+    std::lock_guard lock(hd::hdRegistryMutex());
+    releaseLocked();
+    if (!applied) {
+        mError = "phantom \"" + mName +
+                 "\": the OpenHaptics scheduler did not run within 200 ms of close(), so zero "
+                 "force was not confirmed; force output was disabled anyway.";
+    }
+}
+
+DeviceStatus PhantomDevice::read(DeviceState& state) {
+    if (!mOpen.load(std::memory_order_acquire)) {
+        return DeviceStatus::NotOpen;
+    }
+    PhantomLink& link = *mLink;
+    if (const std::uint32_t code = link.faultCode.load(std::memory_order_acquire);
+        code != hd::kSuccess) {
+        return statusForHdError(code);
+    }
+    std::array<double, 8> s;
+    std::uint64_t writes = 0;
+    if (link.sample.read(s, writes) && writes > 0) {
+        if (writes == link.lastWrites) {
+            link.staleReads.fetch_add(1, std::memory_order_relaxed);
+        }
+        link.lastWrites = writes;
+        link.lastSample = s;
+    } else {
+        // The HD thread was mid-write on every try: use the previous sample, count it stale.
+        link.staleReads.fetch_add(1, std::memory_order_relaxed);
+        s = link.lastSample;
+        writes = link.lastWrites;
+    }
+    const auto now = std::chrono::steady_clock::now() - link.origin;
+    const double ageNs =
+        static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count()) -
+        s[7];
+    if (writes == 0 || ageNs > static_cast<double>(mStaleTimeout.count())) {
+        return DeviceStatus::Stalled;
+    }
+    const Vec3 position(s[0], s[1], s[2]);
+    const Vec3 velocity(s[3], s[4], s[5]);
+    if (!finite(position) || !finite(velocity)) {
+        return DeviceStatus::BadData;
+    }
+    state.position = position;
+    state.velocity = velocity;
+    state.hasVelocity = true;
+    state.buttons = static_cast<std::uint32_t>(s[6]);
+    state.sequence = writes;
+    return DeviceStatus::Ok;
+}
+
+DeviceStatus PhantomDevice::write(const Vec3& forceN) {
+    if (!mOpen.load(std::memory_order_acquire)) {
+        return DeviceStatus::NotOpen;
+    }
+    PhantomLink& link = *mLink;
+    if (const std::uint32_t code = link.faultCode.load(std::memory_order_acquire);
+        code != hd::kSuccess) {
+        return statusForHdError(code);
+    }
+    if (!finite(forceN)) {
+        link.force.publish({0.0, 0.0, 0.0});
+        return DeviceStatus::BadData;
+    }
+    Vec3 f = forceN;
+    const double magnitude = glm::length(f);
+    if (magnitude > mForceLimitN) {
+        f *= mForceLimitN / magnitude; // magnitude > limit >= 0, so no division by zero
+    }
+    link.force.publish({f.x, f.y, f.z});
+    return DeviceStatus::Ok;
+}
+
+std::string PhantomDevice::errorMessage() const {
+    const std::uint32_t code = mLink->faultCode.load(std::memory_order_acquire);
+    if (mRuntime && code != hd::kSuccess) {
+        const hd::HDErrorInfo error{code, mLink->faultInternal.load(), mLink->handle};
+        const bool gone = statusForHdError(code) == DeviceStatus::Disconnected;
+        return "phantom \"" + mName + "\": the OpenHaptics scheduler reported " +
+               mRuntime->api.describe(error) + " on " + hdDeviceLabel() +
+               "; it now applies zero force. " +
+               (gone ? "Check the cable and power, then close and reopen the device."
+                     : "Close and reopen the device; run Touch_Diagnostic if it repeats.");
+    }
+    return mError;
+}
+
+std::uint64_t PhantomDevice::staleSampleCount() const {
+    return mLink->staleReads.load(std::memory_order_relaxed);
+}
+
+std::uint64_t PhantomDevice::hdTickCount() const {
+    return mLink->ticks.load(std::memory_order_acquire);
+}
+
+// ---- probe ------------------------------------------------------------------------------------
+
+std::vector<PhantomInfo> probePhantoms(const std::string& library, std::string& whyNone) {
+    whyNone.clear();
+    std::lock_guard lock(hd::hdRegistryMutex());
+    hd::HdRuntime* rt = hd::findOrLoadHdRuntime(library, whyNone);
+    if (!rt) {
+        return {};
+    }
+    if (rt->scheduledDevices > 0) {
+        whyNone = "OpenHaptics (" + library + ") is in use by " +
+                  std::to_string(rt->scheduledDevices) +
+                  " open phantom device(s) in this process; probe before opening devices.";
+        return {};
+    }
+    const hd::HdApi& api = rt->api;
+    api.takeError();
+    const hd::HHD handle = api.initDevice(nullptr);
+    const hd::HDErrorInfo error = api.takeError();
+    if (error.errorCode != hd::kSuccess || handle == hd::kInvalidHandle) {
+        whyNone = "OpenHaptics (" + library +
+                  ") loaded, but no default device answered: " + api.describe(error) +
+                  ". Check that a PHANToM or Touch is plugged in and powered and that Touch_Setup "
+                  "lists it.";
+        return {};
+    }
+    api.makeCurrentDevice(handle);
+    std::vector<PhantomInfo> found{queryCurrentDevice(api, std::string())};
+    api.disableDevice(handle);
+    api.takeError();
+    return found;
+}
+
+} // namespace hapto

@@ -1,0 +1,113 @@
+#include "hapto/devices/ReplayDevice.h"
+
+#include "hapto/devices/TraceReader.h"
+#include "hapto/scenes/InputError.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+namespace hapto {
+namespace {
+
+const ReplayConfig& replayOf(const DeviceConfig& config) {
+    const auto* r = std::get_if<ReplayConfig>(&config.params);
+    if (config.kind != "replay" || !r) {
+        throw InputError("device '" + config.name +
+                         "': a replay device needs kind \"replay\" (got \"" + config.kind + "\")");
+    }
+    return *r;
+}
+
+} // namespace
+
+ReplayDevice::ReplayDevice(const DeviceConfig& config)
+    : mConfig(config), mReplay(replayOf(config)) {
+    mSamples = TraceReader::load(mReplay.trace, &mHeader);
+    if (mSamples.empty()) {
+        throw InputError(mReplay.trace.string() +
+                         ": the trace holds no samples; nothing to replay");
+    }
+}
+
+DeviceCapabilities ReplayDevice::capabilities() const {
+    DeviceCapabilities c;
+    c.model = "replay of " + mReplay.trace.filename().string() + " (" + mHeader.kind + " '" +
+              mHeader.name + "')";
+    Aabb box = Aabb::empty();
+    double maxForce = 0.0;
+    for (const TraceSample& s : mSamples) {
+        box.expand(s.positionM);
+        maxForce = std::max(maxForce, glm::length(s.forceN));
+    }
+    c.workspace = box;
+    c.maxForceN = mConfig.maxForceN > 0.0 ? mConfig.maxForceN : maxForce;
+    c.nominalRateHz = mHeader.rateHz;
+    std::uint32_t buttons = 0;
+    for (const TraceSample& s : mSamples) {
+        buttons |= s.buttons;
+    }
+    c.buttonCount = buttons == 0 ? 0 : 32 - std::countl_zero(buttons);
+    return c;
+}
+
+DeviceStatus ReplayDevice::open() {
+    mCursor = 0;
+    mPlayed = 0;
+    mReads = 0;
+    mLoops = 0;
+    mLastForceN = Vec3(0.0);
+    mError.clear();
+    mOpen = true;
+    return DeviceStatus::Ok;
+}
+
+void ReplayDevice::close() {
+    mLastForceN = Vec3(0.0);
+    mOpen = false;
+}
+
+DeviceStatus ReplayDevice::read(DeviceState& state) {
+    if (!mOpen) {
+        return DeviceStatus::NotOpen;
+    }
+    const std::uint64_t first = mSamples.front().tick;
+    const std::uint64_t last = mSamples.back().tick;
+    if (mPlayed > last - first) {
+        if (!mReplay.loop) {
+            state.position = mSamples.back().positionM;
+            state.hasVelocity = false;
+            return DeviceStatus::Stalled;
+        }
+        mPlayed = 0;
+        mCursor = 0;
+        ++mLoops;
+    }
+    const std::uint64_t tick = first + mPlayed;
+    while (mCursor + 1 < mSamples.size() && mSamples[mCursor + 1].tick <= tick) {
+        ++mCursor;
+    }
+    ++mPlayed;
+    ++mReads;
+    const TraceSample& s = mSamples[mCursor];
+    state.position = s.positionM;
+    state.velocity = Vec3(0.0);
+    state.hasVelocity = false;
+    state.buttons = s.buttons;
+    state.sequence = mReads;
+    return s.status;
+}
+
+DeviceStatus ReplayDevice::write(const Vec3& forceN) {
+    if (!mOpen) {
+        return DeviceStatus::NotOpen;
+    }
+    if (!std::isfinite(forceN.x) || !std::isfinite(forceN.y) || !std::isfinite(forceN.z)) {
+        mLastForceN = Vec3(0.0);
+        return DeviceStatus::BadData;
+    }
+    mLastForceN = forceN;
+    return DeviceStatus::Ok;
+}
+
+} // namespace hapto

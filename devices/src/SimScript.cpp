@@ -1,0 +1,540 @@
+// Planning the simulated hand's scripts. Design note: every script becomes a list of timed
+// world-frame keyframes, joined by minimum-jerk segments (a hand's reaching profile: rest to
+// rest, peak speed 1.875 L / T). All the thinking (choosing objects, checking paths against
+// solids, drawing random waypoints) happens here, on the control thread; the servo thread only
+// interpolates. Random scripts draw from hapto::Random, so a seed gives the same plan on every
+// platform.
+
+#include "hapto/devices/SimScript.h"
+
+#include "SceneQueries.h"
+
+#include "hapto/scenes/InputError.h"
+#include "hapto/scenes/Random.h"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+namespace hapto {
+namespace {
+
+constexpr double kStandOffM = 0.02;      // Stand-off from the surface before pressing (m).
+constexpr double kFreeMarginM = 0.006;   // Clearance free-space paths keep from solids (m).
+constexpr double kEdgeMarginM = 0.003;   // Contact points stay this far from box edges (m).
+constexpr double kApproachSpeed = 0.10;  // Peak approach speed (m/s).
+constexpr double kPressSpeed = 0.03;     // Peak speed moving in to press (m/s).
+constexpr double kSlideSpeed = 0.05;     // Peak sliding speed (m/s).
+constexpr double kSlideHalfSpanM = 0.02; // Slide up to this far either side of the contact (m).
+
+double minJerk(double tau) {
+    return tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau));
+}
+
+// Duration (s) of a minimum-jerk move of `lengthM` with peak speed `peak` (m/s).
+double moveDuration(double lengthM, double peak) {
+    return std::max(0.05, 1.875 * lengthM / peak);
+}
+
+class Builder {
+public:
+    explicit Builder(const Vec3& start) { mKeys.push_back({0.0, start, ScriptPhase::Move, true}); }
+    const Vec3& last() const { return mKeys.back().target; }
+    double time() const { return mKeys.back().timeS; }
+    std::size_t size() const { return mKeys.size(); }
+    void moveTo(const Vec3& p, double durationS, ScriptPhase phase, bool smooth = true) {
+        mKeys.push_back({time() + durationS, p, phase, smooth});
+    }
+    void moveAt(const Vec3& p, double peakSpeed, ScriptPhase phase) {
+        moveTo(p, moveDuration(glm::length(p - last()), peakSpeed), phase);
+    }
+    void hold(double durationS, ScriptPhase phase) { moveTo(last(), durationS, phase); }
+    void holdUntil(double timeS, ScriptPhase phase) {
+        if (timeS > time()) {
+            moveTo(last(), timeS - time(), phase);
+        }
+    }
+    std::vector<ScriptKeyframe> take() { return std::move(mKeys); }
+
+private:
+    std::vector<ScriptKeyframe> mKeys;
+};
+
+// A* over a voxel grid around a and b (voxels blocked within kFreeMarginM + one voxel of a
+// solid, so a step between free voxel centres keeps the margin), then shortcut smoothing.
+// Returns the waypoints after a, ending at b, or nothing when no path exists in the grid.
+std::optional<std::vector<Vec3>> gridPath(const Scene& scene, const Vec3& a, const Vec3& b,
+                                          std::span<const std::uint32_t> slots) {
+    Aabb region = Aabb::empty();
+    region.expand(a);
+    region.expand(b);
+    region.min -= Vec3(0.06);
+    region.max += Vec3(0.06);
+    const Vec3 size = region.size();
+    const double voxel = std::max(0.004, std::max({size.x, size.y, size.z}) / 96.0);
+    const int nx = static_cast<int>(std::ceil(size.x / voxel));
+    const int ny = static_cast<int>(std::ceil(size.y / voxel));
+    const int nz = static_cast<int>(std::ceil(size.z / voxel));
+    const auto index = [&](int x, int y, int z) { return (z * ny + y) * nx + x; };
+    const auto centre = [&](int i) {
+        const int x = i % nx, y = (i / nx) % ny, z = i / (nx * ny);
+        return region.min + voxel * Vec3(x + 0.5, y + 0.5, z + 0.5);
+    };
+    const double clearance = kFreeMarginM + voxel;
+    std::vector<std::uint8_t> blocked(static_cast<std::size_t>(nx) * ny * nz, 0);
+    for (const std::uint32_t slot : slots) {
+        const SceneObject& o = scene.object(slot);
+        const Aabb box = o.aabb();
+        const Vec3 lo = glm::floor((box.min - Vec3(clearance) - region.min) / voxel);
+        const Vec3 hi = glm::floor((box.max + Vec3(clearance) - region.min) / voxel);
+        for (int z = std::max(0, int(lo.z)); z <= std::min(nz - 1, int(hi.z)); ++z) {
+            for (int y = std::max(0, int(lo.y)); y <= std::min(ny - 1, int(hi.y)); ++y) {
+                for (int x = std::max(0, int(lo.x)); x <= std::min(nx - 1, int(hi.x)); ++x) {
+                    const int i = index(x, y, z);
+                    if (!blocked[i] && detail::signedDistance(o, centre(i)) < clearance) {
+                        blocked[i] = 1;
+                    }
+                }
+            }
+        }
+    }
+    const auto clear = [&](const Vec3& p, const Vec3& q) {
+        return detail::segmentClear(scene, slots, p, q, kFreeMarginM);
+    };
+    // The free voxel nearest p that p reaches in a straight line.
+    const auto attach = [&](const Vec3& p) -> int {
+        const Vec3 g = glm::floor((p - region.min) / voxel);
+        int best = -1;
+        double bestD = 1e300;
+        for (int dz = -2; dz <= 2; ++dz) {
+            for (int dy = -2; dy <= 2; ++dy) {
+                for (int dx = -2; dx <= 2; ++dx) {
+                    const int x = int(g.x) + dx, y = int(g.y) + dy, z = int(g.z) + dz;
+                    if (x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz) {
+                        continue;
+                    }
+                    const int i = index(x, y, z);
+                    const double d = glm::length(centre(i) - p);
+                    if (!blocked[i] && d < bestD && clear(p, centre(i))) {
+                        best = i;
+                        bestD = d;
+                    }
+                }
+            }
+        }
+        return best;
+    };
+    const int from = attach(a), to = attach(b);
+    if (from < 0 || to < 0) {
+        return std::nullopt;
+    }
+    std::vector<double> cost(blocked.size(), 1e300);
+    std::vector<int> parent(blocked.size(), -1);
+    using Entry = std::pair<double, int>;
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+    const Vec3 goal = centre(to);
+    cost[from] = 0.0;
+    open.push({glm::length(goal - centre(from)), from});
+    while (!open.empty()) {
+        const auto [f, i] = open.top();
+        open.pop();
+        if (i == to) {
+            break;
+        }
+        if (f - glm::length(goal - centre(i)) > cost[i] + 1e-12) {
+            continue; // stale
+        }
+        const int x = i % nx, y = (i / nx) % ny, z = i / (nx * ny);
+        for (int dz = -1; dz <= 1; ++dz) {
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int X = x + dx, Y = y + dy, Z = z + dz;
+                    if ((dx | dy | dz) == 0 || X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny ||
+                        Z >= nz) {
+                        continue;
+                    }
+                    const int j = index(X, Y, Z);
+                    if (blocked[j]) {
+                        continue;
+                    }
+                    const double c =
+                        cost[i] + voxel * std::sqrt(double(dx * dx + dy * dy + dz * dz));
+                    if (c < cost[j]) {
+                        cost[j] = c;
+                        parent[j] = i;
+                        open.push({c + glm::length(goal - centre(j)), j});
+                    }
+                }
+            }
+        }
+    }
+    if (from != to && parent[to] < 0) {
+        return std::nullopt;
+    }
+    std::vector<Vec3> raw{b};
+    for (int i = to; i >= 0; i = i == from ? -1 : parent[i]) {
+        raw.push_back(centre(i));
+    }
+    raw.push_back(a);
+    std::reverse(raw.begin(), raw.end());
+    // Shortcuts: from each kept point, jump to the farthest point it sees in a straight line.
+    std::vector<Vec3> out;
+    std::size_t i = 0;
+    while (i + 1 < raw.size()) {
+        std::size_t j = raw.size() - 1;
+        while (j > i + 1 && !clear(raw[i], raw[j])) {
+            --j;
+        }
+        out.push_back(raw[j]);
+        i = j;
+    }
+    return out;
+}
+
+// Waypoints (excluding a, including b) from a to b keeping kFreeMarginM from solids: straight
+// if clear, else a grid path, else straight anyway (the hand then touches something on the way).
+std::vector<Vec3> connect(const Scene& scene, const Vec3& a, const Vec3& b) {
+    Aabb around = Aabb::empty();
+    around.expand(a);
+    around.expand(b);
+    const std::vector<std::uint32_t> slots = detail::objectsNear(scene, around, 0.08);
+    if (detail::segmentClear(scene, slots, a, b, kFreeMarginM)) {
+        return {b};
+    }
+    if (auto path = gridPath(scene, a, b, slots)) {
+        return *path;
+    }
+    return {b};
+}
+
+// True when a hand can stand `kStandOffM` off object `slot` along `out` and move in to it.
+bool reachableSide(const Scene& scene, std::uint32_t slot, const Vec3& surface, const Vec3& out) {
+    const Vec3 standOff = surface + out * kStandOffM;
+    Aabb around = Aabb::empty();
+    around.expand(standOff);
+    around.expand(surface);
+    const std::vector<std::uint32_t> slots = detail::objectsNear(scene, around, 0.02);
+    return detail::segmentClear(scene, slots, standOff, surface + out * (kFreeMarginM * 0.5),
+                                kFreeMarginM * 0.5, slot);
+}
+
+// Distance from the centre to the object's surface along `out` (m), by bisection on the solid.
+double surfaceAlong(const SceneObject& o, const Vec3& out) {
+    double in = 0.0, outT = o.radius() * 1.001 + 1e-6;
+    for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (in + outT);
+        (o.contains(o.center + out * mid) ? in : outT) = mid;
+    }
+    return outT;
+}
+
+void approach(Builder& plan, const Scene& scene, const Vec3& to) {
+    for (const Vec3& p : connect(scene, plan.last(), to)) {
+        plan.moveAt(p, kApproachSpeed, ScriptPhase::Approach);
+    }
+}
+
+std::uint32_t chosenSlot(const SimConfig& config, const Scene& scene) {
+    const auto slot = scene.slotOf(*config.object);
+    if (!slot) {
+        throw InputError("sim script '" + config.script + "': object " +
+                         std::to_string(*config.object) +
+                         " is not in the scene (check \"object\" in the sim settings)");
+    }
+    return *slot;
+}
+
+std::optional<std::uint32_t> nearestSurface(const Scene& scene, const Vec3& p) {
+    std::optional<std::uint32_t> best;
+    double bestD = 0.0;
+    for (std::uint32_t i = 0; i < scene.size(); ++i) {
+        const double d = detail::signedDistance(scene.object(i), p);
+        if (!best || d < bestD) {
+            best = i;
+            bestD = d;
+        }
+    }
+    return best;
+}
+
+Vec3 anyPerpendicular(const Vec3& n) {
+    const Vec3 a = std::abs(n.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+    return glm::normalize(glm::cross(n, a));
+}
+
+} // namespace
+
+std::string_view scriptPhaseName(ScriptPhase phase) {
+    switch (phase) {
+    case ScriptPhase::Move:
+        return "move";
+    case ScriptPhase::Approach:
+        return "approach";
+    case ScriptPhase::Press:
+        return "press";
+    case ScriptPhase::Hold:
+        return "hold";
+    case ScriptPhase::Slide:
+        return "slide";
+    case ScriptPhase::Reach:
+        return "reach";
+    case ScriptPhase::Squeeze:
+        return "squeeze";
+    case ScriptPhase::Lift:
+        return "lift";
+    case ScriptPhase::Carry:
+        return "carry";
+    case ScriptPhase::PutDown:
+        return "put-down";
+    case ScriptPhase::Release:
+        return "release";
+    case ScriptPhase::Done:
+        return "done";
+    }
+    return "unknown";
+}
+
+SimScript::SimScript(std::vector<ScriptKeyframe> keyframes, std::optional<std::size_t> loopStart)
+    : mKeyframes(std::move(keyframes)), mLoopStart(loopStart) {
+    if (mKeyframes.empty()) {
+        mKeyframes.push_back({});
+    }
+    if (mLoopStart && (*mLoopStart + 1 >= mKeyframes.size())) {
+        mLoopStart.reset();
+    }
+}
+
+Vec3 SimScript::targetAt(double timeS, std::size_t& cursor, ScriptPhase& phase) const {
+    const ScriptKeyframe& back = mKeyframes.back();
+    if (mLoopStart && timeS > back.timeS) {
+        const double t0 = mKeyframes[*mLoopStart].timeS;
+        const double period = back.timeS - t0;
+        if (period > 0.0) {
+            timeS = t0 + std::fmod(timeS - t0, period);
+        }
+    }
+    if (mKeyframes.size() < 2 || timeS >= back.timeS) {
+        phase = back.phase;
+        return back.target;
+    }
+    if (timeS < 0.0) {
+        timeS = 0.0;
+    }
+    if (cursor == 0 || cursor >= mKeyframes.size() || mKeyframes[cursor - 1].timeS > timeS) {
+        cursor = 1;
+    }
+    while (mKeyframes[cursor].timeS <= timeS) {
+        ++cursor;
+    }
+    const ScriptKeyframe& a = mKeyframes[cursor - 1];
+    const ScriptKeyframe& b = mKeyframes[cursor];
+    const double tau = (timeS - a.timeS) / (b.timeS - a.timeS);
+    phase = b.phase;
+    return a.target + (b.target - a.target) * (b.smooth ? minJerk(tau) : tau);
+}
+
+SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec3& startWorld) {
+    Random rng(config.seed);
+    Builder plan(startWorld);
+    std::optional<std::size_t> loopStart;
+    std::optional<ObjectId> object;
+    Vec3 contactNormal(0.0);
+    const double cap = config.maxSpeedMPerS;
+    const double depth = config.pressForceN / config.handStiffness;
+
+    if (config.script == "walk") {
+        // Hops of 1..12 cm in random directions at random peak speeds up to 90 % of the cap
+        // (the critically damped hand never outruns its target), now and then a pause.
+        const Aabb& b = scene.bounds();
+        const Vec3 inset = glm::min(Vec3(0.01), 0.5 * b.halfExtents());
+        const Vec3 lo = b.min + inset, hi = b.max - inset;
+        Vec3 p = glm::clamp(startWorld, lo, hi);
+        plan.moveAt(p, 0.5 * cap, ScriptPhase::Move);
+        loopStart = plan.size() - 1;
+        const Vec3 first = p;
+        for (int i = 0; i < 512; ++i) {
+            Vec3 dir(rng.normal(), rng.normal(), rng.normal());
+            dir /= std::max(glm::length(dir), 1e-12);
+            p = glm::clamp(p + dir * rng.uniform(0.01, 0.12), lo, hi);
+            plan.moveAt(p, rng.uniform(0.1, 0.9) * cap, ScriptPhase::Move);
+            if (rng.uniform() < 0.15) {
+                plan.hold(rng.uniform(0.1, 0.5), ScriptPhase::Move);
+            }
+        }
+        plan.moveAt(first, 0.5 * cap, ScriptPhase::Move);
+    } else if (config.script == "free") {
+        // A random waypoint walk near the start, every segment checked against the solids with
+        // a margin; played forwards then backwards, so it loops without a new check.
+        const Aabb& b = scene.bounds();
+        const Vec3 lo = glm::max(b.min + Vec3(kFreeMarginM), startWorld - Vec3(0.08));
+        const Vec3 hi = glm::min(b.max - Vec3(kFreeMarginM), startWorld + Vec3(0.08));
+        const std::vector<std::uint32_t> slots =
+            detail::objectsNear(scene, {glm::min(lo, startWorld), glm::max(hi, startWorld)}, 0.02);
+        const double peakHi = std::min(0.15, cap);
+        std::vector<std::pair<Vec3, double>> legs; // waypoint, duration
+        Vec3 p = startWorld;
+        for (int i = 0; i < 600; ++i) {
+            Vec3 next = p;
+            for (int attempt = 0; attempt < 32; ++attempt) {
+                Vec3 dir(rng.normal(), rng.normal(), rng.normal());
+                dir /= std::max(glm::length(dir), 1e-12);
+                const Vec3 q = glm::clamp(p + dir * rng.uniform(0.005, 0.03), lo, hi);
+                if (detail::segmentClear(scene, slots, p, q, kFreeMarginM)) {
+                    next = q;
+                    break;
+                }
+            }
+            const double duration =
+                next == p ? rng.uniform(0.1, 0.3)
+                          : moveDuration(glm::length(next - p), rng.uniform(0.03, peakHi));
+            legs.emplace_back(next, duration);
+            p = next;
+        }
+        for (const auto& [q, d] : legs) {
+            plan.moveTo(q, d, ScriptPhase::Move);
+        }
+        for (std::size_t i = legs.size(); i-- > 0;) {
+            plan.moveTo(i == 0 ? startWorld : legs[i - 1].first, legs[i].second, ScriptPhase::Move);
+        }
+        loopStart = 0;
+    } else if (config.script == "touch" || config.script == "slide") {
+        const std::optional<std::uint32_t> slot = config.object
+                                                      ? std::optional(chosenSlot(config, scene))
+                                                      : nearestSurface(scene, startWorld);
+        if (!slot) { // Nothing to touch: stay put.
+            plan.hold(1.0, ScriptPhase::Hold);
+        } else {
+            const SceneObject& o = scene.object(*slot);
+            object = o.id;
+            const detail::SurfacePoint sp = detail::contactPoint(o, startWorld, kEdgeMarginM);
+            contactNormal = sp.normal;
+            approach(plan, scene, sp.point + sp.normal * kStandOffM);
+            const Vec3 pressed = sp.point - sp.normal * depth;
+            plan.moveAt(pressed, kPressSpeed, ScriptPhase::Press);
+            if (config.script == "touch") {
+                plan.hold(0.5, ScriptPhase::Hold);
+            } else {
+                const double speed = std::min(kSlideSpeed, cap);
+                loopStart = plan.size() - 1;
+                if (o.shape == Shape::Box) {
+                    // Along the longer in-face axis of the pressed face, within the face.
+                    const Obb box = o.obb();
+                    int normalAxis = 0;
+                    for (int i = 1; i < 3; ++i) {
+                        if (std::abs(glm::dot(box.axes[i], sp.normal)) >
+                            std::abs(glm::dot(box.axes[normalAxis], sp.normal))) {
+                            normalAxis = i;
+                        }
+                    }
+                    const int t1 = (normalAxis + 1) % 3, t2 = (normalAxis + 2) % 3;
+                    const int axis = box.halfExtents[t1] >= box.halfExtents[t2] ? t1 : t2;
+                    const Vec3 t = box.axes[axis];
+                    const double h = box.halfExtents[axis];
+                    const double m = std::min(kEdgeMarginM, 0.5 * h);
+                    const double u0 = glm::dot(sp.point - box.center, t);
+                    const double uHi = std::min(h - m, u0 + kSlideHalfSpanM);
+                    const double uLo = std::max(-h + m, u0 - kSlideHalfSpanM);
+                    plan.moveAt(pressed + t * (uHi - u0), speed, ScriptPhase::Slide);
+                    plan.moveAt(pressed + t * (uLo - u0), speed, ScriptPhase::Slide);
+                    plan.moveAt(pressed, speed, ScriptPhase::Slide);
+                } else {
+                    // Along a great circle, eased, as linear pieces.
+                    const double r = o.radius() - depth;
+                    const Vec3 n = sp.normal, t = anyPerpendicular(n);
+                    const double maxAngle = std::min(kSlideHalfSpanM / o.radius(), 0.6);
+                    const auto arc = [&](double from, double to) {
+                        const double duration =
+                            moveDuration(std::abs(to - from) * o.radius(), speed);
+                        constexpr int kPieces = 24;
+                        for (int i = 1; i <= kPieces; ++i) {
+                            const double a =
+                                from + (to - from) * minJerk(static_cast<double>(i) / kPieces);
+                            plan.moveTo(o.center + r * (std::cos(a) * n + std::sin(a) * t),
+                                        duration / kPieces, ScriptPhase::Slide, false);
+                        }
+                    };
+                    arc(0.0, maxAngle);
+                    arc(maxAngle, -maxAngle);
+                    arc(-maxAngle, 0.0);
+                }
+            }
+        }
+    } else if (config.script == "grasp-left" || config.script == "grasp-right") {
+        // The object nearest `near` whose both sides a hand can reach (both hands decide the
+        // same way, sharing nothing); the nearest one when none can be reached cleanly.
+        std::optional<std::uint32_t> slot;
+        if (config.object) {
+            slot = chosenSlot(config, scene);
+        } else {
+            std::vector<std::pair<double, std::uint32_t>> byDistance;
+            for (std::uint32_t i = 0; i < scene.size(); ++i) {
+                byDistance.emplace_back(glm::length(scene.object(i).center - config.near), i);
+            }
+            std::sort(byDistance.begin(), byDistance.end());
+            for (std::size_t k = 0; k < byDistance.size() && k < 64 && !slot; ++k) {
+                const SceneObject& o = scene.object(byDistance[k].second);
+                const Vec3 x(1.0, 0.0, 0.0);
+                if (reachableSide(scene, byDistance[k].second, o.center + x * surfaceAlong(o, x),
+                                  x) &&
+                    reachableSide(scene, byDistance[k].second, o.center - x * surfaceAlong(o, -x),
+                                  -x)) {
+                    slot = byDistance[k].second;
+                }
+            }
+            if (!slot && !byDistance.empty()) {
+                slot = byDistance.front().second;
+            }
+        }
+        if (!slot) {
+            plan.holdUntil(GraspTimes::kReleaseEnd, ScriptPhase::Done);
+        } else {
+            const SceneObject& o = scene.object(*slot);
+            object = o.id;
+            const double side = config.script == "grasp-left" ? -1.0 : 1.0;
+            const Vec3 out(side, 0.0, 0.0);
+            const Vec3 surface = o.center + out * surfaceAlong(o, out);
+            contactNormal = out;
+            const Vec3 standOff = surface + out * kStandOffM;
+            const Vec3 squeezed = surface - out * depth;
+            // Approach legs share the fixed approach time in proportion to their length.
+            const std::vector<Vec3> legs = connect(scene, startWorld, standOff);
+            double total = 0.0;
+            Vec3 p = startWorld;
+            for (const Vec3& q : legs) {
+                total += glm::length(q - p);
+                p = q;
+            }
+            p = startWorld;
+            if (total > 1e-9) {
+                for (const Vec3& q : legs) {
+                    plan.moveTo(q, GraspTimes::kApproachEnd * glm::length(q - p) / total,
+                                ScriptPhase::Approach);
+                    p = q;
+                }
+            }
+            plan.holdUntil(GraspTimes::kApproachEnd, ScriptPhase::Approach);
+            using G = GraspTimes;
+            plan.moveTo(surface, G::kReachEnd - G::kApproachEnd, ScriptPhase::Reach);
+            plan.moveTo(squeezed, 0.5 * (G::kSqueezeEnd - G::kReachEnd), ScriptPhase::Squeeze);
+            plan.holdUntil(G::kSqueezeEnd, ScriptPhase::Squeeze);
+            plan.moveTo(squeezed + config.lift, G::kLiftEnd - G::kSqueezeEnd, ScriptPhase::Lift);
+            plan.moveTo(squeezed + config.lift + config.carry, G::kCarryEnd - G::kLiftEnd,
+                        ScriptPhase::Carry);
+            plan.moveTo(squeezed + config.carry, G::kPutDownEnd - G::kCarryEnd,
+                        ScriptPhase::PutDown);
+            plan.moveTo(standOff + config.carry, G::kReleaseEnd - G::kPutDownEnd,
+                        ScriptPhase::Release);
+            plan.hold(0.5, ScriptPhase::Done);
+        }
+    } else {
+        throw InputError("unknown sim script '" + config.script +
+                         "' (expected free, touch, slide, walk, grasp-left or grasp-right)");
+    }
+
+    SimScript script(plan.take(), loopStart);
+    script.mObject = object;
+    script.mContactNormal = contactNormal;
+    return script;
+}
+
+} // namespace hapto

@@ -1,0 +1,106 @@
+#include "hapto/devices/TraceFormat.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+
+namespace hapto {
+namespace {
+
+void putU32(unsigned char* out, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) {
+        out[i] = static_cast<unsigned char>(v >> (8 * i));
+    }
+}
+void putU64(unsigned char* out, std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) {
+        out[i] = static_cast<unsigned char>(v >> (8 * i));
+    }
+}
+void putF64(unsigned char* out, double v) {
+    putU64(out, std::bit_cast<std::uint64_t>(v));
+}
+std::uint32_t getU32(const unsigned char* in) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) {
+        v |= static_cast<std::uint32_t>(in[i]) << (8 * i);
+    }
+    return v;
+}
+std::uint64_t getU64(const unsigned char* in) {
+    std::uint64_t v = 0;
+    for (int i = 0; i < 8; ++i) {
+        v |= static_cast<std::uint64_t>(in[i]) << (8 * i);
+    }
+    return v;
+}
+double getF64(const unsigned char* in) {
+    return std::bit_cast<double>(getU64(in));
+}
+
+void putText(unsigned char* out, const std::string& text, std::size_t field) {
+    std::memset(out, 0, field);
+    std::memcpy(out, text.data(), std::min(text.size(), field - 1));
+}
+
+} // namespace
+
+void encodeTraceHeader(const TraceHeader& header, std::uint64_t sampleCount, unsigned char* out) {
+    std::memset(out, 0, kTraceHeaderBytes);
+    std::memcpy(out, kTraceMagic.data(), kTraceMagic.size());
+    putU32(out + 8, header.version);
+    putU32(out + 12, static_cast<std::uint32_t>(kTraceHeaderBytes));
+    putU32(out + 16, static_cast<std::uint32_t>(kTraceSampleBytes));
+    putU32(out + 20, 0);
+    putF64(out + 24, header.rateHz);
+    putU64(out + 32, sampleCount);
+    putU64(out + 40, header.startUnixNs);
+    putText(out + 48, header.kind, kTraceMaxKindBytes + 1);
+    putText(out + 64, header.name, kTraceMaxNameBytes + 1);
+}
+
+TraceHeaderFields decodeTraceHeader(const unsigned char* in) {
+    TraceHeaderFields h;
+    std::memcpy(h.magic.data(), in, 8);
+    h.version = getU32(in + 8);
+    h.headerBytes = getU32(in + 12);
+    h.sampleBytes = getU32(in + 16);
+    h.flags = getU32(in + 20);
+    h.rateHz = getF64(in + 24);
+    h.sampleCount = getU64(in + 32);
+    h.startUnixNs = getU64(in + 40);
+    std::memcpy(h.kind.data(), in + 48, 16);
+    std::memcpy(h.name.data(), in + 64, 64);
+    return h;
+}
+
+void encodeTraceSample(const TraceSample& s, unsigned char* out) noexcept {
+    putU64(out, s.tick);
+    putU64(out + 8, s.timeNs);
+    for (int i = 0; i < 3; ++i) {
+        putF64(out + 16 + 8 * i, s.positionM[i]);
+        putF64(out + 40 + 8 * i, s.forceN[i]);
+    }
+    putU32(out + 64, s.computeNs);
+    putU32(out + 68, s.ioNs);
+    out[72] = static_cast<unsigned char>(s.status);
+    out[73] = out[74] = out[75] = 0;
+    putU32(out + 76, s.buttons);
+}
+
+TraceSample decodeTraceSample(const unsigned char* in) noexcept {
+    TraceSample s;
+    s.tick = getU64(in);
+    s.timeNs = getU64(in + 8);
+    for (int i = 0; i < 3; ++i) {
+        s.positionM[i] = getF64(in + 16 + 8 * i);
+        s.forceN[i] = getF64(in + 40 + 8 * i);
+    }
+    s.computeNs = getU32(in + 64);
+    s.ioNs = getU32(in + 68);
+    s.status = static_cast<DeviceStatus>(in[72]);
+    s.buttons = getU32(in + 76);
+    return s;
+}
+
+} // namespace hapto

@@ -1,0 +1,181 @@
+#include "hapto/devices/TraceReader.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+namespace hapto {
+namespace {
+
+// Reads a NUL-padded ASCII field; false when it holds non-printable bytes or text after a NUL.
+bool text(const char* field, std::size_t size, std::string& out) {
+    out.clear();
+    std::size_t i = 0;
+    for (; i < size && field[i] != '\0'; ++i) {
+        if (field[i] < 0x20 || field[i] > 0x7e) {
+            return false;
+        }
+        out += field[i];
+    }
+    for (; i < size; ++i) {
+        if (field[i] != '\0') {
+            return false;
+        }
+    }
+    return true;
+}
+
+bool finite(const Vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+} // namespace
+
+void TraceReader::fail(std::uint64_t offset, const std::string& what) const {
+    throw InputError(mPath.string() + ": byte " + std::to_string(offset) + ": " + what);
+}
+
+TraceReader::TraceReader(const std::filesystem::path& path) : mPath(path) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec) {
+        throw InputError(path.string() + ": cannot read the trace (" + ec.message() + ")");
+    }
+    mFile = std::fopen(path.c_str(), "rb");
+    if (!mFile) {
+        throw InputError(path.string() + ": cannot open the trace (" + std::strerror(errno) + ")");
+    }
+    try {
+        unsigned char bytes[kTraceHeaderBytes];
+        const std::size_t got = std::fread(bytes, 1, sizeof bytes, mFile);
+        if (got >= 8 && std::memcmp(bytes, kTraceMagic.data(), 8) != 0) {
+            fail(0, "not a hapto trace (the file does not start with \"HAPTOTRC\")");
+        }
+        if (got < kTraceHeaderBytes) {
+            fail(got, "truncated: the header needs " + std::to_string(kTraceHeaderBytes) +
+                          " bytes, the file has " + std::to_string(got));
+        }
+        const TraceHeaderFields h = decodeTraceHeader(bytes);
+        if (h.version != kTraceVersion) {
+            fail(8, "trace format version " + std::to_string(h.version) + "; this build reads " +
+                        std::to_string(kTraceVersion));
+        }
+        if (h.headerBytes != kTraceHeaderBytes) {
+            fail(12, "header size " + std::to_string(h.headerBytes) + ", expected " +
+                         std::to_string(kTraceHeaderBytes));
+        }
+        if (h.sampleBytes != kTraceSampleBytes) {
+            fail(16, "sample size " + std::to_string(h.sampleBytes) + ", expected " +
+                         std::to_string(kTraceSampleBytes));
+        }
+        if (h.flags != 0) {
+            fail(20, "unknown flags " + std::to_string(h.flags) + " (expected 0)");
+        }
+        if (!(h.rateHz > 0.0 && h.rateHz <= 1e6)) {
+            std::ostringstream s;
+            s << "servo rate " << h.rateHz << " Hz is not in (0, 1e6]";
+            fail(24, s.str());
+        }
+        if (!text(h.kind.data(), h.kind.size(), mHeader.kind)) {
+            fail(48, "the kind field is not NUL-padded printable ASCII");
+        }
+        if (!text(h.name.data(), h.name.size(), mHeader.name)) {
+            fail(64, "the name field is not NUL-padded printable ASCII");
+        }
+        const std::uint64_t body = size - kTraceHeaderBytes;
+        mHeader.version = h.version;
+        mHeader.rateHz = h.rateHz;
+        mHeader.startUnixNs = h.startUnixNs;
+        if (h.sampleCount == kTraceCountUnfinished) {
+            mHeader.finished = false;
+            mHeader.sampleCount = body / kTraceSampleBytes;
+        } else {
+            mHeader.finished = true;
+            mHeader.sampleCount = h.sampleCount;
+            if (h.sampleCount > body / kTraceSampleBytes) {
+                fail(size,
+                     "truncated: the header announces " + std::to_string(h.sampleCount) +
+                         " samples (" +
+                         std::to_string(kTraceHeaderBytes + h.sampleCount * kTraceSampleBytes) +
+                         " bytes) but the file ends after " + std::to_string(size) + " bytes");
+            }
+            if (body != h.sampleCount * kTraceSampleBytes) {
+                fail(kTraceHeaderBytes + h.sampleCount * kTraceSampleBytes,
+                     std::to_string(body - h.sampleCount * kTraceSampleBytes) +
+                         " unexpected bytes after the last of " + std::to_string(h.sampleCount) +
+                         " samples");
+            }
+        }
+    } catch (...) {
+        std::fclose(mFile);
+        mFile = nullptr;
+        throw;
+    }
+}
+
+TraceReader::~TraceReader() {
+    if (mFile) {
+        std::fclose(mFile);
+    }
+}
+
+bool TraceReader::next(TraceSample& out) {
+    if (mIndex >= mHeader.sampleCount) {
+        return false;
+    }
+    const std::uint64_t offset = kTraceHeaderBytes + mIndex * kTraceSampleBytes;
+    unsigned char bytes[kTraceSampleBytes];
+    if (std::fread(bytes, 1, sizeof bytes, mFile) != sizeof bytes) {
+        fail(offset, "cannot read sample " + std::to_string(mIndex) + " (file changed?)");
+    }
+    const std::string which = "sample " + std::to_string(mIndex) + ": ";
+    const TraceSample s = decodeTraceSample(bytes);
+    if (bytes[72] > static_cast<unsigned char>(DeviceStatus::Error)) {
+        fail(offset + 72, which + "unknown device status " + std::to_string(bytes[72]));
+    }
+    if (bytes[73] != 0 || bytes[74] != 0 || bytes[75] != 0) {
+        fail(offset + 73, which + "padding bytes are not zero (corrupt record?)");
+    }
+    if (!finite(s.positionM)) {
+        fail(offset + 16, which + "position is not finite");
+    }
+    if (!finite(s.forceN)) {
+        fail(offset + 40, which + "force is not finite");
+    }
+    if (mHaveTick && s.tick <= mLastTick) {
+        fail(offset, which + "tick " + std::to_string(s.tick) + " does not follow tick " +
+                         std::to_string(mLastTick));
+    }
+    if (mHaveTick && s.timeNs < mLastTimeNs) {
+        fail(offset + 8, which + "time goes backwards");
+    }
+    mHaveTick = true;
+    mLastTick = s.tick;
+    mLastTimeNs = s.timeNs;
+    ++mIndex;
+    out = s;
+    return true;
+}
+
+std::vector<TraceSample> TraceReader::readAll() {
+    std::vector<TraceSample> out;
+    out.reserve(static_cast<std::size_t>(mHeader.sampleCount - mIndex));
+    TraceSample s;
+    while (next(s)) {
+        out.push_back(s);
+    }
+    return out;
+}
+
+std::vector<TraceSample> TraceReader::load(const std::filesystem::path& path, TraceHeader* header) {
+    TraceReader reader(path);
+    if (header) {
+        *header = reader.header();
+    }
+    return reader.readAll();
+}
+
+} // namespace hapto

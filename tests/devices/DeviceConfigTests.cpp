@@ -1,0 +1,256 @@
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/devices/DeviceFactory.h"
+#include "hapto/devices/FalconDevice.h"
+#include "hapto/devices/PhantomDevice.h"
+#include "hapto/devices/SimDevice.h"
+#include "hapto/scenes/Generators.h"
+#include "hapto/scenes/InputError.h"
+
+#include "TestSupport.h"
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+using namespace hapto;
+
+namespace {
+
+// The n-th ```json block of devices/README-devices.md.
+std::string readmeExample(int n) {
+    const std::string text =
+        test::readFile(std::string(HAPTO_SOURCE_DIR) + "/devices/README-devices.md");
+    std::size_t at = 0;
+    for (int i = 0; i <= n; ++i) {
+        at = text.find("```json\n", at);
+        REQUIRE(at != std::string::npos);
+        at += 8;
+    }
+    return text.substr(at, text.find("```", at) - at);
+}
+
+std::string errorOf(const std::string& text) {
+    try {
+        parseDeviceConfig(text, "bad.json");
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+// One valid sim device with `extra` spliced into its object.
+std::string withDevice(const std::string& extra) {
+    return R"({"format": "hapto-devices", "version": 1, "devices": [{"name": "a", "kind": "sim")" +
+           (extra.empty() ? "" : ", " + extra) + "}]}";
+}
+
+} // namespace
+
+TEST_CASE("the README dual-device example loads with its values") {
+    const auto configs = parseDeviceConfig(readmeExample(0), "example.json");
+    REQUIRE(configs.size() == 2);
+    CHECK(configs[0].name == "left");
+    CHECK(configs[1].name == "right");
+    for (const DeviceConfig& c : configs) {
+        CHECK(c.kind == "sim");
+        CHECK(c.rateHz == 1000.0);
+        CHECK(c.maxForceN == 8.5);
+        CHECK(c.transform.scale == 1.0);
+        CHECK(c.transform.rotation == Quat(1, 0, 0, 0));
+    }
+    CHECK(configs[0].transform.translation == Vec3(-0.02, 0, 0));
+    CHECK(configs[1].transform.translation == Vec3(0.02, 0, 0));
+    CHECK(std::get<SimConfig>(configs[0].params).script == "grasp-left");
+    CHECK(std::get<SimConfig>(configs[1].params).script == "grasp-right");
+    CHECK(std::get<SimConfig>(configs[1].params).seed == 2);
+}
+
+TEST_CASE("the README hardware example loads; relative traces resolve against the file") {
+    test::TempDir dir;
+    test::writeFile(dir / "d.json", readmeExample(1));
+    const auto configs = loadDeviceConfigFile(dir / "d.json");
+    REQUIRE(configs.size() == 3);
+    const auto& falcon = std::get<FalconConfig>(configs[0].params);
+    CHECK(falcon.serial == "FHS0A1B2");
+    CHECK(falcon.home);
+    CHECK(falcon.bus == -1);
+    CHECK(std::get<PhantomConfig>(configs[1].params).deviceName == "Right PHANToM");
+    CHECK(std::get<PhantomConfig>(configs[1].params).library == "libHD.so");
+    const auto& replay = std::get<ReplayConfig>(configs[2].params);
+    CHECK(replay.loop);
+    CHECK(replay.trace == dir.path() / "runs/left.trace");
+    CHECK(configs[2].rateHz == 1000.0);
+}
+
+TEST_CASE("defaults apply to a minimal device") {
+    const auto configs = parseDeviceConfig(withDevice(""), "min.json");
+    REQUIRE(configs.size() == 1);
+    const DeviceConfig& c = configs[0];
+    CHECK(c.rateHz == 1000.0);
+    CHECK(c.maxForceN == 0.0);
+    CHECK(c.transform.translation == Vec3(0.0));
+    const SimConfig& s = std::get<SimConfig>(c.params);
+    CHECK(s.script == "walk");
+    CHECK(s.seed == 1);
+    CHECK(s.handStiffness == 300.0);
+    CHECK_FALSE(s.object.has_value());
+}
+
+TEST_CASE("every sim field parses") {
+    const auto configs = parseDeviceConfig(
+        withDevice(
+            R"("sim": {"script": "slide", "seed": 18446744073709551615, "start": [0.01, 0, 0],
+          "object": 7, "near": [0, 0.1, 0], "press_n": 2, "max_speed_m_per_s": 0.3,
+          "lift": [0, 0.04, 0], "carry": [0, 0, 0.1], "hand_mass_kg": 0.2,
+          "hand_stiffness_n_per_m": 400, "hand_damping_ratio": 0.8, "resolution_m": 0,
+          "noise_m": 0})"),
+        "all.json");
+    const SimConfig& s = std::get<SimConfig>(configs[0].params);
+    CHECK(s.script == "slide");
+    CHECK(s.seed == 18446744073709551615ull);
+    CHECK(s.start == Vec3(0.01, 0, 0));
+    CHECK(s.object == 7u);
+    CHECK(s.near == Vec3(0, 0.1, 0));
+    CHECK(s.pressForceN == 2.0);
+    CHECK(s.maxSpeedMPerS == 0.3);
+    CHECK(s.lift == Vec3(0, 0.04, 0));
+    CHECK(s.carry == Vec3(0, 0, 0.1));
+    CHECK(s.handMassKg == 0.2);
+    CHECK(s.handStiffness == 400.0);
+    CHECK(s.handDampingRatio == 0.8);
+    CHECK(s.resolutionM == 0.0);
+    CHECK(s.noiseM == 0.0);
+}
+
+TEST_CASE("every bad input names the file and its JSON path") {
+    struct Case {
+        std::string text;
+        std::string where;
+    };
+    const std::string two =
+        R"({"format": "hapto-devices", "version": 1, "devices": [{"name": "a", "kind": "sim"}, )";
+    const std::vector<Case> cases = {
+        {"[1, 2]", "bad.json: (top level): expected a JSON object"},
+        {"{\"format\": \"hapto-devices\",", "bad.json:1:"},
+        {R"({"format": "hapto-scene", "version": 1, "devices": []})", "bad.json: format:"},
+        {R"({"format": "hapto-devices", "version": 2, "devices": []})", "bad.json: version:"},
+        {R"({"format": "hapto-devices", "version": 1})", "missing required field 'devices'"},
+        {R"({"format": "hapto-devices", "version": 1, "devices": []})",
+         "bad.json: devices: list at least one device"},
+        {R"({"format": "hapto-devices", "version": 1, "devices": [], "extra": 1})",
+         "bad.json: (top level): unknown field 'extra'"},
+        {R"({"format": "hapto-devices", "version": 1, "devices": [3]})",
+         "bad.json: devices[0]: expected an object"},
+        {two + R"({"name": "a", "kind": "sim"}]})",
+         "bad.json: devices[1].name: duplicate name 'a' (also at devices[0])"},
+        {two + R"({"name": "", "kind": "sim"}]})", "bad.json: devices[1].name:"},
+        {two + R"({"name": "b c", "kind": "sim"}]})", "bad.json: devices[1].name:"},
+        {two + R"({"kind": "sim"}]})", "bad.json: devices[1]: missing required field 'name'"},
+        {two + R"({"name": "b", "kind": "robot"}]})", "bad.json: devices[1].kind: unknown kind"},
+        {two + R"({"name": "b", "kind": "sim", "rate_hz": 50}]})",
+         "bad.json: devices[1].rate_hz: the rate (Hz) must be >= 100"},
+        {two + R"({"name": "b", "kind": "sim", "rate_hz": 200000}]})",
+         "bad.json: devices[1].rate_hz: the rate (Hz) must be <= 100000"},
+        {two + R"({"name": "b", "kind": "sim", "rate_hz": "fast"}]})",
+         "bad.json: devices[1].rate_hz: expected a number, got a string"},
+        {two + R"({"name": "b", "kind": "sim", "max_force_n": -1}]})",
+         "bad.json: devices[1].max_force_n: the max force (N) must be >= 0"},
+        {two + R"({"name": "b", "kind": "sim", "transform": {"scale": 0}}]})",
+         "bad.json: devices[1].transform.scale: the scale must be > 0 (got 0)"},
+        {two + R"({"name": "b", "kind": "sim", "transform": {"rotation": [1, 1, 0, 0]}}]})",
+         "bad.json: devices[1].transform.rotation: must be a unit quaternion"},
+        {two + R"({"name": "b", "kind": "sim", "transform": {"translation": [0, 0]}}]})",
+         "bad.json: devices[1].transform.translation: expected an array of 3 numbers"},
+        {two + R"({"name": "b", "kind": "sim", "transform": {"translation": [0, "x", 0]}}]})",
+         "bad.json: devices[1].transform.translation[1]: expected a number"},
+        {two + R"({"name": "b", "kind": "sim", "transform": {"shear": 1}}]})",
+         "bad.json: devices[1].transform: unknown field 'shear'"},
+        {two + R"({"name": "b", "kind": "sim", "colour": "red"}]})",
+         "bad.json: devices[1]: unknown field 'colour'"},
+        {two + R"({"name": "b", "kind": "sim", "sim": {"script": "dance"}}]})",
+         "bad.json: devices[1].sim.script: unknown script 'dance'"},
+        {two + R"({"name": "b", "kind": "sim", "sim": {"seed": -1}}]})",
+         "bad.json: devices[1].sim.seed: expected a non-negative integer"},
+        {two + R"({"name": "b", "kind": "sim", "sim": {"speed": 1}}]})",
+         "bad.json: devices[1].sim: unknown field 'speed'"},
+        {two + R"({"name": "b", "kind": "sim", "sim": {"hand_mass_kg": 0}}]})",
+         "bad.json: devices[1].sim.hand_mass_kg:"},
+        {two + R"({"name": "b", "kind": "sim", "sim": {"noise_m": -0.001}}]})",
+         "bad.json: devices[1].sim.noise_m:"},
+        {two + R"({"name": "b", "kind": "sim", "sim": {"object": -3}}]})",
+         "bad.json: devices[1].sim.object: must be in 0.."},
+        {two + R"({"name": "b", "kind": "sim", "replay": {"trace": "x"}}]})",
+         "bad.json: devices[1].replay: settings for kind 'replay' on a device of kind 'sim'"},
+        {two + R"({"name": "b", "kind": "replay"}]})",
+         "bad.json: devices[1]: a replay device needs"},
+        {two + R"({"name": "b", "kind": "replay", "replay": {"trace": 3}}]})",
+         "bad.json: devices[1].replay.trace: expected a string"},
+        {two + R"({"name": "b", "kind": "replay", "replay": {"trace": "t", "loop": 1}}]})",
+         "bad.json: devices[1].replay.loop: expected true or false"},
+        {two + R"({"name": "b", "kind": "falcon", "falcon": {"bus": 999}}]})",
+         "bad.json: devices[1].falcon.bus: must be in -1..255"},
+        {two + R"({"name": "b", "kind": "falcon", "falcon": {"home": "yes"}}]})",
+         "bad.json: devices[1].falcon.home: expected true or false"},
+        {two + R"({"name": "b", "kind": "phantom", "phantom": {"library": ""}}]})",
+         "bad.json: devices[1].phantom.library:"},
+        {two + R"({"name": "b", "kind": "phantom", "phantom": {"serial": "x"}}]})",
+         "bad.json: devices[1].phantom: unknown field 'serial'"},
+    };
+    for (const Case& c : cases) {
+        INFO(c.text);
+        const std::string e = errorOf(c.text);
+        CHECK_THAT(e, Catch::Contains(c.where));
+    }
+}
+
+TEST_CASE("a missing file is refused with its name") {
+    CHECK_THROWS_WITH(loadDeviceConfigFile("/nonexistent/d.json"),
+                      Catch::Contains("/nonexistent/d.json: cannot open"));
+}
+
+TEST_CASE("the default devices are two simulated hands side by side in the clear region") {
+    const auto configs = defaultDeviceConfigs();
+    REQUIRE(configs.size() == 2);
+    CHECK(configs[0].name == "left");
+    CHECK(configs[1].name == "right");
+    CHECK(configs[0].transform.translation == Vec3(-0.02, 0, 0));
+    CHECK(configs[1].transform.translation == Vec3(0.02, 0, 0));
+    const Scene scene = makeDefaultScene();
+    for (const DeviceConfig& c : configs) {
+        CHECK(c.kind == "sim");
+        CHECK(c.rateHz == 1000.0);
+        const Vec3 start = c.transform.positionToWorld(std::get<SimConfig>(c.params).start);
+        for (const SceneObject& o : scene.objects()) {
+            CHECK_FALSE(o.contains(start));
+        }
+        auto device = makeDevice(c, scene);
+        CHECK(device->name() == c.name);
+        CHECK(device->open() == DeviceStatus::Ok);
+    }
+}
+
+TEST_CASE("the factory makes every kind, and hardware kinds fail at open, not before") {
+    const Scene scene = makeDefaultScene();
+    DeviceConfig c = defaultDeviceConfigs()[0];
+    CHECK(dynamic_cast<SimDevice*>(makeDevice(c, scene).get()) != nullptr);
+    c.kind = "falcon";
+    c.params = FalconConfig{};
+    auto falcon = makeDevice(c, scene);
+    CHECK(dynamic_cast<FalconDevice*>(falcon.get()) != nullptr);
+    CHECK(falcon->kind() == "falcon");
+    c.kind = "phantom";
+    PhantomConfig phantom;
+    phantom.library = "libHD-that-does-not-exist.so";
+    c.params = phantom;
+    auto ph = makeDevice(c, scene);
+    CHECK(dynamic_cast<PhantomDevice*>(ph.get()) != nullptr);
+    CHECK(ph->open() != DeviceStatus::Ok); // no OpenHaptics here: a clear error, no throw
+    CHECK_THAT(ph->errorMessage(), Catch::Contains("libHD-that-does-not-exist.so"));
+    c.kind = "gamepad";
+    CHECK_THROWS_AS(makeDevice(c, scene), InputError);
+    c.kind = "sim";
+    SimConfig sim;
+    sim.object = 123456;
+    c.params = sim;
+    CHECK_THROWS_WITH(makeDevice(c, scene), Catch::Contains("123456"));
+}

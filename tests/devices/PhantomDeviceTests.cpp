@@ -1,0 +1,357 @@
+// PhantomDevice against the stand-in HD library built from fakehd/FakeHD.cpp.
+// Tests wait for conditions with generous bounded timeouts and never assert durations.
+
+#include "hapto/devices/PhantomDevice.h"
+
+#include <catch2/catch.hpp>
+
+#include <dlfcn.h>
+
+#include <chrono>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+using namespace hapto;
+
+namespace {
+
+const std::string kFakeLibrary = HAPTO_FAKEHD_LIBRARY;
+constexpr int kDefault = 0; // "Default Device"
+constexpr int kLeft = 1;    // "Left Touch"
+constexpr int kRight = 2;   // "Right Touch"
+
+/// The stand-in library's test hooks, resolved from the same loaded copy PhantomDevice uses.
+/// Resets the stand-in at construction, so declare it before any device.
+struct FakeHd {
+    void (*reset)();
+    void (*setMotion)(int, double, double, double, double, double, double);
+    void (*setButtons)(int, int);
+    void (*lastForce)(int, double*);
+    unsigned long long (*forceFrames)(int);
+    double (*maxForceSeen)(int);
+    void (*injectError)(int, unsigned, int);
+    void (*stall)(int);
+    void (*removeDevice)(int);
+    int (*isInitialised)(int);
+    int (*forceOutputEnabled)(int);
+    int (*schedulerRunning)();
+    int (*callbacksScheduled)();
+    int (*maxDevicesPerTick)();
+    int (*initWhileRunning)();
+
+    FakeHd() {
+        mLib = dlopen(kFakeLibrary.c_str(), RTLD_NOW | RTLD_LOCAL);
+        if (!mLib) {
+            throw std::runtime_error(std::string("cannot load the stand-in HD library: ") +
+                                     dlerror());
+        }
+        get("fakehd_reset", reset);
+        get("fakehd_set_motion", setMotion);
+        get("fakehd_set_buttons", setButtons);
+        get("fakehd_last_force", lastForce);
+        get("fakehd_force_frames", forceFrames);
+        get("fakehd_max_force_seen", maxForceSeen);
+        get("fakehd_inject_error", injectError);
+        get("fakehd_stall", stall);
+        get("fakehd_remove_device", removeDevice);
+        get("fakehd_is_initialised", isInitialised);
+        get("fakehd_force_output_enabled", forceOutputEnabled);
+        get("fakehd_scheduler_running", schedulerRunning);
+        get("fakehd_callbacks_scheduled", callbacksScheduled);
+        get("fakehd_max_devices_per_tick", maxDevicesPerTick);
+        get("fakehd_init_while_running", initWhileRunning);
+        reset();
+    }
+    ~FakeHd() {
+        stall(0);
+        dlclose(mLib); // PhantomDevice's own dlopen keeps it loaded
+    }
+    FakeHd(const FakeHd&) = delete;
+    FakeHd& operator=(const FakeHd&) = delete;
+
+    Vec3 force(int dev) const {
+        double f[3];
+        lastForce(dev, f);
+        return Vec3(f[0], f[1], f[2]);
+    }
+
+private:
+    template <class Fn> void get(const char* name, Fn& fn) {
+        fn = reinterpret_cast<Fn>(dlsym(mLib, name));
+        if (!fn) {
+            throw std::runtime_error(std::string("stand-in HD library lacks ") + name);
+        }
+    }
+    void* mLib = nullptr;
+};
+
+/// Polls `condition` until it holds or 10 s pass; returns whether it held.
+bool waitFor(const std::function<bool()>& condition) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (std::chrono::steady_clock::now() < deadline) {
+        if (condition()) {
+            return true;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return condition();
+}
+
+PhantomConfig fakeConfig(const std::string& deviceName) {
+    PhantomConfig c;
+    c.deviceName = deviceName;
+    c.library = kFakeLibrary;
+    return c;
+}
+
+bool near(const Vec3& a, const Vec3& b, double tolerance = 1e-12) {
+    return glm::length(a - b) <= tolerance;
+}
+
+} // namespace
+
+TEST_CASE("a phantom opens by name or the default, and a wrong name is an error naming it") {
+    FakeHd fake;
+    {
+        PhantomDevice dev("left", fakeConfig(""), 0.0);
+        CHECK(dev.kind() == "phantom");
+        CHECK(dev.name() == "left");
+        REQUIRE(dev.open() == DeviceStatus::Ok);
+        CHECK(fake.isInitialised(kDefault) == 1);
+        CHECK(fake.forceOutputEnabled(kDefault) == 1);
+        CHECK(dev.open() == DeviceStatus::Ok); // already open: no second hdInitDevice
+        const DeviceCapabilities caps = dev.capabilities();
+        CHECK(caps.model == "Fake Touch");
+        CHECK(caps.maxForceN == Approx(3.3));          // HD_NOMINAL_MAX_FORCE, N
+        CHECK(caps.maxStiffness == Approx(1260.0));    // 1.26 N/mm -> N/m
+        CHECK(caps.workspace.min.x == Approx(-0.080)); // mm -> m
+        CHECK(caps.workspace.max.z == Approx(0.035));
+        dev.close();
+        CHECK(fake.isInitialised(kDefault) == 0);
+    }
+    {
+        PhantomDevice dev("right", fakeConfig("Right Touch"), 2.0);
+        REQUIRE(dev.open() == DeviceStatus::Ok);
+        CHECK(fake.isInitialised(kRight) == 1);
+        CHECK(fake.isInitialised(kDefault) == 0);
+        CHECK(dev.capabilities().maxForceN == Approx(2.0)); // the configured clamp is smaller
+    }
+    CHECK(fake.isInitialised(kRight) == 0); // the destructor closed it
+    {
+        PhantomDevice dev("left", fakeConfig("No Such Touch"), 0.0);
+        CHECK(dev.open() == DeviceStatus::Error);
+        const std::string msg = dev.errorMessage();
+        CHECK_THAT(msg, Catch::Contains("No Such Touch"));
+        CHECK_THAT(msg, Catch::Contains("\"left\""));
+        CHECK_THAT(msg, Catch::Contains("HD_COMM_CONFIG_ERROR"));
+        DeviceState s;
+        CHECK(dev.read(s) == DeviceStatus::NotOpen);
+        CHECK(dev.write(Vec3(1, 0, 0)) == DeviceStatus::NotOpen);
+    }
+    CHECK(fake.schedulerRunning() == 0);
+    CHECK(fake.callbacksScheduled() == 0);
+}
+
+TEST_CASE("positions arrive in metres from the HD's millimetres, with velocity and buttons") {
+    FakeHd fake;
+    fake.setMotion(kDefault, 12.5, -40.0, 7.0, 0.0, 0.0, 0.0);
+    fake.setButtons(kDefault, 0b10);
+    PhantomDevice dev("left", fakeConfig(""), 0.0);
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    DeviceState s;
+    REQUIRE(dev.read(s) == DeviceStatus::Ok);
+    CHECK(near(s.position, Vec3(0.0125, -0.040, 0.007)));
+    CHECK(s.hasVelocity);
+    CHECK(near(s.velocity, Vec3(0.0)));
+    CHECK(s.buttons == 0b10u);
+    CHECK(s.sequence > 0);
+
+    // Now move along x at 100 mm/s and z at -50 mm/s: velocity in m/s, x grows, y stays.
+    fake.setMotion(kDefault, 12.5, -40.0, 7.0, 100.0, 0.0, -50.0);
+    fake.setButtons(kDefault, 0b01);
+    REQUIRE(waitFor([&] {
+        return dev.read(s) == DeviceStatus::Ok && near(s.velocity, Vec3(0.1, 0.0, -0.05));
+    }));
+    const std::uint64_t firstSequence = s.sequence;
+    const double firstX = s.position.x;
+    REQUIRE(waitFor([&] {
+        DeviceState t;
+        return dev.read(t) == DeviceStatus::Ok && t.sequence > firstSequence + 5 &&
+               t.position.x > firstX && t.position.z < 0.007 &&
+               std::abs(t.position.y + 0.040) < 1e-12 && t.buttons == 0b01u;
+    }));
+}
+
+TEST_CASE("forces arrive in newtons, clamped to the limit, and are zero after close") {
+    FakeHd fake;
+    PhantomDevice dev("left", fakeConfig("Left Touch"), 2.0);
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    CHECK(near(fake.force(kLeft), Vec3(0.0))); // open applies zero force
+
+    REQUIRE(dev.write(Vec3(1.0, -0.5, 0.25)) == DeviceStatus::Ok);
+    CHECK(waitFor([&] { return near(fake.force(kLeft), Vec3(1.0, -0.5, 0.25)); }));
+
+    // 5 N along y exceeds the 2 N limit: the device gets 2 N along y.
+    REQUIRE(dev.write(Vec3(0.0, 5.0, 0.0)) == DeviceStatus::Ok);
+    CHECK(waitFor([&] { return near(fake.force(kLeft), Vec3(0.0, 2.0, 0.0), 1e-9); }));
+    CHECK(fake.maxForceSeen(kLeft) <= 2.0 + 1e-9);
+
+    // A non-finite force is refused and zero is applied instead.
+    CHECK(dev.write(Vec3(std::nan(""), 0.0, 0.0)) == DeviceStatus::BadData);
+    CHECK(waitFor([&] { return near(fake.force(kLeft), Vec3(0.0)); }));
+
+    REQUIRE(dev.write(Vec3(0.0, 0.0, 1.5)) == DeviceStatus::Ok);
+    REQUIRE(waitFor([&] { return near(fake.force(kLeft), Vec3(0.0, 0.0, 1.5)); }));
+    const unsigned long long framesBeforeClose = fake.forceFrames(kLeft);
+    dev.close();
+    // The last frame before hdDisableDevice applied zero (the fake keeps it after the release).
+    CHECK(fake.forceFrames(kLeft) > framesBeforeClose);
+    CHECK(near(fake.force(kLeft), Vec3(0.0)));
+    CHECK(fake.isInitialised(kLeft) == 0);
+    CHECK(fake.forceOutputEnabled(kLeft) == 0);
+    CHECK(fake.schedulerRunning() == 0);
+    CHECK(dev.write(Vec3(1, 0, 0)) == DeviceStatus::NotOpen);
+    dev.close(); // twice is safe
+}
+
+TEST_CASE("two phantoms share one HD scheduler and each gets its own force") {
+    FakeHd fake;
+    fake.setMotion(kLeft, -100.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    fake.setMotion(kRight, 100.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    PhantomDevice left("left", fakeConfig("Left Touch"), 0.0);
+    PhantomDevice right("right", fakeConfig("Right Touch"), 0.0);
+    REQUIRE(left.open() == DeviceStatus::Ok);
+    REQUIRE(right.open() == DeviceStatus::Ok);
+    CHECK(fake.initWhileRunning() == 0); // the scheduler was paused around hdInitDevice
+    CHECK(fake.callbacksScheduled() == 2);
+    // Both devices are framed within one tick of the one scheduler thread.
+    CHECK(waitFor([&] { return fake.maxDevicesPerTick() == 2; }));
+
+    DeviceState l, r;
+    REQUIRE(waitFor([&] { return left.read(l) == DeviceStatus::Ok; }));
+    REQUIRE(waitFor([&] { return right.read(r) == DeviceStatus::Ok; }));
+    CHECK(near(l.position, Vec3(-0.1, 0.0, 0.0)));
+    CHECK(near(r.position, Vec3(0.1, 0.0, 0.0)));
+
+    REQUIRE(left.write(Vec3(1.0, 0.0, 0.0)) == DeviceStatus::Ok);
+    REQUIRE(right.write(Vec3(0.0, -2.0, 0.0)) == DeviceStatus::Ok);
+    CHECK(waitFor([&] {
+        return near(fake.force(kLeft), Vec3(1.0, 0.0, 0.0)) &&
+               near(fake.force(kRight), Vec3(0.0, -2.0, 0.0));
+    }));
+
+    // Closing one leaves the other running on the same scheduler.
+    left.close();
+    CHECK(fake.schedulerRunning() == 1);
+    CHECK(fake.callbacksScheduled() == 1);
+    CHECK(near(fake.force(kLeft), Vec3(0.0)));
+    REQUIRE(right.write(Vec3(0.0, 0.0, 0.5)) == DeviceStatus::Ok);
+    CHECK(waitFor([&] { return near(fake.force(kRight), Vec3(0.0, 0.0, 0.5)); }));
+    CHECK(waitFor([&] { return right.read(r) == DeviceStatus::Ok; }));
+    right.close();
+    CHECK(fake.schedulerRunning() == 0);
+}
+
+TEST_CASE("an HD error in the scheduler becomes a fault with the HD code and text") {
+    FakeHd fake;
+    PhantomDevice dev("left", fakeConfig(""), 0.0);
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    REQUIRE(dev.write(Vec3(0.5, 0.0, 0.0)) == DeviceStatus::Ok);
+    REQUIRE(waitFor([&] { return near(fake.force(kDefault), Vec3(0.5, 0.0, 0.0)); }));
+
+    fake.injectError(kDefault, 0x0300 /* HD_DEVICE_FAULT */, 42);
+    DeviceState s;
+    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Error; }));
+    CHECK(dev.write(Vec3(0.5, 0.0, 0.0)) == DeviceStatus::Error);
+    const std::string msg = dev.errorMessage();
+    CHECK_THAT(msg, Catch::Contains("0x0300"));
+    CHECK_THAT(msg, Catch::Contains("HD_DEVICE_FAULT"));
+    CHECK_THAT(msg, Catch::Contains("Device fault (fake)")); // hdGetErrorString's text
+    CHECK_THAT(msg, Catch::Contains("42"));
+    // A faulted device applies zero force.
+    CHECK(waitFor([&] { return near(fake.force(kDefault), Vec3(0.0)); }));
+    dev.close();
+    CHECK_THAT(dev.errorMessage(), Catch::Contains("HD_DEVICE_FAULT")); // kept after close
+
+    // Reopening clears the fault.
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    CHECK(dev.read(s) == DeviceStatus::Ok);
+}
+
+TEST_CASE("an unplugged phantom reads Disconnected") {
+    FakeHd fake;
+    PhantomDevice dev("left", fakeConfig(""), 0.0);
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    fake.removeDevice(kDefault);
+    DeviceState s;
+    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Disconnected; }));
+    CHECK_THAT(dev.errorMessage(), Catch::Contains("HD_COMM_ERROR"));
+    CHECK_THAT(dev.errorMessage(), Catch::Contains("cable"));
+}
+
+TEST_CASE("a stalled HD scheduler makes read() report Stalled, and close() still returns") {
+    FakeHd fake;
+    PhantomDevice dev("left", fakeConfig(""), 0.0);
+    dev.setStaleTimeout(std::chrono::milliseconds(20));
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    DeviceState s;
+    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Ok; }));
+
+    fake.stall(1);
+    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Stalled; }));
+    CHECK(dev.read(s) == DeviceStatus::Stalled); // no newer sample: counted as a stale read
+    CHECK(dev.staleSampleCount() > 0);
+    fake.stall(0);
+    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Ok; }));
+
+    fake.stall(1);
+    dev.close(); // gives up waiting for the zero-force tick, releases the device anyway
+    CHECK(fake.isInitialised(kDefault) == 0);
+    CHECK(fake.callbacksScheduled() == 0);
+    CHECK_THAT(dev.errorMessage(), Catch::Contains("not confirmed"));
+}
+
+TEST_CASE("a missing HD library is a clear error and probePhantoms says why") {
+    const std::string missing = "/nonexistent/hapto/libHD.so";
+    PhantomConfig config;
+    config.library = missing;
+    PhantomDevice dev("left", config, 0.0);
+    CHECK(dev.open() == DeviceStatus::Error);
+    CHECK_THAT(dev.errorMessage(), Catch::Contains("not found"));
+    CHECK_THAT(dev.errorMessage(), Catch::Contains("install OpenHaptics"));
+    CHECK_THAT(dev.errorMessage(), Catch::Contains(missing));
+
+    std::string why;
+    const std::vector<PhantomInfo> found = probePhantoms(missing, why);
+    CHECK(found.empty());
+    CHECK_THAT(why, Catch::Contains("OpenHaptics"));
+    CHECK_THAT(why, Catch::Contains("not found: install OpenHaptics from 3D Systems; hapto loads "
+                                    "it at run time"));
+
+    // A library that is not libHD at all is named as such.
+    const std::vector<PhantomInfo> none = probePhantoms("libc.so.6", why);
+    CHECK(none.empty());
+    CHECK_THAT(why, Catch::Contains("not a usable OpenHaptics HD library"));
+}
+
+TEST_CASE("probePhantoms lists the stand-in's default device") {
+    FakeHd fake;
+    std::string why;
+    const std::vector<PhantomInfo> found = probePhantoms(kFakeLibrary, why);
+    REQUIRE(found.size() == 1);
+    CHECK(why.empty());
+    CHECK(found[0].deviceName.empty());
+    CHECK(found[0].model == "Fake Touch");
+    CHECK(found[0].serial == "FAKE-0001");
+    CHECK(found[0].maxForceN == Approx(3.3));
+    CHECK(found[0].workspace.max.x == Approx(0.080));
+    CHECK(fake.isInitialised(kDefault) == 0); // the probe released it
+
+    // While a phantom of that library is open, the probe refuses instead of interfering.
+    PhantomDevice dev("left", fakeConfig(""), 0.0);
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    CHECK(probePhantoms(kFakeLibrary, why).empty());
+    CHECK_THAT(why, Catch::Contains("in use"));
+}

@@ -1,0 +1,394 @@
+#include "hapto/devices/DeviceFactory.h"
+#include "hapto/devices/HandModel.h"
+#include "hapto/devices/SimDevice.h"
+#include "hapto/scenes/Generators.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+using namespace hapto;
+
+namespace {
+
+DeviceConfig simConfig(const std::string& script, std::uint64_t seed,
+                       Vec3 translation = Vec3(0.0)) {
+    DeviceConfig c;
+    c.name = "hand";
+    c.kind = "sim";
+    c.transform.translation = translation;
+    SimConfig s;
+    s.script = script;
+    s.seed = seed;
+    c.params = s;
+    return c;
+}
+
+SimConfig& sim(DeviceConfig& c) {
+    return std::get<SimConfig>(c.params);
+}
+
+// Depth (m) of p below the face of an axis-aligned box whose outward normal is n.
+double depthBelowFace(const SceneObject& o, const Vec3& n, const Vec3& p) {
+    const double plane = glm::dot(o.center, n) + glm::dot(o.halfExtents, glm::abs(n));
+    return plane - glm::dot(p, n);
+}
+
+// A penalty renderer for one box face: F = k * depth * n while p is inside the box.
+Vec3 penaltyForce(const SceneObject& o, const Vec3& n, const Vec3& p, double k) {
+    return o.contains(p) ? k * depthBelowFace(o, n, p) * n : Vec3(0.0);
+}
+
+std::vector<Vec3> run(SimDevice& d, int ticks) {
+    std::vector<Vec3> out;
+    out.reserve(ticks);
+    DeviceState s;
+    for (int i = 0; i < ticks; ++i) {
+        REQUIRE(d.read(s) == DeviceStatus::Ok);
+        out.push_back(s.position);
+    }
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("hand model: a constant force moves the equilibrium by F / k") {
+    HandModel hand(0.15, 300.0, 1.0);
+    hand.reset(Vec3(0.0));
+    const Vec3 f(1.5, -0.6, 0.3);
+    for (int i = 0; i < 5000; ++i) {
+        hand.step(Vec3(0.01, 0, 0), f, 1e-3);
+    }
+    const Vec3 expected = Vec3(0.01, 0, 0) + f / 300.0;
+    CHECK(glm::length(hand.position() - expected) < 1e-9);
+    CHECK(glm::length(hand.velocity()) < 1e-9);
+    CHECK(hand.damping() == Approx(2.0 * std::sqrt(300.0 * 0.15)));
+}
+
+TEST_CASE("hand model: stable and non-overshooting at 100 Hz") {
+    HandModel hand(0.15, 300.0, 1.0);
+    hand.reset(Vec3(0.0));
+    double maxX = 0.0;
+    for (int i = 0; i < 500; ++i) {
+        hand.step(Vec3(0.05, 0, 0), Vec3(0.0), 1e-2);
+        maxX = std::max(maxX, hand.position().x);
+    }
+    CHECK(maxX <= 0.05 + 1e-12);
+    CHECK(hand.position().x == Approx(0.05).margin(1e-6));
+}
+
+TEST_CASE("sim: same seed gives the same trajectory bit for bit, another seed differs") {
+    const Scene scene = makeDefaultScene();
+    for (const char* script : {"walk", "free", "slide"}) {
+        INFO(script);
+        SimDevice a(simConfig(script, 7), scene), b(simConfig(script, 7), scene),
+            c(simConfig(script, 8), scene);
+        REQUIRE(a.open() == DeviceStatus::Ok);
+        REQUIRE(b.open() == DeviceStatus::Ok);
+        REQUIRE(c.open() == DeviceStatus::Ok);
+        const auto pa = run(a, 4000), pb = run(b, 4000), pc = run(c, 4000);
+        CHECK(pa == pb);
+        CHECK(pa != pc);
+        // Reopening starts over exactly.
+        REQUIRE(a.open() == DeviceStatus::Ok);
+        CHECK(run(a, 4000) == pa);
+    }
+}
+
+TEST_CASE("sim: the device feels the force written to it") {
+    const Scene empty; // nothing to touch: the hand holds still at its start
+    DeviceConfig c = simConfig("touch", 1);
+    sim(c).noiseM = 0.0;
+    sim(c).resolutionM = 0.0;
+    SimDevice d(c, empty);
+    REQUIRE(d.open() == DeviceStatus::Ok);
+    const Vec3 f(0.0, 2.0, -1.0);
+    DeviceState s;
+    for (int i = 0; i < 5000; ++i) {
+        REQUIRE(d.write(f) == DeviceStatus::Ok);
+        REQUIRE(d.read(s) == DeviceStatus::Ok);
+    }
+    CHECK(glm::length(s.position - f / 300.0) < 1e-9);
+    // Forces beyond the limit are clamped; non-finite ones refused.
+    CHECK(d.write(Vec3(100.0, 0, 0)) == DeviceStatus::Ok);
+    CHECK(d.write(Vec3(NAN, 0, 0)) == DeviceStatus::BadData);
+    d.close();
+    CHECK(d.read(s) == DeviceStatus::NotOpen);
+    CHECK(d.write(f) == DeviceStatus::NotOpen);
+}
+
+TEST_CASE("sim free: never enters a solid over a long run in random scenes") {
+    for (std::uint64_t seed : {1u, 2u, 3u}) {
+        RandomOptions opt;
+        opt.count = 150;
+        opt.seed = seed;
+        opt.keepClear = 0.03;
+        opt.rotate = seed == 2;
+        const Scene scene = makeRandomScene(opt);
+        SimDevice d(simConfig("free", seed), scene);
+        REQUIRE(d.open() == DeviceStatus::Ok);
+        DeviceState s;
+        Aabb visited = Aabb::empty();
+        int inside = 0;
+        for (int i = 0; i < 120000; ++i) { // 2 minutes at 1 kHz
+            REQUIRE(d.read(s) == DeviceStatus::Ok);
+            const Vec3 p = d.handPositionWorld();
+            visited.expand(p);
+            if (i % 2 == 0) {
+                for (const SceneObject& o : scene.objects()) {
+                    inside += o.contains(p);
+                }
+            }
+        }
+        INFO("seed " << seed);
+        CHECK(inside == 0);
+        CHECK(glm::length(visited.size()) > 0.03); // it did move about
+        CHECK(d.phase() == ScriptPhase::Move);
+    }
+}
+
+TEST_CASE("sim touch: ends up pressing on the nearest surface, steadily") {
+    const Scene scene = makeDefaultScene();
+    DeviceConfig c = simConfig("touch", 1, Vec3(0.01, 0.0, 0.0));
+    SimDevice d(c, scene);
+    REQUIRE(d.open() == DeviceStatus::Ok);
+    REQUIRE(d.script()->object().has_value());
+    const SceneObject& o = scene.object(*scene.slotOf(*d.script()->object()));
+    const Vec3 n = d.script()->contactNormal();
+    const double kSurface = 800.0;
+    DeviceState s;
+    Vec3 force(0.0);
+    std::vector<double> depths;
+    for (int i = 0; i < 12000; ++i) {
+        REQUIRE(d.write(force) == DeviceStatus::Ok);
+        REQUIRE(d.read(s) == DeviceStatus::Ok);
+        const Vec3 p = c.transform.positionToWorld(s.position);
+        force = penaltyForce(o, n, p, kSurface);
+        if (i >= 11000) {
+            depths.push_back(o.contains(p) ? depthBelowFace(o, n, p) : -1.0);
+        }
+    }
+    CHECK(d.phase() == ScriptPhase::Hold);
+    const auto [lo, hi] = std::minmax_element(depths.begin(), depths.end());
+    // Pressing with 1.5 N through the hand's 300 N/m against 800 N/m: about 1.4 mm deep.
+    CHECK(*lo > 0.0005);
+    CHECK(*hi < 0.003);
+    CHECK(*hi - *lo < 5e-5); // steady
+    CHECK(glm::length(force) == Approx(1.5 * 800.0 / 1100.0).epsilon(0.05));
+}
+
+TEST_CASE("sim slide: moves along the surface while pressing on it") {
+    const Scene scene = makeDefaultScene();
+    DeviceConfig c = simConfig("slide", 1, Vec3(-0.01, 0.0, 0.0));
+    SimDevice d(c, scene);
+    REQUIRE(d.open() == DeviceStatus::Ok);
+    const SceneObject& o = scene.object(*scene.slotOf(*d.script()->object()));
+    const Vec3 n = d.script()->contactNormal();
+    DeviceState s;
+    Vec3 force(0.0);
+    int sliding = 0, inContact = 0;
+    double maxDepth = 0.0;
+    Aabb along = Aabb::empty(); // the contact point's travel within the face plane
+    for (int i = 0; i < 20000; ++i) {
+        REQUIRE(d.write(force) == DeviceStatus::Ok);
+        REQUIRE(d.read(s) == DeviceStatus::Ok);
+        const Vec3 p = c.transform.positionToWorld(s.position);
+        force = penaltyForce(o, n, p, 800.0);
+        if (d.phase() == ScriptPhase::Slide) {
+            ++sliding;
+            inContact += o.contains(p);
+            maxDepth = std::max(maxDepth, depthBelowFace(o, n, p));
+            along.expand(p - glm::dot(p, n) * n);
+        }
+    }
+    REQUIRE(sliding > 10000);
+    CHECK(inContact > 0.98 * sliding);
+    CHECK(glm::length(along.size()) > 0.02); // centimetres along the face
+    CHECK(maxDepth < 0.004);
+}
+
+TEST_CASE("sim walk: stays in the scene bounds below the speed cap") {
+    const Scene scene = makeDefaultScene();
+    DeviceConfig c = simConfig("walk", 3);
+    SimDevice d(c, scene);
+    REQUIRE(d.open() == DeviceStatus::Ok);
+    DeviceState s;
+    double maxSpeed = 0.0;
+    int outside = 0;
+    const Aabb b = scene.bounds();
+    for (int i = 0; i < 120000; ++i) {
+        REQUIRE(d.read(s) == DeviceStatus::Ok);
+        REQUIRE(s.hasVelocity);
+        maxSpeed = std::max(maxSpeed, glm::length(s.velocity));
+        outside += !b.contains(c.transform.positionToWorld(s.position));
+    }
+    CHECK(outside == 0);
+    CHECK(maxSpeed <= 0.5);
+    CHECK(maxSpeed > 0.2); // hand speeds, not a crawl
+}
+
+TEST_CASE("sim: quantisation and noise stay within what is configured") {
+    const Scene scene = makeDefaultScene();
+    for (const auto& [noise, resolution] : std::vector<std::pair<double, double>>{
+             {1e-4, 1e-3}, {5e-6, 0.0}, {0.0, 2e-5}, {0.0, 0.0}}) {
+        DeviceConfig c = simConfig("walk", 5);
+        sim(c).noiseM = noise;
+        sim(c).resolutionM = resolution;
+        SimDevice d(c, scene);
+        REQUIRE(d.open() == DeviceStatus::Ok);
+        DeviceState s;
+        double maxError = 0.0;
+        bool onGrid = true;
+        for (int i = 0; i < 5000; ++i) {
+            REQUIRE(d.read(s) == DeviceStatus::Ok);
+            for (int k = 0; k < 3; ++k) {
+                maxError = std::max(maxError, std::abs(s.position[k] - d.handPosition()[k]));
+                if (resolution > 0.0) {
+                    const double q = s.position[k] / resolution;
+                    onGrid = onGrid && std::abs(q - std::round(q)) < 1e-6;
+                }
+            }
+        }
+        INFO("noise " << noise << " resolution " << resolution);
+        CHECK(maxError <= noise + 0.5 * resolution + 1e-12);
+        CHECK(onGrid);
+        if (noise == 0.0 && resolution == 0.0) {
+            CHECK(maxError == 0.0);
+        } else {
+            CHECK(maxError > 0.1 * (noise + 0.5 * resolution)); // the effect is there
+        }
+    }
+}
+
+TEST_CASE("sim: workspace transforms put left and right where the configuration says") {
+    const Scene scene = makeDefaultScene();
+    DeviceConfig left = simConfig("touch", 1, Vec3(-0.02, 0, 0));
+    DeviceConfig right = simConfig("touch", 1, Vec3(0.02, 0, 0));
+    // Right device turned 90 degrees about +y and scaled: device +x is world -z.
+    right.transform.rotation = glm::angleAxis(std::numbers::pi / 2, Vec3(0, 1, 0));
+    right.transform.scale = 2.0;
+    for (DeviceConfig* c : {&left, &right}) {
+        sim(*c).noiseM = 0.0;
+        sim(*c).resolutionM = 0.0;
+    }
+    SimDevice l(left, scene), r(right, scene);
+    REQUIRE(l.open() == DeviceStatus::Ok);
+    REQUIRE(r.open() == DeviceStatus::Ok);
+    CHECK(glm::length(l.handPositionWorld() - Vec3(-0.02, 0, 0)) < 1e-12);
+    CHECK(glm::length(r.handPositionWorld() - Vec3(0.02, 0, 0)) < 1e-12);
+    DeviceState sl, sr;
+    for (int i = 0; i < 3000; ++i) {
+        REQUIRE(l.read(sl) == DeviceStatus::Ok);
+        REQUIRE(r.read(sr) == DeviceStatus::Ok);
+        // Readings are device-frame; mapped back they are the hand in the world.
+        REQUIRE(glm::length(left.transform.positionToWorld(sl.position) - l.handPositionWorld()) <
+                1e-12);
+        REQUIRE(glm::length(right.transform.positionToWorld(sr.position) - r.handPositionWorld()) <
+                1e-12);
+    }
+    CHECK(l.handPositionWorld().x < r.handPositionWorld().x);
+    CHECK(glm::length(right.transform.positionToWorld(Vec3(0.01, 0, 0)) - Vec3(0.02, 0, -0.02)) <
+          1e-12);
+    // A world force along -z pushes the rotated device along its +x.
+    CHECK(glm::length(right.transform.forceToDevice(Vec3(0, 0, -1)) - Vec3(1, 0, 0)) < 1e-12);
+}
+
+TEST_CASE("sim grasp: two hands squeeze one object from -x and +x, lift, carry, release") {
+    // Sparser than the default scene, whose 200 overlapping cubes leave almost no object free
+    // on both sides.
+    RandomOptions opt;
+    opt.count = 40;
+    opt.seed = 7;
+    opt.keepClear = 0.04;
+    const Scene scene = makeRandomScene(opt);
+    DeviceConfig lc = simConfig("grasp-left", 1, Vec3(-0.02, 0, 0));
+    DeviceConfig rc = simConfig("grasp-right", 2, Vec3(0.02, 0, 0));
+    lc.name = "left";
+    rc.name = "right";
+    SimDevice l(lc, scene), r(rc, scene);
+    REQUIRE(l.open() == DeviceStatus::Ok);
+    REQUIRE(r.open() == DeviceStatus::Ok);
+    REQUIRE(l.script()->object().has_value());
+    REQUIRE(l.script()->object() == r.script()->object());
+    const SceneObject& o = scene.object(*scene.slotOf(*l.script()->object()));
+
+    std::vector<ScriptPhase> seen;
+    DeviceState sl, sr;
+    int approachInside = 0;
+    Vec3 squeezeL(0.0), squeezeR(0.0), liftedL(0.0), carriedL(0.0);
+    bool buttonWhileLifting = true;
+    for (int i = 0; i < 9500; ++i) {
+        REQUIRE(l.read(sl) == DeviceStatus::Ok);
+        REQUIRE(r.read(sr) == DeviceStatus::Ok);
+        REQUIRE(l.phase() == r.phase()); // one timetable
+        if (seen.empty() || seen.back() != l.phase()) {
+            seen.push_back(l.phase());
+        }
+        if (l.phase() == ScriptPhase::Approach) {
+            for (const SceneObject& other : scene.objects()) {
+                approachInside += other.contains(l.handPositionWorld());
+                approachInside += other.contains(r.handPositionWorld());
+            }
+        }
+        if (l.phase() == ScriptPhase::Lift) {
+            buttonWhileLifting = buttonWhileLifting && (sl.buttons & 1u) && (sr.buttons & 1u);
+        }
+        const double t = l.timeS();
+        if (std::abs(t - 4.4) < 1e-9) {
+            squeezeL = l.handPositionWorld();
+            squeezeR = r.handPositionWorld();
+        }
+        if (std::abs(t - GraspTimes::kLiftEnd) < 1e-9) {
+            liftedL = l.handPositionWorld();
+        }
+        if (std::abs(t - GraspTimes::kCarryEnd) < 1e-9) {
+            carriedL = l.handPositionWorld();
+        }
+    }
+    const std::vector<ScriptPhase> expected = {
+        ScriptPhase::Approach, ScriptPhase::Reach,   ScriptPhase::Squeeze, ScriptPhase::Lift,
+        ScriptPhase::Carry,    ScriptPhase::PutDown, ScriptPhase::Release, ScriptPhase::Done};
+    CHECK(seen == expected);
+    CHECK(approachInside == 0);
+    CHECK(buttonWhileLifting);
+    // Squeezing: each hand just inside its own side (no renderer here pushes back).
+    CHECK(squeezeL.x < o.center.x);
+    CHECK(squeezeR.x > o.center.x);
+    CHECK(o.contains(squeezeL));
+    CHECK(o.contains(squeezeR));
+    CHECK(std::abs(squeezeL.y - o.center.y) < 0.002);
+    CHECK(std::abs(squeezeR.z - o.center.z) < 0.002);
+    // Lifted by 5 cm (+y), then carried 10 cm (+x).
+    CHECK(liftedL.y - squeezeL.y == Approx(0.05).margin(0.003));
+    CHECK(carriedL.x - liftedL.x == Approx(0.10).margin(0.003));
+    // Released: both hands off the object's put-down place.
+    SceneObject moved = o;
+    moved.center += Vec3(0.10, 0, 0);
+    CHECK_FALSE(moved.contains(l.handPositionWorld()));
+    CHECK_FALSE(moved.contains(r.handPositionWorld()));
+    CHECK(sl.buttons == 0u);
+}
+
+TEST_CASE("sim: any number of devices run side by side without sharing state") {
+    const Scene scene = makeDefaultScene();
+    std::vector<std::unique_ptr<Device>> devices;
+    for (int i = 0; i < 8; ++i) {
+        DeviceConfig c = simConfig(i % 2 ? "walk" : "free", 11, Vec3(0.004 * i - 0.014, 0, 0));
+        c.name = "d" + std::to_string(i);
+        devices.push_back(makeDevice(c, scene));
+        REQUIRE(devices.back()->open() == DeviceStatus::Ok);
+    }
+    SimDevice alone(simConfig("walk", 11, Vec3(0.004 * 1 - 0.014, 0, 0)), scene);
+    REQUIRE(alone.open() == DeviceStatus::Ok);
+    DeviceState s, a;
+    for (int t = 0; t < 2000; ++t) {
+        for (auto& d : devices) {
+            REQUIRE(d->read(s) == DeviceStatus::Ok);
+            if (d.get() == devices[1].get()) {
+                REQUIRE(alone.read(a) == DeviceStatus::Ok);
+                REQUIRE(a.position == s.position);
+            }
+        }
+    }
+}

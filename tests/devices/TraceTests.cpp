@@ -1,0 +1,247 @@
+#include "hapto/devices/SpscRing.h"
+#include "hapto/devices/TraceReader.h"
+#include "hapto/devices/TraceRecorder.h"
+#include "hapto/scenes/InputError.h"
+#include "hapto/scenes/Random.h"
+
+#include "TestSupport.h"
+
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <filesystem>
+#include <thread>
+
+using namespace hapto;
+
+namespace {
+
+TraceHeader header() {
+    TraceHeader h;
+    h.rateHz = 1000.0;
+    h.kind = "sim";
+    h.name = "left";
+    h.startUnixNs = 1700000000123456789ull;
+    return h;
+}
+
+std::vector<TraceSample> randomSamples(std::size_t n, std::uint64_t seed) {
+    Random rng(seed);
+    std::vector<TraceSample> out(n);
+    std::uint64_t tick = 5;
+    for (std::size_t i = 0; i < n; ++i) {
+        TraceSample& s = out[i];
+        tick += 1 + (rng.uniform() < 0.05 ? rng.below(3) : 0);
+        s.tick = tick;
+        s.timeNs = tick * 1000000ull + rng.below(1000);
+        s.positionM = Vec3(rng.normal(), rng.normal(), rng.normal()) * 0.05;
+        s.forceN = Vec3(rng.normal(), rng.normal(), rng.normal());
+        s.computeNs = static_cast<std::uint32_t>(rng.below(1000000));
+        s.ioNs = static_cast<std::uint32_t>(rng.below(100000));
+        s.status = static_cast<DeviceStatus>(rng.below(6));
+        s.buttons = static_cast<std::uint32_t>(rng.below(4));
+    }
+    return out;
+}
+
+void writeTrace(const std::filesystem::path& p, const std::vector<TraceSample>& samples) {
+    TraceRecorder rec(p, header(), 64);
+    for (const TraceSample& s : samples) {
+        if (!rec.push(s)) {
+            rec.drain();
+            REQUIRE(rec.push(s));
+        }
+    }
+    rec.close();
+}
+
+std::string errorReading(const std::filesystem::path& p) {
+    try {
+        TraceReader::load(p);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+void patch(const std::filesystem::path& p, std::size_t offset, const std::string& bytes) {
+    std::string data = test::readFile(p);
+    data.replace(offset, bytes.size(), bytes);
+    test::writeFile(p, data);
+}
+
+} // namespace
+
+TEST_CASE("trace: write then read gives back every sample exactly") {
+    test::TempDir dir;
+    const auto samples = randomSamples(5000, 1);
+    writeTrace(dir / "t.trace", samples);
+    CHECK(std::filesystem::file_size(dir / "t.trace") ==
+          kTraceHeaderBytes + samples.size() * kTraceSampleBytes);
+    TraceHeader h;
+    const auto back = TraceReader::load(dir / "t.trace", &h);
+    CHECK(back == samples);
+    CHECK(h.finished);
+    CHECK(h.sampleCount == samples.size());
+    CHECK(h.rateHz == 1000.0);
+    CHECK(h.kind == "sim");
+    CHECK(h.name == "left");
+    CHECK(h.startUnixNs == 1700000000123456789ull);
+    CHECK(h.version == kTraceVersion);
+}
+
+TEST_CASE("trace: the header layout is the documented one") {
+    test::TempDir dir;
+    writeTrace(dir / "t.trace", randomSamples(3, 2));
+    const std::string bytes = test::readFile(dir / "t.trace");
+    CHECK(bytes.substr(0, 8) == "HAPTOTRC");
+    CHECK(bytes[8] == 1); // version, little-endian
+    CHECK(bytes[12] == static_cast<char>(128));
+    CHECK(bytes[16] == 80);
+    CHECK(bytes[32] == 3); // sample count
+    CHECK(bytes.substr(48, 3) == "sim");
+    CHECK(bytes.substr(64, 4) == "left");
+}
+
+TEST_CASE("trace: an empty recording is valid") {
+    test::TempDir dir;
+    writeTrace(dir / "t.trace", {});
+    TraceHeader h;
+    CHECK(TraceReader::load(dir / "t.trace", &h).empty());
+    CHECK(h.sampleCount == 0);
+}
+
+TEST_CASE("trace: truncated and corrupt files are refused with the byte offset") {
+    test::TempDir dir;
+    const auto p = dir / "t.trace";
+    const auto samples = randomSamples(10, 3);
+    const auto fresh = [&] { writeTrace(p, samples); };
+
+    fresh();
+    std::filesystem::resize_file(p, kTraceHeaderBytes + 9 * kTraceSampleBytes + 40);
+    CHECK_THAT(errorReading(p), Catch::Contains("t.trace: byte 888: truncated: the header "
+                                                "announces 10 samples"));
+    fresh();
+    std::filesystem::resize_file(p, 50);
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 50: truncated: the header needs 128"));
+    test::writeFile(p, "");
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 0: truncated"));
+    test::writeFile(p, "{\"format\": \"hapto-scene\"} and then some more text to fill");
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 0: not a hapto trace"));
+    fresh();
+    patch(p, 8, std::string("\x02", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 8: trace format version 2"));
+    fresh();
+    patch(p, 16, std::string("\x40", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 16: sample size 64"));
+    fresh();
+    patch(p, 24, std::string(8, '\xff')); // NaN rate
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 24: servo rate"));
+    fresh();
+    patch(p, 64, std::string("\x01", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 64: the name field"));
+    fresh();
+    patch(p, kTraceHeaderBytes + 2 * kTraceSampleBytes + 72, std::string("\x09", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 360: sample 2: unknown device status 9"));
+    fresh();
+    patch(p, kTraceHeaderBytes + 3 * kTraceSampleBytes + 16, std::string(8, '\xff'));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 384: sample 3: position is not finite"));
+    fresh();
+    patch(p, kTraceHeaderBytes + 4 * kTraceSampleBytes, std::string(8, '\0'));
+    CHECK_THAT(errorReading(p), Catch::Contains("sample 4: tick 0 does not follow"));
+    fresh();
+    test::writeFile(p, test::readFile(p) + "xyz");
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 928: 3 unexpected bytes after the last"));
+    CHECK_THAT(errorReading(dir / "none.trace"), Catch::Contains("none.trace: cannot read"));
+}
+
+TEST_CASE("trace: a recording that was never closed reads its whole records") {
+    test::TempDir dir;
+    const auto p = dir / "t.trace";
+    const auto samples = randomSamples(10, 4);
+    writeTrace(p, samples);
+    patch(p, 32, std::string(8, '\xff'));
+    std::filesystem::resize_file(p, kTraceHeaderBytes + 7 * kTraceSampleBytes + 13);
+    TraceHeader h;
+    const auto back = TraceReader::load(p, &h);
+    CHECK_FALSE(h.finished);
+    CHECK(back == std::vector<TraceSample>(samples.begin(), samples.begin() + 7));
+}
+
+TEST_CASE("trace recorder: a full ring drops and counts instead of blocking") {
+    test::TempDir dir;
+    TraceRecorder rec(dir / "t.trace", header(), 8);
+    CHECK(rec.capacity() == 8);
+    const auto samples = randomSamples(20, 5);
+    int accepted = 0;
+    for (const TraceSample& s : samples) {
+        accepted += rec.push(s);
+    }
+    CHECK(accepted == 8);
+    CHECK(rec.dropped() == 12);
+    CHECK(rec.drain() == 8);
+    CHECK(rec.push(samples[19]));
+    rec.close();
+    CHECK(rec.written() == 9);
+    CHECK_FALSE(rec.push(samples[0])); // closed: dropped
+    CHECK(rec.dropped() == 13);
+    const auto back = TraceReader::load(dir / "t.trace");
+    REQUIRE(back.size() == 9);
+    CHECK(back[8] == samples[19]);
+}
+
+TEST_CASE("trace recorder: a servo thread and a draining thread lose nothing uncounted") {
+    test::TempDir dir;
+    constexpr std::uint64_t kTicks = 200000;
+    std::atomic<bool> done{false};
+    std::uint64_t pushed = 0;
+    {
+        TraceRecorder rec(dir / "t.trace", header(), 256);
+        std::thread servo([&] {
+            TraceSample s;
+            for (std::uint64_t t = 0; t < kTicks; ++t) {
+                s.tick = t;
+                s.timeNs = t * 1000;
+                s.positionM = Vec3(static_cast<double>(t), 0, 0);
+                pushed += rec.push(s);
+            }
+            done = true;
+        });
+        while (!done) {
+            rec.drain();
+            std::this_thread::yield();
+        }
+        servo.join();
+        rec.close();
+        CHECK(rec.written() == pushed);
+        CHECK(pushed + rec.dropped() == kTicks);
+    }
+    const auto back = TraceReader::load(dir / "t.trace"); // checks ticks strictly increase
+    REQUIRE(back.size() == pushed);
+    for (const TraceSample& s : back) {
+        REQUIRE(s.positionM.x == static_cast<double>(s.tick));
+    }
+}
+
+TEST_CASE("spsc ring: order, capacity rounding, wrap-around") {
+    SpscRing<int> ring(5);
+    CHECK(ring.capacity() == 8);
+    int out = 0;
+    CHECK_FALSE(ring.tryPop(out));
+    for (int round = 0; round < 10; ++round) {
+        for (int i = 0; i < 8; ++i) {
+            REQUIRE(ring.tryPush(round * 8 + i));
+        }
+        REQUIRE_FALSE(ring.tryPush(-1));
+        CHECK(ring.sizeApprox() == 8);
+        int batch[3];
+        REQUIRE(ring.popInto(batch) == 3);
+        CHECK(batch[0] == round * 8);
+        CHECK(batch[2] == round * 8 + 2);
+        for (int i = 3; i < 8; ++i) {
+            REQUIRE(ring.tryPop(out));
+            REQUIRE(out == round * 8 + i);
+        }
+        CHECK(ring.sizeApprox() == 0);
+    }
+}
