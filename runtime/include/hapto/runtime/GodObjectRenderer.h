@@ -1,0 +1,160 @@
+#pragma once
+/// God-object (proxy) haptic rendering of a point tool against oriented boxes and spheres.
+
+#include "hapto/runtime/CandidateSet.h"
+#include "hapto/scenes/Scene.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace hapto {
+
+/// How a renderer behaves; fixed at construction.
+struct RendererConfig {
+    /// Contact damping b (N·s/m), applied along the contact force direction only while in
+    /// contact, never pulling the tool into a surface. >= 0; 0 turns it off.
+    double damping = 0.0;
+    /// Proxy solver passes per tick (each pass: one small plane solve + one swept test over the
+    /// nearby objects), 1..GodObjectRenderer::kMaxIterations.
+    std::uint32_t maxIterations = 10;
+};
+
+/// What happened in a tick besides the force.
+enum class RenderStatus : std::uint8_t {
+    Ok,                ///< Normal tick.
+    NonFiniteInput,    ///< Device position was NaN/inf: zero force, proxy kept.
+    NonFiniteOutput,   ///< The computation produced NaN/inf (a broken scene?): zero force.
+    CandidatesDropped, ///< The CandidateSet overflowed (a span was dropped); tick still ran.
+    NearListFull,      ///< More nearby objects than kMaxNearObjects: ran on the raw spans.
+};
+
+/// How often each fault happened in one renderer, as plain values.
+struct RenderCounters {
+    std::uint64_t ticks = 0;             ///< update() calls.
+    std::uint64_t nonFiniteInput = 0;    ///< Ticks with a NaN/inf device position.
+    std::uint64_t nonFiniteOutput = 0;   ///< Ticks whose result was NaN/inf (zeroed).
+    std::uint64_t candidatesDropped = 0; ///< Ticks whose CandidateSet had overflowed.
+    std::uint64_t nearListFull = 0;      ///< Ticks that fell back to the raw spans.
+};
+
+/// One active constraint plane of the proxy.
+struct Contact {
+    std::uint32_t slot = 0; ///< The touched object's slot in `scene.objects()`.
+    ObjectId id = 0;        ///< The touched object's id.
+    Vec3 normal{0.0};       ///< Outward unit normal of the constraint plane (world).
+    double depth = 0.0;     ///< How far the device point is behind that plane (m), > 0.
+};
+
+/// The result of one tick.
+struct RenderOutput {
+    Vec3 force{0.0};                   ///< Force to send (N, world frame), before ForceSafety.
+    Vec3 proxy{0.0};                   ///< Proxy (god-object) position after the tick (m, world).
+    std::array<Contact, 3> contacts{}; ///< Active constraints; the first `contactCount` are valid.
+    std::uint8_t contactCount = 0;     ///< 0 = free motion, 1 = face, 2 = edge/crease, 3 = corner.
+    bool sliding = false;              ///< In contact and the proxy moved along the surface.
+    RenderStatus status = RenderStatus::Ok; ///< Faults, as a value.
+    std::uint8_t iterations = 0;     ///< Solver passes used (both solves when friction slipped).
+    std::uint32_t objectsTested = 0; ///< Candidate slots examined (duplicates included).
+};
+
+/// Renders one point device against a scene with a god-object proxy (Zilles & Salisbury 1995,
+/// Ruspini et al. 1997) and Coulomb friction. One instance per device: it holds that device's
+/// proxy and scratch space, shares nothing, and never allocates after construction.
+///
+/// Size: 1408 bytes (64-byte aligned; checked by a static_assert in the source file), of which
+/// 1024 are the near-object scratch list.
+class alignas(64) GodObjectRenderer {
+public:
+    /// Constraint planes solved at once (a corner needs three).
+    static constexpr std::size_t kMaxContacts = 3;
+    /// Nearby objects one tick can track; beyond this the tick runs on the raw candidate spans.
+    static constexpr std::size_t kMaxNearObjects = 256;
+    /// Upper bound for RendererConfig::maxIterations.
+    static constexpr std::uint32_t kMaxIterations = 32;
+    /// The proxy rides this far (m) outside every surface: a 10 nm skin that closes the cracks
+    /// between flush objects. It adds stiffness x 1e-8 m to each force (8 µN at 800 N/m).
+    static constexpr double kSkinM = 1e-8;
+
+    /// Checks the configuration; throws std::invalid_argument on a negative/NaN damping or
+    /// an iteration count outside 1..kMaxIterations. [control]
+    explicit GodObjectRenderer(const RendererConfig& config = {});
+
+    /// Puts the proxy on the device point with no contact and no friction state. If that point
+    /// is inside an object, that object is ignored until the proxy has left it. [servo]
+    void reset(const Vec3& devicePosition) noexcept;
+
+    /// One servo tick: moves the proxy toward `devicePosition` (m, world) without entering any
+    /// candidate object, applies friction, and returns force = k (proxy - device) - damping
+    /// (N). `deviceVelocity` (m/s) feeds damping; if it is not finite it is estimated from the
+    /// last position over `dtSeconds`. Only objects named in `candidates` are looked at (slots
+    /// outside the scene are skipped). With several contacts the smallest stiffness and the
+    /// smallest friction coefficients among the touched objects apply (conservative). Never
+    /// allocates, locks or throws. [servo]
+    RenderOutput update(const Scene& scene, const CandidateSet& candidates,
+                        const Vec3& devicePosition, const Vec3& deviceVelocity,
+                        double dtSeconds) noexcept;
+
+    /// The proxy position (m, world). [servo]
+    const Vec3& proxy() const noexcept { return mProxy; }
+    /// Fault counters since construction. [servo] (copy them out to share)
+    const RenderCounters& counters() const noexcept { return mCounters; }
+    /// True while the last tick ended in contact. [servo]
+    bool inContact() const noexcept { return mContactCount > 0; }
+    /// The configuration. [any thread]
+    const RendererConfig& config() const noexcept { return mConfig; }
+
+private:
+    /// A constraint half-space {x : dot(normal, x) >= offset}, from one object's face.
+    struct Plane {
+        Vec3 normal{0.0};
+        double offset = 0.0;
+        std::uint32_t slot = 0;
+    };
+    /// Where a solve ended.
+    struct Solve {
+        Vec3 proxy{0.0};
+        std::array<Plane, kMaxContacts> planes{};
+        std::uint32_t planeCount = 0;
+        bool touched = false; ///< The proxy reached a surface this solve.
+        Vec3 firstTouch{0.0}; ///< Where it first did.
+        std::uint32_t iterations = 0;
+    };
+    struct Hit;
+
+    void buildNear(const Scene& scene, const CandidateSet& candidates, const Vec3& center,
+                   double radius, std::uint32_t& tested) noexcept;
+    Solve solve(const Scene& scene, const CandidateSet& candidates, const Vec3& start,
+                const Vec3& goal) const noexcept;
+    Hit sweep(const Scene& scene, const CandidateSet& candidates, const Vec3& from,
+              const Vec3& to) const noexcept;
+    bool covered(const Scene& scene, const CandidateSet& candidates, const Vec3& probe,
+                 std::uint32_t self) const noexcept;
+    template <class Fn>
+    void forEachNear(const Scene& scene, const CandidateSet& candidates, Fn&& fn) const noexcept;
+
+    RendererConfig mConfig;
+    RenderCounters mCounters;
+    Vec3 mProxy{0.0};      ///< God-object position (m).
+    Vec3 mLastDevice{0.0}; ///< Device position of the previous tick (m).
+    bool mHasLastDevice = false;
+    bool mSlipping = false; ///< Friction state: kinetic (true) or static (false).
+    std::uint8_t mContactCount = 0;
+    std::array<std::uint32_t, kMaxContacts> mContactSlots{}; ///< Last tick's touched slots.
+    /// Pose of a touched object at the end of the last tick, to carry the proxy when it moves.
+    struct ContactPose {
+        ObjectId id = 0;
+        Vec3 center{0.0};
+        Quat rotation{1, 0, 0, 0};
+    };
+    std::array<ContactPose, kMaxContacts> mContactPoses{};
+
+    // Per-tick scratch: the deduplicated candidates that can matter this tick.
+    Vec3 mNearCenter{0.0};
+    double mNearRadius = -1.0; ///< < 0: no list built this tick.
+    bool mNearOverflow = false;
+    std::uint32_t mNearCount = 0;
+    std::array<std::uint32_t, kMaxNearObjects> mNear{};
+};
+
+} // namespace hapto

@@ -1,0 +1,139 @@
+#pragma once
+/// The runtime: one servo thread per device over one shared World, and the load they measure.
+
+#include "hapto/devices/Device.h"
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/devices/Mailbox.h"
+#include "hapto/index/Cursor.h"
+#include "hapto/runtime/DeviceMetrics.h"
+#include "hapto/runtime/ForceSafety.h"
+#include "hapto/runtime/GodObjectRenderer.h"
+#include "hapto/runtime/World.h"
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace hapto {
+
+class TraceRecorder;
+
+/// No object: a ContactReport slot that holds no contact.
+inline constexpr ObjectId kNoObject = 0xFFFFFFFFu;
+
+/// What a servo thread tells the control thread about its contacts, every tick (world frame).
+struct ContactReport {
+    std::uint64_t tick = 0; ///< The servo tick it describes.
+    Vec3 devicePoint{0.0};  ///< Device point (m).
+    Vec3 proxy{0.0};        ///< God-object proxy (m).
+    Vec3 force{0.0};        ///< Force sent, external force included (N).
+    std::array<ObjectId, 3> objects{kNoObject, kNoObject, kNoObject}; ///< Touched object ids.
+    std::array<Vec3, 3> normals{};  ///< Their outward contact normals.
+    std::uint32_t contactCount = 0; ///< How many of the above are set.
+};
+
+/// How servo threads run.
+struct RuntimeOptions {
+    bool realtime = true;     ///< Ask for SCHED_FIFO and pin device i to core i % cores.
+    int fifoPriority = 80;    ///< SCHED_FIFO priority when realtime.
+    std::uint64_t spinNs = 0; ///< Spin this long before each deadline instead of sleeping (ns).
+    int missLimit = 3;        ///< K: after K missed deadlines in a row, command zero force
+                              ///< until a tick meets its deadline again.
+    double lateWakeupFraction = 0.1; ///< A wake-up later than this fraction of the period is late.
+    std::uint64_t stallTimeoutNs =
+        50'000'000;            ///< Watchdog: no tick for this long faults the device.
+    RendererConfig renderer{}; ///< Proxy settings for every device.
+};
+
+/// One device as the runtime drives it.
+struct RuntimeDevice {
+    std::unique_ptr<Device> device;    ///< The backend, not yet opened.
+    DeviceConfig config;               ///< Name, transform, rate, max force.
+    TraceRecorder* recorder = nullptr; ///< Optional per-tick recording (owned by the caller).
+};
+
+/// Summary of one device's run, loads as fractions of its period.
+struct DeviceReport {
+    std::string name, kind;
+    double rateHz = 0;
+    std::uint64_t ticks = 0;
+    HistogramSummary loadFraction; ///< (wake-up to force written) / period.
+    HistogramSummary latenessNs;   ///< Wake-up lateness (ns).
+    HistogramSummary ioNs;         ///< Device I/O per tick (ns).
+    std::uint64_t lateWakeups = 0, missedDeadlines = 0, zeroedForMisses = 0;
+    double locateStepsMean = 0, candidatesMean = 0;
+    std::uint64_t outsideTicks = 0, contactTicks = 0, snapshotsSeen = 0;
+    SafetyCounters safety{}; ///< Clamps, rate limits, non-finite forces.
+    std::string fault;       ///< Empty, or what faulted the device.
+    bool realtime = false;   ///< SCHED_FIFO was granted.
+    bool stable = false;     ///< p99.9 load < 1 and misses <= 0.1 % of ticks, no fault.
+};
+
+/// The whole run.
+struct RunReport {
+    std::vector<DeviceReport> devices;
+    double loadSum = 0;       ///< Sum of the devices' mean loads (CPU cores' worth of servo work).
+    double loadPerCore = 0;   ///< loadSum / cores.
+    int cores = 1;            ///< Hardware threads.
+    bool stable = false;      ///< Every device stable.
+    double durationS = 0;     ///< Wall time from start to stop (s).
+    std::string realtimeNote; ///< Why SCHED_FIFO or pinning was not granted, if not.
+};
+
+/// Runs D servo threads. Construct, start(), let it run (poll or call maintain()), stop().
+/// Threading: every public member is [control] except where marked.
+class Runtime {
+public:
+    Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOptions options = {});
+    ~Runtime();
+    Runtime(const Runtime&) = delete;
+    Runtime& operator=(const Runtime&) = delete;
+
+    /// Opens every device and starts its thread. A device that fails to open is reported as
+    /// faulted and the others run. Returns the number of threads started. [control]
+    std::size_t start();
+    /// Watchdog and world maintenance; call every few milliseconds while running. [control]
+    void maintain();
+    /// Stops every thread: each commands zero force, then the devices are closed. [control]
+    void stop();
+    /// True while some servo thread is live. [any thread]
+    bool anyRunning() const;
+
+    /// Live metrics of device i. [any thread]
+    const DeviceMetrics& metrics(std::size_t i) const;
+    /// Number of devices. [any thread]
+    std::size_t deviceCount() const;
+    /// The device (to inspect after stop, or for tests). [control]
+    Device& device(std::size_t i);
+    /// Builds the report from the metrics (live or final). [control]
+    RunReport report() const;
+
+    /// One line per device for a terminal live view. [control]
+    std::string liveLine(std::size_t i) const;
+
+    /// The newest contact report of device i; false before its first tick. [any thread]
+    bool contact(std::size_t i, ContactReport& report) const;
+    /// Adds a world-frame force (N) to every force device i renders from its next tick on,
+    /// before the safety filter (e.g. the weight of a carried object). [control]
+    void setExternalForce(std::size_t i, const Vec3& forceN);
+
+private:
+    struct Channel;
+    void servoMain(Channel& channel);
+
+    World& mWorld;
+    RuntimeOptions mOptions;
+    std::vector<std::unique_ptr<Channel>> mChannels;
+    std::uint64_t mStartNs = 0, mStopNs = 0;
+    std::string mRealtimeNote;
+};
+
+/// Renders a report as JSON text (the `hapto run --report` format). [control]
+std::string reportToJson(const RunReport& report);
+
+} // namespace hapto

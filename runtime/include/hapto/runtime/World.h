@@ -1,0 +1,140 @@
+#pragma once
+/// The shared world: immutable snapshots of the scene and its index, published by the control
+/// thread and read by every servo thread without locks, waiting or allocation.
+
+#include "hapto/index/SpatialIndex.h"
+#include "hapto/scenes/Scene.h"
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <future>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace hapto {
+
+/// One immutable state of the world. Servo threads hold a raw pointer to it for a tick.
+struct WorldSnapshot {
+    std::uint64_t version = 0;                 ///< Increases with every publication.
+    std::shared_ptr<const Scene> scene;        ///< Every object at its current pose.
+    std::shared_ptr<const SpatialIndex> index; ///< Built over the resting objects.
+    /// Slots of objects not (or not correctly) in the index: moving, or added since the last
+    /// build. The renderer tests them by brute force every tick, the paper's section 3.
+    std::vector<std::uint32_t> moving;
+
+    /// The moving slots as a span. [servo]
+    std::span<const std::uint32_t> movingSlots() const noexcept { return moving; }
+};
+
+/// A servo thread's published claim on a snapshot (a hazard pointer), one cache line each.
+struct alignas(64) SnapshotReader {
+    std::atomic<const WorldSnapshot*> held{nullptr}; ///< The snapshot this reader may be using.
+    std::atomic<bool> inUse{false};                  ///< Allocated to a thread.
+};
+
+/// Owns the snapshots. Design note: publication is one atomic pointer store. A reader claims
+/// the current snapshot by storing it in its SnapshotReader and re-checking that it is still
+/// current (the hazard-pointer protocol); the control thread frees a retired snapshot only
+/// when no reader holds it. Readers never wait or allocate; a claim retries only if a
+/// publication raced it, and publications are rare next to ticks. An update copies the scene
+/// (O(N) on the control thread) and reuses the index: while an object moves, its stale index
+/// entries only add candidates (harmless: the renderer tests real geometry) and the moving
+/// list makes sure it is tested where it now is. Once it has rested for `restDelay`, a new
+/// index is built on a background thread (TBB inside) and published.
+class World {
+public:
+    /// Readers a world can serve (servo threads plus tools).
+    static constexpr std::size_t kMaxReaders = 64;
+
+    /// Builds the index over the scene and publishes version 1. [control]
+    World(Scene scene, IndexSpec spec);
+    ~World();
+    World(const World&) = delete;
+    World& operator=(const World&) = delete;
+
+    /// Registers a reader (one per servo thread); nullptr when all are taken. [control]
+    SnapshotReader* registerReader();
+    /// Gives a reader back; it must not be inside a tick. [control]
+    void unregisterReader(SnapshotReader* reader);
+
+    /// Claims the current snapshot for `reader` until its next acquire. Lock-free, never
+    /// allocates. [servo]
+    const WorldSnapshot& acquire(SnapshotReader& reader) const noexcept {
+        const WorldSnapshot* s = mCurrent.load(std::memory_order_acquire);
+        for (;;) {
+            reader.held.store(s, std::memory_order_seq_cst);
+            const WorldSnapshot* again = mCurrent.load(std::memory_order_seq_cst);
+            if (again == s) {
+                return *s;
+            }
+            s = again;
+        }
+    }
+    /// The current snapshot, for the control thread (which also owns reclamation). [control]
+    const WorldSnapshot& current() const noexcept {
+        return *mCurrent.load(std::memory_order_acquire);
+    }
+
+    /// Moves an object now: the next tick of every servo thread sees it at its new pose, and
+    /// it is rendered by brute force until it rests. Throws InputError for an unknown id. [control]
+    void moveObject(ObjectId id, const Vec3& center, const Quat& rotation);
+    /// Adds an object: rendered by brute force at once, indexed once it rests. [control]
+    void addObject(const SceneObject& object);
+    /// Removes an object: takes effect when the index without it is built (background). [control]
+    void removeObject(ObjectId id);
+    /// True while the object is rendered by the brute-force path. [control]
+    bool isMoving(ObjectId id) const;
+
+    /// Re-indexes objects that have rested for `restDelay`, publishes finished builds, and
+    /// frees snapshots no reader holds. Call it often from the control thread. [control]
+    void maintain();
+    /// Waits for any background build and publishes it; then reclaims. For tests and
+    /// shutdown. [control]
+    void settle();
+
+    /// How long an object must stay still before it goes back into the index.
+    void setRestDelay(std::chrono::nanoseconds delay) { mRestDelay = delay; }
+    /// The index specification every build uses. [any thread]
+    const IndexSpec& spec() const { return mSpec; }
+    /// Index builds published so far (the first one included). [control]
+    std::uint64_t buildsPublished() const { return mBuildsPublished; }
+    /// Snapshots retired but still held by some reader. [control]
+    std::size_t retiredCount() const { return mRetired.size(); }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    struct Mover {
+        ObjectId id;
+        Clock::time_point lastMove;
+    };
+    struct PendingBuild {
+        std::vector<ObjectId> removed; // ids this build leaves out
+        Clock::time_point started;
+        std::future<std::shared_ptr<const SpatialIndex>> index;
+    };
+
+    void publish(std::shared_ptr<const Scene> scene, std::shared_ptr<const SpatialIndex> index);
+    std::vector<std::uint32_t> movingSlotsFor(const Scene& scene) const;
+    void startBuild();
+    static std::shared_ptr<const Scene> without(const Scene& scene,
+                                                const std::vector<ObjectId>& ids);
+    void finishBuild();
+    void reclaim();
+
+    IndexSpec mSpec;
+    std::atomic<const WorldSnapshot*> mCurrent{nullptr};
+    std::unique_ptr<WorldSnapshot> mOwned; // the current snapshot's owner
+    std::vector<std::unique_ptr<WorldSnapshot>> mRetired;
+    std::array<SnapshotReader, kMaxReaders> mReaders{};
+    std::vector<Mover> mMovers;
+    std::unique_ptr<PendingBuild> mBuild;
+    std::vector<ObjectId> mPendingRemovals; // removals wait for a build
+    std::chrono::nanoseconds mRestDelay = std::chrono::milliseconds(100);
+    std::uint64_t mVersion = 0;
+    std::uint64_t mBuildsPublished = 0;
+};
+
+} // namespace hapto

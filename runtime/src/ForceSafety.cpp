@@ -1,0 +1,97 @@
+#include "hapto/runtime/ForceSafety.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hapto {
+
+namespace {
+
+bool isFinite(const Vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+} // namespace
+
+ForceSafety::ForceSafety(const SafetyConfig& config) : mConfig(config) {
+    if (!(config.maxForceN > 0.0) || !std::isfinite(config.maxForceN)) {
+        throw std::invalid_argument("ForceSafety: maxForceN must be a finite force > 0 N (got " +
+                                    std::to_string(config.maxForceN) + ")");
+    }
+    if (!(config.maxForceStepN > 0.0)) {
+        throw std::invalid_argument(
+            "ForceSafety: maxForceStepN must be > 0 N per tick, or +infinity to disable (got " +
+            std::to_string(config.maxForceStepN) + ")");
+    }
+}
+
+ForceSafety::ForceSafety(const ForceSafety& other) noexcept
+    : mConfig(other.mConfig), mLast(other.mLast) {
+    const SafetyCounters c = other.counters();
+    mFiltered.store(c.filtered, std::memory_order_relaxed);
+    mClamped.store(c.clamped, std::memory_order_relaxed);
+    mRateLimited.store(c.rateLimited, std::memory_order_relaxed);
+    mNonFinite.store(c.nonFinite, std::memory_order_relaxed);
+}
+
+ForceSafety& ForceSafety::operator=(const ForceSafety& other) noexcept {
+    if (this != &other) {
+        mConfig = other.mConfig;
+        mLast = other.mLast;
+        const SafetyCounters c = other.counters();
+        mFiltered.store(c.filtered, std::memory_order_relaxed);
+        mClamped.store(c.clamped, std::memory_order_relaxed);
+        mRateLimited.store(c.rateLimited, std::memory_order_relaxed);
+        mNonFinite.store(c.nonFinite, std::memory_order_relaxed);
+    }
+    return *this;
+}
+
+Vec3 ForceSafety::filter(const Vec3& forceN) noexcept {
+    bump(mFiltered);
+    if (!isFinite(forceN)) {
+        bump(mNonFinite);
+        mLast = Vec3(0.0);
+        return mLast;
+    }
+    Vec3 f = forceN;
+    const double magnitude = glm::length(f);
+    if (!std::isfinite(magnitude)) { // components finite but the length overflows
+        bump(mNonFinite);
+        mLast = Vec3(0.0);
+        return mLast;
+    }
+    if (magnitude > mConfig.maxForceN) {
+        f *= mConfig.maxForceN / magnitude;
+        bump(mClamped);
+    }
+    // Both mLast and f lie in the ball of radius maxForceN, so any point between them does too.
+    // A release (a smaller force, not reversed) passes at once: letting go is never the danger,
+    // and a lingering force would feel like glue. Growth and reversals are rate-limited.
+    const Vec3 step = f - mLast;
+    const double stepN = glm::length(step);
+    const bool release = glm::length(f) <= glm::length(mLast) && glm::dot(f, mLast) >= 0.0;
+    if (stepN > mConfig.maxForceStepN && !release) {
+        f = mLast + step * (mConfig.maxForceStepN / stepN);
+        bump(mRateLimited);
+    }
+    if (!isFinite(f)) {
+        bump(mNonFinite);
+        f = Vec3(0.0);
+    }
+    mLast = f;
+    return f;
+}
+
+void ForceSafety::reset() noexcept {
+    mLast = Vec3(0.0);
+}
+
+SafetyCounters ForceSafety::counters() const noexcept {
+    return {mFiltered.load(std::memory_order_relaxed), mClamped.load(std::memory_order_relaxed),
+            mRateLimited.load(std::memory_order_relaxed),
+            mNonFinite.load(std::memory_order_relaxed)};
+}
+
+} // namespace hapto

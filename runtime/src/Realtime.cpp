@@ -1,0 +1,67 @@
+#include "hapto/runtime/Realtime.h"
+
+#include <cerrno>
+#include <cstring>
+#include <ctime>
+#include <pthread.h>
+#include <sched.h>
+
+namespace hapto::rt {
+namespace {
+thread_local bool tInServoLoop = false;
+}
+
+std::uint64_t nowNs() noexcept {
+    timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return static_cast<std::uint64_t>(ts.tv_sec) * 1'000'000'000ull +
+           static_cast<std::uint64_t>(ts.tv_nsec);
+}
+
+void sleepUntilNs(std::uint64_t deadlineNs, std::uint64_t spinNs) noexcept {
+    const std::uint64_t wakeNs = deadlineNs > spinNs ? deadlineNs - spinNs : 0;
+    timespec ts;
+    ts.tv_sec = static_cast<time_t>(wakeNs / 1'000'000'000ull);
+    ts.tv_nsec = static_cast<long>(wakeNs % 1'000'000'000ull);
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    }
+    if (spinNs > 0) {
+        while (nowNs() < deadlineNs) {
+            __builtin_ia32_pause();
+        }
+    }
+}
+
+RealtimeGrant makeCurrentThreadRealtime(int priority, int cpu) {
+    RealtimeGrant g;
+    sched_param p{};
+    p.sched_priority = priority;
+    if (const int e = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p); e == 0) {
+        g.fifo = true;
+    } else {
+        g.note = std::string("SCHED_FIFO refused (") + std::strerror(e) +
+                 "): run as root, or grant CAP_SYS_NICE / an rtprio limit; running with normal "
+                 "scheduling";
+    }
+    if (cpu >= 0) {
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        CPU_SET(cpu, &set);
+        if (const int e = pthread_setaffinity_np(pthread_self(), sizeof set, &set); e == 0) {
+            g.pinned = true;
+        } else {
+            g.note += (g.note.empty() ? "" : "; ") + std::string("CPU affinity refused (") +
+                      std::strerror(e) + ")";
+        }
+    }
+    return g;
+}
+
+bool inServoLoop() noexcept {
+    return tInServoLoop;
+}
+void setInServoLoop(bool inside) noexcept {
+    tInServoLoop = inside;
+}
+
+} // namespace hapto::rt

@@ -1,0 +1,511 @@
+// The servo threads. Design note: each device owns one Channel, a cache-line-aligned block
+// holding everything its thread touches per tick (cursors, proxy renderer, force safety,
+// metrics, its snapshot claim). Threads share only the read-only World snapshots. Everything
+// is sized before the loop starts; inside the loop a tick is: sleep to an absolute deadline,
+// read, claim the snapshot, locate both cursors, render, filter, write, record. Faults become
+// zero force and a recorded FaultKind, never an exception.
+
+#include "hapto/runtime/Runtime.h"
+
+#include "hapto/devices/TraceRecorder.h"
+#include "hapto/index/Cursor.h"
+#include "hapto/runtime/Realtime.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace hapto {
+
+const char* faultName(FaultKind kind) noexcept {
+    switch (kind) {
+    case FaultKind::None:
+        return "none";
+    case FaultKind::OpenFailed:
+        return "open-failed";
+    case FaultKind::ReadFailed:
+        return "read-failed";
+    case FaultKind::WriteFailed:
+        return "write-failed";
+    case FaultKind::NonFinite:
+        return "non-finite";
+    case FaultKind::Watchdog:
+        return "watchdog";
+    }
+    return "unknown";
+}
+
+namespace {
+
+using Triple = std::array<double, 3>;
+Triple triple(const Vec3& v) {
+    return {v.x, v.y, v.z};
+}
+Vec3 vec(const Triple& t) {
+    return {t[0], t[1], t[2]};
+}
+
+// ContactReport as plain words for the mailbox (GLM vectors are not trivially copyable).
+struct ContactWire {
+    std::uint64_t tick;
+    Triple devicePoint, proxy, force;
+    std::array<ObjectId, 3> objects;
+    std::array<Triple, 3> normals;
+    std::uint32_t contactCount;
+};
+
+} // namespace
+
+struct alignas(64) Runtime::Channel {
+    RuntimeDevice rd;
+    DeviceMetrics metrics;
+    Cursor deviceCursor; // the device point's leaf
+    Cursor proxyCursor;  // the proxy's leaf: they differ while pressing into a surface
+    GodObjectRenderer renderer;
+    ForceSafety safety;
+    SnapshotReader* reader = nullptr;
+    Mailbox<ContactWire> contacts; // servo -> control, every tick
+    Mailbox<Triple> externalForce; // control -> servo, world frame (N)
+    std::uint64_t periodNs = 1'000'000;
+    int cpu = -1;
+    std::atomic<bool> stop{false};
+    std::thread thread;
+    bool opened = false;
+    std::string openError;
+    rt::RealtimeGrant grant;
+
+    Channel(RuntimeDevice d, const RuntimeOptions& o, double maxForceN)
+        : rd(std::move(d)), renderer(o.renderer), safety(safetyFor(maxForceN)) {}
+
+    static SafetyConfig safetyFor(double maxForceN) {
+        SafetyConfig c;
+        if (maxForceN > 0) {
+            c.maxForceN = maxForceN;
+        }
+        return c;
+    }
+};
+
+namespace {
+
+bool finite(const Vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+void storeVec(std::atomic<double> (&dst)[3], const Vec3& v) {
+    for (int i = 0; i < 3; ++i) {
+        dst[i].store(v[i], std::memory_order_relaxed);
+    }
+}
+
+} // namespace
+
+Runtime::Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOptions options)
+    : mWorld(world), mOptions(options) {
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+        if (!devices[i].device) {
+            throw std::invalid_argument("runtime: device " + std::to_string(i) + " is null");
+        }
+        if (!(devices[i].config.rateHz > 0)) {
+            throw std::invalid_argument("runtime: device '" + devices[i].config.name +
+                                        "' has no servo rate");
+        }
+        const double maxForce = devices[i].config.maxForceN;
+        auto ch = std::make_unique<Channel>(std::move(devices[i]), mOptions, maxForce);
+        ch->periodNs = static_cast<std::uint64_t>(std::llround(1e9 / ch->rd.config.rateHz));
+        ch->cpu = mOptions.realtime ? static_cast<int>(i % cores) : -1;
+        mChannels.push_back(std::move(ch));
+    }
+}
+
+Runtime::~Runtime() {
+    stop();
+}
+
+std::size_t Runtime::start() {
+    mStartNs = rt::nowNs();
+    std::size_t started = 0;
+    for (auto& chp : mChannels) {
+        Channel& ch = *chp;
+        const DeviceStatus st = ch.rd.device->open();
+        if (st != DeviceStatus::Ok) {
+            ch.openError = std::string(statusName(st)) + ": " + ch.rd.device->errorMessage();
+            ch.metrics.fault.store(FaultKind::OpenFailed);
+            ch.metrics.faultStatus.store(static_cast<std::uint8_t>(st));
+            continue;
+        }
+        ch.opened = true;
+        ch.reader = mWorld.registerReader();
+        if (!ch.reader) {
+            throw std::runtime_error("runtime: more devices than the world has reader slots (" +
+                                     std::to_string(World::kMaxReaders) + ")");
+        }
+        ch.metrics.running.store(true);
+        ch.metrics.heartbeatNs.store(rt::nowNs());
+        ch.thread = std::thread([this, &ch] { servoMain(ch); });
+        ++started;
+    }
+    return started;
+}
+
+void Runtime::servoMain(Channel& ch) {
+    // Set-up: may allocate (the real-time grant's note), nothing below the loop entry does.
+    if (mOptions.realtime) {
+        ch.grant = rt::makeCurrentThreadRealtime(mOptions.fifoPriority, ch.cpu);
+    } else {
+        ch.grant.note = "real-time scheduling not requested";
+    }
+    Device& dev = *ch.rd.device;
+    DeviceMetrics& m = ch.metrics;
+    const WorkspaceTransform& xf = ch.rd.config.transform;
+    const std::uint64_t period = ch.periodNs;
+    const double dt = static_cast<double>(period) * 1e-9;
+    const std::uint64_t lateNs =
+        static_cast<std::uint64_t>(mOptions.lateWakeupFraction * static_cast<double>(period));
+    const std::uint64_t startNs = mStartNs;
+
+    const WorldSnapshot* snap = &mWorld.acquire(*ch.reader);
+    std::uint64_t version = snap->version;
+    ch.deviceCursor.reset(*snap->index);
+    ch.proxyCursor.reset(*snap->index);
+    DeviceState state;
+    Vec3 lastPosition(0.0);
+    bool first = true;
+    int consecutiveMisses = 0;
+    std::uint64_t tick = 0;
+    const auto fault = [&](FaultKind k, DeviceStatus st) {
+        m.faultStatus.store(static_cast<std::uint8_t>(st), std::memory_order_relaxed);
+        m.fault.store(k, std::memory_order_release);
+        (void)dev.write(Vec3(0.0));
+    };
+
+    rt::setInServoLoop(true);
+    std::uint64_t deadline = rt::nowNs() + period;
+    while (!ch.stop.load(std::memory_order_acquire)) {
+        rt::sleepUntilNs(deadline, mOptions.spinNs);
+        const std::uint64_t wake = rt::nowNs();
+        const std::uint64_t lateness = wake > deadline ? wake - deadline : 0;
+
+        DeviceStatus st = dev.read(state);
+        const std::uint64_t readDone = rt::nowNs();
+        if (st != DeviceStatus::Ok) {
+            fault(FaultKind::ReadFailed, st);
+            break;
+        }
+        if (!finite(state.position) || (state.hasVelocity && !finite(state.velocity))) {
+            fault(FaultKind::NonFinite, DeviceStatus::BadData);
+            break;
+        }
+
+        const WorldSnapshot& s = mWorld.acquire(*ch.reader);
+        if (s.version != version) {
+            version = s.version;
+            ch.deviceCursor.reset(*s.index);
+            ch.proxyCursor.reset(*s.index);
+            DeviceMetrics::bump(m.snapshotsSeen);
+        }
+
+        const Vec3 p = xf.positionToWorld(state.position);
+        if (first) {
+            ch.renderer.reset(p);
+            lastPosition = p;
+            first = false;
+        }
+        const Vec3 v =
+            state.hasVelocity ? xf.velocityToWorld(state.velocity) : (p - lastPosition) / dt;
+        lastPosition = p;
+
+        const LocateResult atDevice = ch.deviceCursor.locate(p);
+        const LocateResult atProxy = ch.proxyCursor.locate(ch.renderer.proxy());
+        CandidateSet candidates;
+        candidates.add(atDevice.candidates);
+        if (atProxy.leaf != atDevice.leaf || atProxy.outside != atDevice.outside) {
+            candidates.add(atProxy.candidates);
+        }
+        candidates.add(s.movingSlots());
+        const RenderOutput out = ch.renderer.update(*s.scene, candidates, p, v, dt);
+        Triple external{0.0, 0.0, 0.0};
+        (void)ch.externalForce.read(external);
+
+        Vec3 force = ch.safety.filter(out.force + vec(external));
+        if (consecutiveMisses >= mOptions.missLimit) {
+            force = Vec3(0.0);
+            ch.safety.reset();
+            DeviceMetrics::bump(m.zeroedForMisses);
+        }
+        const Vec3 deviceForce = xf.forceToDevice(force);
+        const std::uint64_t writeStart = rt::nowNs();
+        st = dev.write(deviceForce);
+        const std::uint64_t done = rt::nowNs();
+        if (st != DeviceStatus::Ok) {
+            fault(FaultKind::WriteFailed, st);
+            break;
+        }
+
+        // Record.
+        const std::uint64_t tickNs = done - wake;
+        const std::uint64_t ioNs = (readDone - wake) + (done - writeStart);
+        m.tickNs.record(tickNs);
+        m.latenessNs.record(lateness);
+        m.ioNs.record(ioNs);
+        if (lateness > lateNs) {
+            DeviceMetrics::bump(m.lateWakeups);
+        }
+        DeviceMetrics::bump(m.locateStepsSum, atDevice.steps + atProxy.steps);
+        DeviceMetrics::bump(m.candidatesSum, out.objectsTested);
+        if (atDevice.outside) {
+            DeviceMetrics::bump(m.outsideTicks);
+        }
+        if (out.contactCount > 0) {
+            DeviceMetrics::bump(m.contactTicks);
+        }
+        storeVec(m.forceN, force);
+        storeVec(m.positionM, p);
+        ContactWire report{tick,
+                           triple(p),
+                           triple(out.proxy),
+                           triple(force),
+                           {kNoObject, kNoObject, kNoObject},
+                           {},
+                           out.contactCount};
+        for (std::uint32_t c = 0; c < out.contactCount && c < report.objects.size(); ++c) {
+            report.objects[c] = out.contacts[c].id;
+            report.normals[c] = triple(out.contacts[c].normal);
+        }
+        ch.contacts.publish(report);
+        if (ch.rd.recorder) {
+            TraceSample sample{};
+            sample.tick = tick;
+            sample.timeNs = wake - startNs;
+            sample.positionM = state.position;
+            sample.forceN = deviceForce;
+            sample.computeNs =
+                static_cast<std::uint32_t>(std::min<std::uint64_t>(tickNs, UINT32_MAX));
+            sample.ioNs = static_cast<std::uint32_t>(std::min<std::uint64_t>(ioNs, UINT32_MAX));
+            sample.status = st;
+            sample.buttons = state.buttons;
+            (void)ch.rd.recorder->push(sample);
+        }
+        ++tick;
+        DeviceMetrics::bump(m.ticks);
+        m.heartbeatNs.store(done, std::memory_order_relaxed);
+
+        // The next deadline. A tick whose force came after the next deadline missed it;
+        // skip the slots it overran instead of bursting to catch up.
+        deadline += period;
+        if (done > deadline) {
+            DeviceMetrics::bump(m.missedDeadlines);
+            ++consecutiveMisses;
+            deadline += ((done - deadline) / period + 1) * period;
+        } else {
+            consecutiveMisses = 0;
+        }
+    }
+    (void)dev.write(Vec3(0.0));
+    storeVec(m.forceN, Vec3(0.0));
+    rt::setInServoLoop(false);
+    m.running.store(false, std::memory_order_release);
+}
+
+void Runtime::maintain() {
+    const std::uint64_t now = rt::nowNs();
+    for (auto& chp : mChannels) {
+        Channel& ch = *chp;
+        if (!ch.metrics.running.load(std::memory_order_acquire)) {
+            continue;
+        }
+        const std::uint64_t beat = ch.metrics.heartbeatNs.load(std::memory_order_relaxed);
+        if (now > beat && now - beat > mOptions.stallTimeoutNs &&
+            ch.metrics.fault.load() == FaultKind::None) {
+            // The thread is stuck inside the device; when it returns it writes zero and ends.
+            ch.metrics.fault.store(FaultKind::Watchdog);
+            ch.stop.store(true, std::memory_order_release);
+        }
+    }
+    mWorld.maintain();
+}
+
+void Runtime::stop() {
+    for (auto& ch : mChannels) {
+        ch->stop.store(true, std::memory_order_release);
+    }
+    for (auto& chp : mChannels) {
+        Channel& ch = *chp;
+        if (ch.thread.joinable()) {
+            ch.thread.join();
+        }
+        if (ch.opened) {
+            ch.rd.device->close();
+            mWorld.unregisterReader(ch.reader);
+            ch.reader = nullptr;
+            ch.opened = false;
+            if (!ch.grant.note.empty() && mRealtimeNote.find(ch.grant.note) == std::string::npos) {
+                mRealtimeNote += (mRealtimeNote.empty() ? "" : "; ") + ch.grant.note;
+            }
+        }
+    }
+    if (mStartNs != 0 && mStopNs == 0) {
+        mStopNs = rt::nowNs();
+    }
+}
+
+bool Runtime::anyRunning() const {
+    return std::any_of(mChannels.begin(), mChannels.end(), [](auto& ch) {
+        return ch->metrics.running.load(std::memory_order_acquire);
+    });
+}
+
+const DeviceMetrics& Runtime::metrics(std::size_t i) const {
+    return mChannels.at(i)->metrics;
+}
+std::size_t Runtime::deviceCount() const {
+    return mChannels.size();
+}
+Device& Runtime::device(std::size_t i) {
+    return *mChannels.at(i)->rd.device;
+}
+
+RunReport Runtime::report() const {
+    RunReport r;
+    r.cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    r.stable = !mChannels.empty();
+    for (const auto& chp : mChannels) {
+        const Channel& ch = *chp;
+        const DeviceMetrics& m = ch.metrics;
+        DeviceReport d;
+        d.name = ch.rd.config.name;
+        d.kind = ch.rd.config.kind;
+        d.rateHz = ch.rd.config.rateHz;
+        d.ticks = m.ticks.load();
+        HistogramSummary t = m.tickNs.summary();
+        const double period = static_cast<double>(ch.periodNs);
+        d.loadFraction = {t.count,        t.mean / period, t.p50 / period,
+                          t.p99 / period, t.p999 / period, t.max / period};
+        d.latenessNs = m.latenessNs.summary();
+        d.ioNs = m.ioNs.summary();
+        d.lateWakeups = m.lateWakeups.load();
+        d.missedDeadlines = m.missedDeadlines.load();
+        d.zeroedForMisses = m.zeroedForMisses.load();
+        const double ticks = static_cast<double>(std::max<std::uint64_t>(1, d.ticks));
+        d.locateStepsMean = static_cast<double>(m.locateStepsSum.load()) / ticks;
+        d.candidatesMean = static_cast<double>(m.candidatesSum.load()) / ticks;
+        d.outsideTicks = m.outsideTicks.load();
+        d.contactTicks = m.contactTicks.load();
+        d.snapshotsSeen = m.snapshotsSeen.load();
+        d.safety = ch.safety.counters();
+        d.realtime = ch.grant.fifo;
+        const FaultKind f = m.fault.load();
+        if (f == FaultKind::OpenFailed) {
+            d.fault = std::string("open-failed: ") + ch.openError;
+        } else if (f != FaultKind::None) {
+            d.fault = std::string(faultName(f)) + ": " +
+                      std::string(statusName(static_cast<DeviceStatus>(m.faultStatus.load())));
+        }
+        d.stable = d.fault.empty() && d.ticks > 0 && d.loadFraction.p999 < 1.0 &&
+                   static_cast<double>(d.missedDeadlines) <= 0.001 * static_cast<double>(d.ticks);
+        r.loadSum += d.loadFraction.mean;
+        r.stable = r.stable && d.stable;
+        r.devices.push_back(std::move(d));
+    }
+    r.loadPerCore = r.loadSum / r.cores;
+    const std::uint64_t end = mStopNs ? mStopNs : rt::nowNs();
+    r.durationS = mStartNs ? static_cast<double>(end - mStartNs) * 1e-9 : 0.0;
+    r.realtimeNote = mRealtimeNote;
+    return r;
+}
+
+std::string Runtime::liveLine(std::size_t i) const {
+    const Channel& ch = *mChannels.at(i);
+    const DeviceMetrics& m = ch.metrics;
+    const HistogramSummary t = m.tickNs.summary();
+    const double period = static_cast<double>(ch.periodNs);
+    const Vec3 f(m.forceN[0].load(), m.forceN[1].load(), m.forceN[2].load());
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "%-10s %9llu ticks  load p50 %5.1f%%  p99.9 %5.1f%%  max %6.1f%%  missed %llu  "
+                  "|F| %5.2f N%s",
+                  ch.rd.config.name.c_str(), static_cast<unsigned long long>(m.ticks.load()),
+                  100.0 * t.p50 / period, 100.0 * t.p999 / period, 100.0 * t.max / period,
+                  static_cast<unsigned long long>(m.missedDeadlines.load()), glm::length(f),
+                  m.fault.load() != FaultKind::None ? "  FAULTED" : "");
+    return line;
+}
+
+bool Runtime::contact(std::size_t i, ContactReport& report) const {
+    ContactWire w;
+    if (!mChannels.at(i)->contacts.read(w)) {
+        return false;
+    }
+    report.tick = w.tick;
+    report.devicePoint = vec(w.devicePoint);
+    report.proxy = vec(w.proxy);
+    report.force = vec(w.force);
+    report.objects = w.objects;
+    for (std::size_t c = 0; c < 3; ++c) {
+        report.normals[c] = vec(w.normals[c]);
+    }
+    report.contactCount = w.contactCount;
+    return true;
+}
+
+void Runtime::setExternalForce(std::size_t i, const Vec3& forceN) {
+    mChannels.at(i)->externalForce.publish(triple(forceN));
+}
+
+std::string reportToJson(const RunReport& r) {
+    using nlohmann::json;
+    const auto load = [](const HistogramSummary& s) {
+        return json{
+            {"mean", s.mean}, {"p50", s.p50}, {"p99", s.p99}, {"p999", s.p999}, {"max", s.max}};
+    };
+    json devices = json::array();
+    for (const DeviceReport& d : r.devices) {
+        devices.push_back(json{
+            {"name", d.name},
+            {"kind", d.kind},
+            {"rate_hz", d.rateHz},
+            {"ticks", d.ticks},
+            {"load", load(d.loadFraction)},
+            {"late_wakeups", d.lateWakeups},
+            {"missed_deadlines", d.missedDeadlines},
+            {"zeroed_for_misses", d.zeroedForMisses},
+            {"lateness_ns", load(d.latenessNs)},
+            {"io",
+             {{"mean_ns", d.ioNs.mean},
+              {"p99_ns", d.ioNs.p99},
+              {"max_ns", d.ioNs.max},
+              {"fraction_of_tick", d.loadFraction.mean > 0
+                                       ? d.ioNs.mean / (d.loadFraction.mean * 1e9 / d.rateHz)
+                                       : 0.0}}},
+            {"locate_steps_mean", d.locateStepsMean},
+            {"candidates_mean", d.candidatesMean},
+            {"outside_ticks", d.outsideTicks},
+            {"contact_ticks", d.contactTicks},
+            {"snapshots_seen", d.snapshotsSeen},
+            {"safety",
+             {{"clamped", d.safety.clamped},
+              {"rate_limited", d.safety.rateLimited},
+              {"non_finite", d.safety.nonFinite}}},
+            {"faults", d.fault.empty() ? 0 : 1},
+            {"fault", d.fault},
+            {"realtime", d.realtime},
+            {"stable", d.stable},
+        });
+    }
+    json total{{"load_sum", r.loadSum},
+               {"load_per_core", r.loadPerCore},
+               {"cores", r.cores},
+               {"stable", r.stable},
+               {"duration_s", r.durationS}};
+    json out{{"devices", devices}, {"total", total}};
+    if (!r.realtimeNote.empty()) {
+        out["realtime_note"] = r.realtimeNote;
+    }
+    return out.dump(2) + "\n";
+}
+
+} // namespace hapto

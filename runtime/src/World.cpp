@@ -1,0 +1,200 @@
+#include "hapto/runtime/World.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include <algorithm>
+#include <string>
+
+namespace hapto {
+
+World::World(Scene scene, IndexSpec spec) : mSpec(spec) {
+    auto shared = std::make_shared<const Scene>(std::move(scene));
+    std::shared_ptr<const SpatialIndex> index = buildIndex(*shared, mSpec);
+    ++mBuildsPublished;
+    publish(std::move(shared), std::move(index));
+}
+
+World::~World() {
+    if (mBuild && mBuild->index.valid()) {
+        mBuild->index.wait();
+    }
+}
+
+SnapshotReader* World::registerReader() {
+    for (SnapshotReader& r : mReaders) {
+        bool expected = false;
+        if (r.inUse.compare_exchange_strong(expected, true)) {
+            r.held.store(nullptr);
+            return &r;
+        }
+    }
+    return nullptr;
+}
+
+void World::unregisterReader(SnapshotReader* reader) {
+    if (reader) {
+        reader->held.store(nullptr);
+        reader->inUse.store(false);
+    }
+}
+
+void World::publish(std::shared_ptr<const Scene> scene, std::shared_ptr<const SpatialIndex> index) {
+    auto next = std::make_unique<WorldSnapshot>();
+    next->version = ++mVersion;
+    next->scene = std::move(scene);
+    next->index = std::move(index);
+    next->moving = movingSlotsFor(*next->scene);
+    mCurrent.store(next.get(), std::memory_order_seq_cst);
+    if (mOwned) {
+        mRetired.push_back(std::move(mOwned));
+    }
+    mOwned = std::move(next);
+    reclaim();
+}
+
+std::vector<std::uint32_t> World::movingSlotsFor(const Scene& scene) const {
+    std::vector<std::uint32_t> slots;
+    for (const Mover& m : mMovers) {
+        if (const auto slot = scene.slotOf(m.id)) {
+            slots.push_back(*slot);
+        }
+    }
+    std::sort(slots.begin(), slots.end());
+    return slots;
+}
+
+void World::moveObject(ObjectId id, const Vec3& center, const Quat& rotation) {
+    const WorldSnapshot& cur = current();
+    const auto slot = cur.scene->slotOf(id);
+    if (!slot) {
+        throw InputError("move: no object with id " + std::to_string(id));
+    }
+    auto scene = std::make_shared<Scene>(*cur.scene);
+    scene->setPose(*slot, center, rotation);
+    const auto now = Clock::now();
+    const auto it =
+        std::find_if(mMovers.begin(), mMovers.end(), [&](auto& m) { return m.id == id; });
+    if (it == mMovers.end()) {
+        mMovers.push_back({id, now});
+    } else {
+        it->lastMove = now;
+    }
+    publish(std::move(scene), cur.index);
+}
+
+void World::addObject(const SceneObject& object) {
+    const WorldSnapshot& cur = current();
+    if (cur.scene->slotOf(object.id)) {
+        throw InputError("add: an object with id " + std::to_string(object.id) + " exists already");
+    }
+    std::vector<SceneObject> objects(cur.scene->objects().begin(), cur.scene->objects().end());
+    objects.push_back(object);
+    auto scene = std::make_shared<const Scene>(cur.scene->bounds(), std::move(objects));
+    mMovers.push_back({object.id, Clock::now()});
+    // The old index knows nothing of the new slot; slots of the others are unchanged.
+    publish(std::move(scene), cur.index);
+}
+
+void World::removeObject(ObjectId id) {
+    if (!current().scene->slotOf(id) ||
+        std::find(mPendingRemovals.begin(), mPendingRemovals.end(), id) != mPendingRemovals.end()) {
+        throw InputError("remove: no object with id " + std::to_string(id));
+    }
+    // Slots shift, so the current index cannot serve the smaller scene: the removal is
+    // published with the index built without the object.
+    mPendingRemovals.push_back(id);
+}
+
+bool World::isMoving(ObjectId id) const {
+    return std::any_of(mMovers.begin(), mMovers.end(), [&](auto& m) { return m.id == id; });
+}
+
+std::shared_ptr<const Scene> World::without(const Scene& scene, const std::vector<ObjectId>& ids) {
+    std::vector<SceneObject> objects;
+    objects.reserve(scene.size());
+    for (const SceneObject& o : scene.objects()) {
+        if (std::find(ids.begin(), ids.end(), o.id) == ids.end()) {
+            objects.push_back(o);
+        }
+    }
+    return std::make_shared<const Scene>(scene.bounds(), std::move(objects));
+}
+
+void World::startBuild() {
+    auto build = std::make_unique<PendingBuild>();
+    build->removed = std::exchange(mPendingRemovals, {});
+    build->started = Clock::now();
+    std::shared_ptr<const Scene> scene =
+        build->removed.empty() ? current().scene : without(*current().scene, build->removed);
+    build->index = std::async(std::launch::async,
+                              [scene, spec = mSpec]() -> std::shared_ptr<const SpatialIndex> {
+                                  return buildIndex(*scene, spec);
+                              });
+    mBuild = std::move(build);
+}
+
+void World::finishBuild() {
+    std::shared_ptr<const SpatialIndex> index = mBuild->index.get();
+    const auto started = mBuild->started;
+    const std::vector<ObjectId> removed = std::move(mBuild->removed);
+    mBuild.reset();
+    // Objects that moved after the build started stay on the brute-force path.
+    std::erase_if(mMovers, [&](const Mover& m) {
+        return m.lastMove < started ||
+               std::find(removed.begin(), removed.end(), m.id) != removed.end();
+    });
+    ++mBuildsPublished;
+    // The scene built over was the then-current one less `removed`; since then objects only
+    // moved (same slots) or were appended, so the current scene less `removed` has the same
+    // slots for everything the new index holds, and the newest poses.
+    const WorldSnapshot& cur = current();
+    publish(removed.empty() ? cur.scene : without(*cur.scene, removed), std::move(index));
+}
+
+void World::maintain() {
+    if (mBuild) {
+        if (mBuild->index.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+            finishBuild();
+        }
+        reclaim();
+        return;
+    }
+    const auto now = Clock::now();
+    const bool anyRested = std::any_of(mMovers.begin(), mMovers.end(), [&](const Mover& m) {
+        return now - m.lastMove >= mRestDelay;
+    });
+    if (anyRested || !mPendingRemovals.empty()) {
+        startBuild();
+    }
+    reclaim();
+}
+
+void World::settle() {
+    // Finish what is in flight, then anything it left to do (at most one more build).
+    for (int round = 0; round < 3; ++round) {
+        if (mBuild) {
+            mBuild->index.wait();
+            finishBuild();
+        }
+        if (mPendingRemovals.empty() &&
+            std::none_of(mMovers.begin(), mMovers.end(),
+                         [&](const Mover& m) { return Clock::now() - m.lastMove >= mRestDelay; })) {
+            break;
+        }
+        startBuild();
+    }
+    reclaim();
+}
+
+void World::reclaim() {
+    std::erase_if(mRetired, [&](const std::unique_ptr<WorldSnapshot>& s) {
+        for (const SnapshotReader& r : mReaders) {
+            if (r.held.load(std::memory_order_seq_cst) == s.get()) {
+                return false;
+            }
+        }
+        return true;
+    });
+}
+
+} // namespace hapto

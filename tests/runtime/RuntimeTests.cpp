@@ -1,0 +1,222 @@
+#include "ScriptedDevice.h"
+
+#include "hapto/runtime/Runtime.h"
+#include "hapto/scenes/Generators.h"
+
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <thread>
+
+using namespace hapto;
+using test::Inject;
+using test::ScriptedDevice;
+
+namespace {
+
+Scene cubeScene() {
+    Material m;
+    m.stiffness = 500.0;
+    return Scene(Aabb{Vec3(-0.125), Vec3(0.125)},
+                 {makeBox(7, Vec3(0), Vec3(0.025), Quat(1, 0, 0, 0), m)});
+}
+
+struct Rig {
+    World world;
+    std::vector<ScriptedDevice*> devices;
+    std::unique_ptr<Runtime> runtime;
+
+    Rig(Scene scene, int count, double rateHz, std::function<void(int, ScriptedDevice&)> setup = {},
+        RuntimeOptions options = {})
+        : world(std::move(scene), IndexSpec::parse("octree:2:0.005")) {
+        std::vector<RuntimeDevice> rds;
+        for (int i = 0; i < count; ++i) {
+            auto d = std::make_unique<ScriptedDevice>("d" + std::to_string(i),
+                                                      test::pressIntoCube(0.004 * i - 0.01));
+            if (setup) {
+                setup(i, *d);
+            }
+            devices.push_back(d.get());
+            DeviceConfig c;
+            c.name = "d" + std::to_string(i);
+            c.kind = "scripted";
+            c.rateHz = rateHz;
+            c.maxForceN = 5.0;
+            rds.push_back({std::move(d), c, nullptr});
+        }
+        options.realtime = false; // tests share a noisy machine; SCHED_FIFO is for sessions
+        runtime = std::make_unique<Runtime>(world, std::move(rds), options);
+    }
+
+    // Runs until every device has at least `ticks` reads or `limit` passes.
+    void runFor(std::uint64_t ticks, std::chrono::seconds limit = std::chrono::seconds(30)) {
+        runtime->start();
+        const auto until = std::chrono::steady_clock::now() + limit;
+        while (std::chrono::steady_clock::now() < until) {
+            runtime->maintain();
+            bool all = true;
+            for (std::size_t i = 0; i < devices.size(); ++i) {
+                all = all && (devices[i]->reads() >= ticks ||
+                              runtime->metrics(i).fault.load() != FaultKind::None);
+            }
+            if (all) {
+                break;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        runtime->stop();
+    }
+};
+
+} // namespace
+
+TEST_CASE("D devices tick, feel the cube, and the report agrees with what they saw") {
+    Rig rig(cubeScene(), 4, 2000.0);
+    rig.runFor(3000);
+    const RunReport r = rig.runtime->report();
+    REQUIRE(r.devices.size() == 4);
+    for (std::size_t i = 0; i < 4; ++i) {
+        const DeviceReport& d = r.devices[i];
+        INFO(d.name);
+        CHECK(d.fault.empty());
+        CHECK(d.ticks >= 3000);
+        CHECK(d.ticks == rig.runtime->metrics(i).ticks.load());
+        CHECK(d.ticks <= rig.devices[i]->reads());
+        CHECK(rig.devices[i]->writes() >= d.ticks); // every tick wrote, plus the final zero
+        CHECK(d.loadFraction.count == d.ticks);
+        CHECK(d.loadFraction.p50 > 0.0);
+        CHECK(d.loadFraction.p50 <= d.loadFraction.p99);
+        CHECK(d.loadFraction.p99 <= d.loadFraction.p999);
+        CHECK(d.loadFraction.p999 <= d.loadFraction.max);
+        CHECK(d.contactTicks > d.ticks / 2); // pressing 2 mm into the cube most of the run
+        CHECK(d.candidatesMean >= 1.0);
+        CHECK(d.rateHz == 2000.0);
+        // 2 mm into a 500 N/m cube: about 1 N, never above the 5 N clamp.
+        CHECK(rig.devices[i]->maxForceSeen() <= 5.0 + 1e-9);
+        CHECK(rig.devices[i]->maxForceSeen() == Approx(1.0).margin(0.2));
+        CHECK(glm::length(rig.devices[i]->lastForce()) == 0.0);
+        CHECK(rig.devices[i]->closed());
+    }
+    CHECK(r.loadSum == Approx(r.devices[0].loadFraction.mean + r.devices[1].loadFraction.mean +
+                              r.devices[2].loadFraction.mean + r.devices[3].loadFraction.mean));
+    CHECK(r.loadPerCore == Approx(r.loadSum / r.cores));
+
+    const auto j = nlohmann::json::parse(reportToJson(r));
+    REQUIRE(j["devices"].size() == 4);
+    for (const char* key :
+         {"name", "kind", "rate_hz", "ticks", "load", "late_wakeups", "missed_deadlines", "io",
+          "locate_steps_mean", "candidates_mean", "faults", "stable"}) {
+        CHECK(j["devices"][0].contains(key));
+    }
+    for (const char* key : {"mean", "p50", "p99", "p999", "max"}) {
+        CHECK(j["devices"][0]["load"].contains(key));
+    }
+    for (const char* key : {"load_sum", "load_per_core", "stable"}) {
+        CHECK(j["total"].contains(key));
+    }
+}
+
+TEST_CASE("each injected fault zeroes that device and leaves the others running") {
+    struct Case {
+        Inject inject;
+        FaultKind expected;
+    };
+    const Case c = GENERATE(Case{Inject::ReadError, FaultKind::ReadFailed},
+                            Case{Inject::Disconnect, FaultKind::ReadFailed},
+                            Case{Inject::NonFinite, FaultKind::NonFinite},
+                            Case{Inject::Stall, FaultKind::Watchdog});
+    INFO("inject " << static_cast<int>(c.inject));
+    Rig rig(cubeScene(), 3, 1000.0, [&](int i, ScriptedDevice& d) {
+        if (i == 1) {
+            d.inject(c.inject, 200);
+        }
+    });
+    rig.runtime->start();
+    // Wait for the fault, then for the healthy devices to go on well past it.
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (rig.runtime->metrics(1).fault.load() == FaultKind::None &&
+           std::chrono::steady_clock::now() < until) {
+        rig.runtime->maintain();
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    const std::uint64_t ticksAtFault = rig.runtime->metrics(0).ticks.load();
+    while (rig.runtime->metrics(0).ticks.load() < ticksAtFault + 300 &&
+           std::chrono::steady_clock::now() < until) {
+        rig.runtime->maintain();
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    // The faulted thread ends by itself (the stalled one once its read returns).
+    while (rig.runtime->metrics(1).running.load() && std::chrono::steady_clock::now() < until) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    CHECK(rig.runtime->metrics(1).fault.load() == c.expected);
+    CHECK_FALSE(rig.runtime->metrics(1).running.load());
+    CHECK(glm::length(rig.devices[1]->lastForce()) == 0.0); // zero before the thread ended
+    CHECK(rig.runtime->metrics(0).running.load());
+    CHECK(rig.runtime->metrics(2).running.load());
+    CHECK(rig.runtime->metrics(0).fault.load() == FaultKind::None);
+    rig.runtime->stop();
+    const RunReport r = rig.runtime->report();
+    CHECK_FALSE(r.devices[1].fault.empty());
+    CHECK_FALSE(r.devices[1].stable);
+    CHECK(r.devices[0].fault.empty());
+    CHECK(r.devices[0].ticks >= ticksAtFault + 300);
+    for (auto* d : rig.devices) {
+        CHECK(glm::length(d->lastForce()) == 0.0);
+    }
+}
+
+TEST_CASE("a device that fails to open is reported and the others run") {
+    Rig rig(cubeScene(), 2, 1000.0, [](int i, ScriptedDevice& d) {
+        if (i == 0) {
+            d.inject(Inject::OpenFails, 0);
+        }
+    });
+    rig.runFor(300);
+    const RunReport r = rig.runtime->report();
+    CHECK(r.devices[0].fault.find("open-failed") == 0);
+    CHECK(r.devices[0].fault.find("injected open failure") != std::string::npos);
+    CHECK(r.devices[0].ticks == 0);
+    CHECK(r.devices[1].ticks >= 300);
+    CHECK_FALSE(r.stable);
+}
+
+TEST_CASE("after K missed deadlines in a row the device gets zero force until it catches up") {
+    RuntimeOptions opt;
+    opt.missLimit = 2;
+    // Ticks from 100 to 160 take 3 periods each: every one misses its deadline.
+    Rig rig(
+        cubeScene(), 1, 1000.0,
+        [](int, ScriptedDevice& d) { d.inject(Inject::SlowTicks, 100, 3'000'000); }, opt);
+    rig.runtime->start();
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (rig.runtime->metrics(0).zeroedForMisses.load() < 5 &&
+           std::chrono::steady_clock::now() < until) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    // While every tick misses, the force sent is zero.
+    CHECK(rig.runtime->metrics(0).zeroedForMisses.load() >= 5);
+    CHECK(glm::length(rig.devices[0]->lastForce()) == 0.0);
+    rig.runtime->stop();
+    const RunReport r = rig.runtime->report();
+    CHECK(r.devices[0].missedDeadlines >= 5);
+    CHECK_FALSE(r.devices[0].stable);
+}
+
+TEST_CASE("servo threads pick up a new snapshot at their next tick") {
+    Rig rig(cubeScene(), 2, 1000.0);
+    rig.runtime->start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    rig.world.moveObject(7, Vec3(0, 0.001, 0), Quat(1, 0, 0, 0));
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while ((rig.runtime->metrics(0).snapshotsSeen.load() == 0 ||
+            rig.runtime->metrics(1).snapshotsSeen.load() == 0) &&
+           std::chrono::steady_clock::now() < until) {
+        rig.runtime->maintain();
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    CHECK(rig.runtime->metrics(0).snapshotsSeen.load() >= 1);
+    CHECK(rig.runtime->metrics(1).snapshotsSeen.load() >= 1);
+    rig.runtime->stop();
+}

@@ -1,0 +1,128 @@
+#pragma once
+/// A test device: follows a position function of the tick, records every force written, and
+/// injects faults on request.
+
+#include "hapto/devices/Device.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <thread>
+
+namespace hapto::test {
+
+/// What to inject, from which tick on.
+enum class Inject { Nothing, ReadError, Disconnect, NonFinite, Stall, SlowTicks, OpenFails };
+
+class ScriptedDevice : public Device {
+public:
+    using Path = std::function<Vec3(std::uint64_t tick)>;
+
+    ScriptedDevice(std::string name, Path path) : mName(std::move(name)), mPath(std::move(path)) {}
+
+    void inject(Inject what, std::uint64_t fromTick, std::uint64_t slowNs = 0) {
+        mInject = what;
+        mFromTick = fromTick;
+        mSlowNs = slowNs;
+    }
+
+    std::string_view name() const override { return mName; }
+    std::string_view kind() const override { return "scripted"; }
+    DeviceCapabilities capabilities() const override {
+        return {"scripted test device", Aabb{Vec3(-1), Vec3(1)}, 10.0, 0.0, 1000.0, 0};
+    }
+    DeviceStatus open() override {
+        if (mInject == Inject::OpenFails) {
+            return DeviceStatus::Error;
+        }
+        mOpen = true;
+        return DeviceStatus::Ok;
+    }
+    void close() override {
+        if (mOpen) {
+            recordForce(Vec3(0.0));
+        }
+        mOpen = false;
+        mClosed = true;
+    }
+    DeviceStatus read(DeviceState& s) override {
+        const std::uint64_t t = mReads.load(std::memory_order_relaxed);
+        mReads.store(t + 1, std::memory_order_relaxed);
+        if (t >= mFromTick) {
+            switch (mInject) {
+            case Inject::ReadError:
+                return DeviceStatus::Error;
+            case Inject::Disconnect:
+                return DeviceStatus::Disconnected;
+            case Inject::NonFinite:
+                s.position = Vec3(std::numeric_limits<double>::quiet_NaN());
+                return DeviceStatus::Ok;
+            case Inject::Stall:
+                if (t == mFromTick) {
+                    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+                }
+                break;
+            case Inject::SlowTicks:
+                std::this_thread::sleep_for(std::chrono::nanoseconds(mSlowNs));
+                break;
+            default:
+                break;
+            }
+        }
+        s.position = mPath(t);
+        s.hasVelocity = false;
+        s.sequence = t;
+        return DeviceStatus::Ok;
+    }
+    DeviceStatus write(const Vec3& f) override {
+        recordForce(f);
+        return DeviceStatus::Ok;
+    }
+    std::string errorMessage() const override {
+        return mInject == Inject::OpenFails ? "injected open failure" : "";
+    }
+
+    std::uint64_t reads() const { return mReads.load(); }
+    std::uint64_t writes() const { return mWrites.load(); }
+    Vec3 lastForce() const { return {mLast[0].load(), mLast[1].load(), mLast[2].load()}; }
+    double maxForceSeen() const { return mMaxForce.load(); }
+    /// Largest force magnitude written while reads >= tick (for "zero after K misses" checks).
+    bool closed() const { return mClosed; }
+
+private:
+    void recordForce(const Vec3& f) {
+        for (int i = 0; i < 3; ++i) {
+            mLast[i].store(f[i]);
+        }
+        const double n = glm::length(f);
+        if (n > mMaxForce.load()) {
+            mMaxForce.store(n);
+        }
+        mWrites.fetch_add(1);
+    }
+
+    std::string mName;
+    Path mPath;
+    Inject mInject = Inject::Nothing;
+    std::uint64_t mFromTick = 0, mSlowNs = 0;
+    std::atomic<std::uint64_t> mReads{0}, mWrites{0};
+    std::atomic<double> mLast[3]{};
+    std::atomic<double> mMaxForce{0};
+    bool mOpen = false, mClosed = false;
+};
+
+/// A path that starts 1 cm above the top face of a 5 cm cube at the origin and presses 2 mm
+/// into it after 50 ticks, then holds.
+inline ScriptedDevice::Path pressIntoCube(double x = 0.0) {
+    return [x](std::uint64_t t) {
+        const double top = 0.025;
+        if (t < 50) {
+            return Vec3(x, top + 0.01 - 0.012 * static_cast<double>(t) / 50.0, 0.0);
+        }
+        return Vec3(x, top - 0.002, 0.0);
+    };
+}
+
+} // namespace hapto::test
