@@ -12,6 +12,25 @@ namespace hapto::cli {
 /// `hapto scene ...`: generators and scene information. [control]
 void addSceneCommands(CLI::App& app);
 
+/// `hapto query` and `hapto index-stats`: build a spatial index, query it, describe it.
+/// [control]
+void addIndexCommands(CLI::App& app);
+
+/// `hapto trace export|info`: trace files as CSV, and what they hold. [control]
+void addTraceCommands(CLI::App& app);
+
+/// `hapto bench query`: per-query cost of indices along a hand-speed walk. [control]
+void addBenchCommands(CLI::App& app);
+
+/// `hapto demo grasp`: the scripted two-handed grasp. [control]
+void addDemoCommands(CLI::App& app);
+
+/// `hapto devices`: hardware found, or why none. [control]
+void addDeviceCommands(CLI::App& app);
+
+/// `hapto run`: a multi-device session with load report. [control]
+void addRunCommands(CLI::App& app);
+
 /// Loads `path`, or the embedded default scene when it is empty. Throws InputError. [control]
 Scene loadSceneOrDefault(const std::string& path);
 

@@ -18,6 +18,12 @@ int main(int argc, char** argv) {
     app.set_help_all_flag("--help-all", "Print help for every subcommand and exit");
 
     hapto::cli::addSceneCommands(app);
+    hapto::cli::addRunCommands(app);
+    hapto::cli::addDeviceCommands(app);
+    hapto::cli::addDemoCommands(app);
+    hapto::cli::addBenchCommands(app);
+    hapto::cli::addIndexCommands(app);
+    hapto::cli::addTraceCommands(app);
 
     try {
         app.parse(argc, argv);

@@ -1,0 +1,226 @@
+// `hapto demo grasp`: two simulated hands pick up, carry and put down an object.
+
+#include "Commands.h"
+
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/devices/DeviceFactory.h"
+#include "hapto/devices/SimDevice.h"
+#include "hapto/index/IndexSpec.h"
+#include "hapto/runtime/GraspController.h"
+#include "hapto/runtime/Runtime.h"
+#include "hapto/scenes/Generators.h"
+#include "hapto/scenes/InputError.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <thread>
+
+namespace hapto::cli {
+namespace {
+
+struct DemoArgs {
+    std::string scene;
+    std::string devices;
+    std::string report;
+    std::string index = "octree:2:0.005";
+    ObjectId object = 0;
+    bool realtime = false;
+};
+
+// Two simulated hands for the grasp scene: left starts at the -x side, right at the +x side,
+// both above the floor, in clear space.
+std::vector<DeviceConfig> graspHands(ObjectId object) {
+    std::vector<DeviceConfig> hands(2);
+    const char* names[2] = {"left", "right"};
+    const char* scripts[2] = {"grasp-left", "grasp-right"};
+    const Vec3 starts[2] = {Vec3(-0.12, -0.04, 0.0), Vec3(0.04, -0.04, 0.0)};
+    for (int i = 0; i < 2; ++i) {
+        hands[i].name = names[i];
+        hands[i].kind = "sim";
+        hands[i].transform.translation = starts[i];
+        SimConfig sim;
+        sim.script = scripts[i];
+        sim.seed = static_cast<std::uint64_t>(i + 1);
+        sim.object = object;
+        sim.pressForceN = 2.0;
+        hands[i].params = sim;
+    }
+    return hands;
+}
+
+// Per device: what the hand felt while the object was held.
+struct Felt {
+    double maxForceN = 0;
+    double squeezeSumN = 0; // force along the grasp axis, into the object
+    double verticalSumN = 0;
+    std::uint64_t samples = 0;
+};
+
+int runDemo(const DemoArgs& a) {
+    const Scene scene = a.scene.empty() ? makeGraspScene() : loadSceneOrDefault(a.scene);
+    if (!scene.slotOf(a.object)) {
+        throw InputError("--object: the scene has no object with id " + std::to_string(a.object));
+    }
+    std::vector<DeviceConfig> configs =
+        a.devices.empty() ? graspHands(a.object) : loadDeviceConfigFile(a.devices);
+    if (configs.size() != 2) {
+        throw InputError(a.devices +
+                         ": the grasp demo takes exactly two devices (left, right), got " +
+                         std::to_string(configs.size()));
+    }
+    World world(scene, IndexSpec::parse(a.index));
+    std::vector<RuntimeDevice> devices;
+    std::vector<SimDevice*> sims;
+    for (const DeviceConfig& c : configs) {
+        RuntimeDevice rd{makeDevice(c, scene), c, nullptr};
+        sims.push_back(dynamic_cast<SimDevice*>(rd.device.get()));
+        devices.push_back(std::move(rd));
+    }
+    RuntimeOptions options;
+    options.realtime = a.realtime;
+    Runtime runtime(world, std::move(devices), options);
+    GraspController grasp(world, runtime, 0, 1);
+
+    const Vec3 startPosition = scene.object(*scene.slotOf(a.object)).center;
+    std::printf(
+        "hapto demo grasp: object %u at (%.3f, %.3f, %.3f) m, %u objects, devices %s + %s\n",
+        a.object, startPosition.x, startPosition.y, startPosition.z, scene.size(),
+        configs[0].name.c_str(), configs[1].name.c_str());
+    if (runtime.start() != 2) {
+        runtime.stop();
+        throw std::runtime_error(
+            "a device could not be opened: " + runtime.report().devices[0].fault + " " +
+            runtime.report().devices[1].fault);
+    }
+
+    // Until both scripts are done (simulated hands) or 12 s, plus a second to settle.
+    Felt felt[2];
+    const auto t0 = std::chrono::steady_clock::now();
+    auto next = t0;
+    GraspState last = GraspState::Idle;
+    for (;;) {
+        next += std::chrono::milliseconds(1);
+        std::this_thread::sleep_until(next);
+        const double t =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        runtime.maintain();
+        grasp.step(0.001);
+        if (grasp.state() != last) {
+            const auto& p = grasp.path().back();
+            std::printf("  %6.3f s  %-8s object at (%.3f, %.3f, %.3f) m\n", p.timeS,
+                        grasp.state() == GraspState::Grasped   ? "grasped"
+                        : grasp.state() == GraspState::Falling ? "released"
+                                                               : "at rest",
+                        p.position.x, p.position.y, p.position.z);
+            last = grasp.state();
+        }
+        if (grasp.state() == GraspState::Grasped) {
+            ContactReport c[2];
+            if (runtime.contact(0, c[0]) && runtime.contact(1, c[1])) {
+                const Vec3 axis = glm::normalize(c[1].devicePoint - c[0].devicePoint);
+                for (int i = 0; i < 2; ++i) {
+                    const double sign = i == 0 ? -1.0 : 1.0; // left is pushed to -axis
+                    felt[i].maxForceN = std::max(felt[i].maxForceN, glm::length(c[i].force));
+                    felt[i].squeezeSumN += sign * glm::dot(c[i].force, axis);
+                    felt[i].verticalSumN += c[i].force.y;
+                    ++felt[i].samples;
+                }
+            }
+        }
+        const bool scriptsDone = sims[0] && sims[1] && sims[0]->phase() == ScriptPhase::Done &&
+                                 sims[1]->phase() == ScriptPhase::Done;
+        if ((scriptsDone && grasp.state() == GraspState::Idle && t > 1.0) || t > 12.0 ||
+            !runtime.anyRunning()) {
+            break;
+        }
+    }
+    runtime.stop();
+    world.setRestDelay(std::chrono::nanoseconds(0));
+    world.settle();
+
+    const Vec3 endPosition =
+        world.current().scene->object(*world.current().scene->slotOf(a.object)).center;
+    const RunReport r = runtime.report();
+    std::printf("grasped %zu time(s), %llu control steps; object moved (%.3f, %.3f, %.3f) m to "
+                "(%.3f, %.3f, %.3f) m; back in the index: %s\n",
+                grasp.graspStarts().size(), static_cast<unsigned long long>(grasp.graspedSteps()),
+                endPosition.x - startPosition.x, endPosition.y - startPosition.y,
+                endPosition.z - startPosition.z, endPosition.x, endPosition.y, endPosition.z,
+                world.isMoving(a.object) ? "no" : "yes");
+    std::printf("weight %.3f N (%.1f g); deepest overlap with another object %.2g m\n",
+                grasp.massKg() * 9.81, grasp.massKg() * 1000, grasp.worstPenetrationM());
+    nlohmann::json devicesJson = nlohmann::json::array();
+    for (int i = 0; i < 2; ++i) {
+        const DeviceReport& d = r.devices[i];
+        const double n = static_cast<double>(std::max<std::uint64_t>(1, felt[i].samples));
+        std::printf("  %-6s squeeze %.2f N, vertical %.2f N while held, max |F| %.2f N; load "
+                    "p50 %.1f%% p99.9 %.1f%%, %s\n",
+                    d.name.c_str(), felt[i].squeezeSumN / n, felt[i].verticalSumN / n,
+                    felt[i].maxForceN, 100 * d.loadFraction.p50, 100 * d.loadFraction.p999,
+                    d.fault.empty() ? (d.stable ? "stable" : "UNSTABLE") : d.fault.c_str());
+        devicesJson.push_back({{"name", d.name},
+                               {"ticks", d.ticks},
+                               {"squeeze_mean_n", felt[i].squeezeSumN / n},
+                               {"vertical_mean_n", felt[i].verticalSumN / n},
+                               {"max_force_n", felt[i].maxForceN},
+                               {"load",
+                                {{"p50", d.loadFraction.p50},
+                                 {"p999", d.loadFraction.p999},
+                                 {"max", d.loadFraction.max}}},
+                               {"stable", d.stable},
+                               {"fault", d.fault}});
+    }
+    if (!a.report.empty()) {
+        nlohmann::json path = nlohmann::json::array();
+        for (const GraspPathPoint& p : grasp.path()) {
+            path.push_back({{"t_s", p.timeS},
+                            {"state", p.state == GraspState::Grasped   ? "grasped"
+                                      : p.state == GraspState::Falling ? "falling"
+                                                                       : "rest"},
+                            {"position", {p.position.x, p.position.y, p.position.z}}});
+        }
+        const nlohmann::json report{
+            {"object_id", a.object},
+            {"grasped_ticks", grasp.graspedSteps()},
+            {"grasp_starts_s", grasp.graspStarts()},
+            {"grasp_ends_s", grasp.graspEnds()},
+            {"start_position", {startPosition.x, startPosition.y, startPosition.z}},
+            {"end_position", {endPosition.x, endPosition.y, endPosition.z}},
+            {"mass_kg", grasp.massKg()},
+            {"back_in_index", !world.isMoving(a.object)},
+            {"path", path},
+            {"devices", devicesJson}};
+        std::ofstream out(a.report);
+        out << report.dump(2) << "\n";
+        if (!out) {
+            throw InputError(a.report + ": cannot write the report");
+        }
+        std::printf("report written to %s\n", a.report.c_str());
+    }
+    return 0;
+}
+
+} // namespace
+
+void addDemoCommands(CLI::App& app) {
+    auto* demo = app.add_subcommand("demo", "Scripted demonstrations");
+    demo->require_subcommand(1);
+    auto* cmd = demo->add_subcommand(
+        "grasp", "Two simulated hands approach an object from both sides, squeeze, lift it 5 cm, "
+                 "carry it 10 cm sideways, put it down and let go (about 9 s)");
+    auto a = std::make_shared<DemoArgs>();
+    cmd->add_option("--scene", a->scene, "Scene file (default: the built-in grasp scene, y up)");
+    cmd->add_option("--devices", a->devices,
+                    "Two-device configuration (default: simulated hands with the grasp-left / "
+                    "grasp-right scripts)");
+    cmd->add_option("--object", a->object, "Id of the object to grasp")->capture_default_str();
+    cmd->add_option("--index", a->index, "Spatial index SPEC")->capture_default_str();
+    cmd->add_option("--report", a->report, "Write a JSON report here");
+    cmd->add_flag("--realtime", a->realtime, "Ask for SCHED_FIFO for the servo threads");
+    cmd->callback([a] { runDemo(*a); });
+}
+
+} // namespace hapto::cli

@@ -1,0 +1,229 @@
+// `hapto query` and `hapto index-stats`: build a spatial index over a scene and ask it things.
+
+#include "Commands.h"
+
+#include "hapto/index/Cursor.h"
+#include "hapto/index/IndexSpec.h"
+#include "hapto/index/SpatialIndex.h"
+#include "hapto/scenes/InputError.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+namespace hapto::cli {
+namespace {
+
+std::string_view trim(std::string_view s) {
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) {
+        s.remove_prefix(1);
+    }
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) {
+        s.remove_suffix(1);
+    }
+    return s;
+}
+
+/// Reads `x,y,z` lines (m), with an optional `x,y,z` header; blank lines are skipped.
+std::vector<Vec3> readPoints(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        throw InputError("cannot read points file '" + path + "': no such file or no access");
+    }
+    std::vector<Vec3> points;
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+        const std::string_view text = trim(line);
+        if (text.empty() || (points.empty() && text == "x,y,z")) {
+            continue;
+        }
+        Vec3 p(0.0);
+        std::string_view rest = text;
+        bool ok = true;
+        for (int a = 0; a < 3 && ok; ++a) {
+            const std::size_t comma = rest.find(',');
+            const bool last = a == 2;
+            if (last == (comma != std::string_view::npos)) {
+                ok = false;
+                break;
+            }
+            const std::string_view field = trim(rest.substr(0, comma));
+            const auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), p[a]);
+            ok = ec == std::errc() && ptr == field.data() + field.size() && !field.empty() &&
+                 std::isfinite(p[a]);
+            rest = last ? std::string_view() : rest.substr(comma + 1);
+        }
+        if (!ok) {
+            throw InputError(path + ":" + std::to_string(number) +
+                             ": expected a point as three finite numbers x,y,z in metres (e.g. "
+                             "0.01,-0.02,0.005), got '" +
+                             std::string(text) + "'");
+        }
+        points.push_back(p);
+    }
+    return points;
+}
+
+void runQuery(const std::string& scenePath, const std::string& specText,
+              const std::string& pointsPath, const std::string& outPath) {
+    const IndexSpec spec = IndexSpec::parse(specText);
+    const std::vector<Vec3> points = readPoints(pointsPath);
+    const Scene scene = loadSceneOrDefault(scenePath);
+    const std::unique_ptr<SpatialIndex> index = buildIndex(scene, spec);
+
+    std::ofstream file;
+    if (!outPath.empty()) {
+        file.open(outPath, std::ios::binary | std::ios::trunc);
+        if (!file) {
+            throw InputError("cannot write output file '" + outPath +
+                             "': check the folder exists and is writable");
+        }
+    }
+    std::ostream& out = outPath.empty() ? std::cout : file;
+    std::string text = "point,candidates\n";
+    Cursor cursor(*index);
+    std::vector<ObjectId> ids;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const LocateResult r = cursor.locate(points[i]);
+        ids.clear();
+        for (const std::uint32_t slot : r.candidates) {
+            ids.push_back(scene.object(slot).id);
+        }
+        std::sort(ids.begin(), ids.end());
+        text += std::to_string(i);
+        text += ',';
+        for (std::size_t k = 0; k < ids.size(); ++k) {
+            if (k > 0) {
+                text += ' ';
+            }
+            text += std::to_string(ids[k]);
+        }
+        text += '\n';
+        if (text.size() > (1u << 20)) {
+            out << text;
+            text.clear();
+        }
+    }
+    out << text;
+    out.flush();
+    if (!out) {
+        throw std::runtime_error("writing the query results failed");
+    }
+}
+
+nlohmann::json statsJson(const IndexStats& s) {
+    nlohmann::json bins = nlohmann::json::array();
+    for (const IndexStats::Bin& b : s.objectsPerLeaf) {
+        bins.push_back(
+            {{"min_objects", b.minObjects}, {"max_objects", b.maxObjects}, {"leaves", b.leaves}});
+    }
+    return {{"index", s.index},
+            {"objects", s.objects},
+            {"nodes", s.nodes},
+            {"leaves", s.leaves},
+            {"empty_leaves", s.emptyLeaves},
+            {"depth", s.depth},
+            {"leaves_at_minimum_size", s.leavesAtMinimumSize},
+            {"object_cell_pairs", s.objectCellPairs},
+            {"max_objects_per_leaf", s.maxObjectsPerLeaf},
+            {"mean_objects_per_leaf", s.meanObjectsPerLeaf},
+            {"objects_per_leaf", bins},
+            {"bytes", s.bytes},
+            {"bytes_per_object", s.bytesPerObject},
+            {"build_seconds", s.buildSeconds},
+            {"build_cpu_seconds", s.buildCpuSeconds}};
+}
+
+void printStats(const IndexStats& s, const std::string& source) {
+    std::printf("scene:              %s\n", source.c_str());
+    std::printf("index:              %s\n", s.index.c_str());
+    std::printf("objects:            %u\n", s.objects);
+    std::printf("build:              %.3f s wall, %.3f s CPU (all threads)\n", s.buildSeconds,
+                s.buildCpuSeconds);
+    std::printf("nodes:              %llu\n", static_cast<unsigned long long>(s.nodes));
+    std::printf("leaves:             %llu (%llu empty, %llu at minimum size)\n",
+                static_cast<unsigned long long>(s.leaves),
+                static_cast<unsigned long long>(s.emptyLeaves),
+                static_cast<unsigned long long>(s.leavesAtMinimumSize));
+    std::printf("depth:              %u\n", s.depth);
+    std::printf("object-cell pairs:  %llu (%.2f per object)\n",
+                static_cast<unsigned long long>(s.objectCellPairs),
+                s.objects == 0 ? 0.0 : static_cast<double>(s.objectCellPairs) / s.objects);
+    std::printf("objects per leaf:   mean %.2f, max %u\n", s.meanObjectsPerLeaf,
+                s.maxObjectsPerLeaf);
+    for (const IndexStats::Bin& b : s.objectsPerLeaf) {
+        if (b.leaves == 0) {
+            continue;
+        }
+        char range[48];
+        if (b.minObjects == b.maxObjects) {
+            std::snprintf(range, sizeof range, "%u", b.minObjects);
+        } else {
+            std::snprintf(range, sizeof range, "%u-%u", b.minObjects, b.maxObjects);
+        }
+        std::printf("  %12s objects: %llu leaves\n", range,
+                    static_cast<unsigned long long>(b.leaves));
+    }
+    std::printf("memory:             %llu bytes (%.1f per object)\n",
+                static_cast<unsigned long long>(s.bytes), s.bytesPerObject);
+}
+
+} // namespace
+
+void addIndexCommands(CLI::App& app) {
+    const std::string specHelp = "Index: brute, grid:N (e.g. grid:5) or octree:M:MIN (e.g. "
+                                 "octree:2:0.005, MIN in metres), each optionally + :aabb";
+    // query
+    {
+        auto* cmd = app.add_subcommand(
+            "query", "Build an index and list each point's candidate object ids as CSV "
+                     "(point,candidates)");
+        auto scene = std::make_shared<std::string>();
+        auto spec = std::make_shared<std::string>();
+        auto points = std::make_shared<std::string>();
+        auto out = std::make_shared<std::string>();
+        cmd->add_option("--scene", *scene, "Scene file")->required();
+        cmd->add_option("--index", *spec, specHelp)->required();
+        cmd->add_option("--points", *points,
+                        "CSV file, one point x,y,z (m) per line, optional header x,y,z")
+            ->required();
+        cmd->add_option("-o,--output", *out, "Output CSV file (default: standard output)");
+        cmd->callback([=] { runQuery(*scene, *spec, *points, *out); });
+    }
+    // index-stats
+    {
+        auto* cmd = app.add_subcommand(
+            "index-stats", "Build an index over a scene and print its statistics (nodes, "
+                           "leaves, depth, fill histogram, object-cell pairs, memory, build "
+                           "time)");
+        auto scene = std::make_shared<std::string>();
+        auto spec = std::make_shared<std::string>();
+        auto json = std::make_shared<bool>(false);
+        cmd->add_option("--scene", *scene, "Scene file (default: the embedded default scene)");
+        cmd->add_option("--index", *spec, specHelp)->required();
+        cmd->add_flag("--json", *json, "Print the statistics as one JSON object");
+        cmd->callback([=] {
+            const IndexSpec parsed = IndexSpec::parse(*spec);
+            const Scene s = loadSceneOrDefault(*scene);
+            const std::unique_ptr<SpatialIndex> index = buildIndex(s, parsed);
+            if (*json) {
+                std::cout << statsJson(index->stats()).dump(2) << "\n";
+            } else {
+                printStats(index->stats(), scene->empty() ? "(embedded default scene)" : *scene);
+            }
+        });
+    }
+}
+
+} // namespace hapto::cli

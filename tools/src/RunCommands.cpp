@@ -1,0 +1,202 @@
+// `hapto run`: a session of D devices over one shared world, reporting each device's load.
+
+#include "Commands.h"
+
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/devices/DeviceFactory.h"
+#include "hapto/devices/TraceRecorder.h"
+#include "hapto/index/IndexSpec.h"
+#include "hapto/runtime/Runtime.h"
+#include "hapto/scenes/InputError.h"
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <thread>
+#include <unistd.h>
+
+namespace hapto::cli {
+namespace {
+
+std::atomic<bool> gStopRequested{false};
+
+extern "C" void onStopSignal(int) {
+    gStopRequested.store(true);
+}
+
+struct RunArgs {
+    std::string scene;
+    std::string devices;
+    std::string index = "octree:2:0.005";
+    double rateHz = 0;
+    double durationS = 5;
+    std::string report;
+    std::string record;
+    bool noRealtime = false;
+    double spinUs = 0;
+    int missLimit = 3;
+    bool quiet = false;
+};
+
+void printSummary(const RunReport& r) {
+    std::printf("\n%-10s %-7s %8s %9s %8s %8s %8s %8s %7s %7s %6s %s\n", "device", "kind", "rate",
+                "ticks", "load", "p50", "p99.9", "max", "missed", "late", "cand", "verdict");
+    for (const DeviceReport& d : r.devices) {
+        std::printf(
+            "%-10s %-7s %6.0fHz %9llu %7.2f%% %7.2f%% %7.2f%% %7.1f%% %7llu %7llu %6.1f %s\n",
+            d.name.c_str(), d.kind.c_str(), d.rateHz, static_cast<unsigned long long>(d.ticks),
+            100 * d.loadFraction.mean, 100 * d.loadFraction.p50, 100 * d.loadFraction.p999,
+            100 * d.loadFraction.max, static_cast<unsigned long long>(d.missedDeadlines),
+            static_cast<unsigned long long>(d.lateWakeups), d.candidatesMean,
+            d.fault.empty() ? (d.stable ? "stable" : "UNSTABLE") : ("FAULT " + d.fault).c_str());
+    }
+    std::printf(
+        "total: load %.2f%% of one core summed over %zu devices, %.2f%% per core (%d cores); %s\n",
+        100 * r.loadSum, r.devices.size(), 100 * r.loadPerCore, r.cores,
+        r.stable ? "stable" : "NOT stable");
+    if (!r.realtimeNote.empty()) {
+        std::printf("note: %s\n", r.realtimeNote.c_str());
+    }
+}
+
+int runSession(const RunArgs& a) {
+    const Scene scene = loadSceneOrDefault(a.scene);
+    const IndexSpec spec = IndexSpec::parse(a.index);
+    std::vector<DeviceConfig> configs =
+        a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
+    if (a.rateHz > 0) {
+        for (DeviceConfig& c : configs) {
+            c.rateHz = a.rateHz;
+        }
+    }
+    World world(scene, spec);
+
+    std::vector<std::unique_ptr<TraceRecorder>> recorders;
+    if (!a.record.empty()) {
+        std::filesystem::create_directories(a.record);
+    }
+    std::vector<RuntimeDevice> devices;
+    for (const DeviceConfig& c : configs) {
+        RuntimeDevice rd{makeDevice(c, scene), c, nullptr};
+        if (!a.record.empty()) {
+            TraceHeader header;
+            header.rateHz = c.rateHz;
+            header.kind = c.kind;
+            header.name = c.name;
+            header.startUnixNs =
+                static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                               std::chrono::system_clock::now().time_since_epoch())
+                                               .count());
+            recorders.push_back(std::make_unique<TraceRecorder>(
+                std::filesystem::path(a.record) / (c.name + ".trace"), header));
+            rd.recorder = recorders.back().get();
+        }
+        devices.push_back(std::move(rd));
+    }
+    RuntimeOptions opt;
+    opt.realtime = !a.noRealtime;
+    opt.spinNs = static_cast<std::uint64_t>(a.spinUs * 1000);
+    opt.missLimit = a.missLimit;
+    Runtime runtime(world, std::move(devices), opt);
+
+    std::signal(SIGINT, onStopSignal);
+    std::signal(SIGTERM, onStopSignal);
+    const bool live = !a.quiet && isatty(STDERR_FILENO);
+    std::fprintf(stderr, "hapto run: %zu devices, %u objects, index %s, %.1f s%s\n", configs.size(),
+                 scene.size(), spec.toString().c_str(), a.durationS,
+                 a.durationS <= 0 ? " (until Ctrl-C)" : "");
+    if (runtime.start() == 0) {
+        const RunReport r = runtime.report();
+        for (const DeviceReport& d : r.devices) {
+            std::fprintf(stderr, "hapto run: %s: %s\n", d.name.c_str(), d.fault.c_str());
+        }
+        std::fprintf(stderr, "hapto run: no device could be opened\n");
+        return 1;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    auto lastLive = start;
+    bool drewLive = false;
+    while (!gStopRequested.load() && runtime.anyRunning()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        runtime.maintain();
+        for (auto& rec : recorders) {
+            rec->drain();
+        }
+        const auto now = std::chrono::steady_clock::now();
+        if (live && now - lastLive > std::chrono::milliseconds(250)) {
+            lastLive = now;
+            if (drewLive) {
+                std::fprintf(stderr, "\x1b[%zuA", runtime.deviceCount());
+            }
+            for (std::size_t i = 0; i < runtime.deviceCount(); ++i) {
+                std::fprintf(stderr, "\r\x1b[2K%s\n", runtime.liveLine(i).c_str());
+            }
+            drewLive = true;
+        }
+        if (a.durationS > 0 && now - start >= std::chrono::duration<double>(a.durationS)) {
+            break;
+        }
+    }
+    runtime.stop();
+    for (auto& rec : recorders) {
+        rec->close();
+    }
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    const RunReport r = runtime.report();
+    printSummary(r);
+    if (!a.report.empty()) {
+        std::ofstream out(a.report);
+        out << reportToJson(r);
+        if (!out) {
+            throw InputError(a.report + ": cannot write the report");
+        }
+        std::fprintf(stderr, "report written to %s\n", a.report.c_str());
+    }
+    return 0;
+}
+
+} // namespace
+
+void addRunCommands(CLI::App& app) {
+    auto* cmd = app.add_subcommand(
+        "run", "Run a haptic session: one servo thread per device over one shared index, "
+               "reporting each device's haptic load");
+    auto a = std::make_shared<RunArgs>();
+    cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
+    cmd->add_option("--devices", a->devices,
+                    "Device configuration file (default: two simulated hands, left and right)");
+    cmd->add_option("--index", a->index,
+                    "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb")
+        ->capture_default_str();
+    cmd->add_option("--rate", a->rateHz,
+                    "Servo rate for every device (Hz; default: each device's own)")
+        ->check(CLI::Range(100.0, 100000.0));
+    cmd->add_option("--duration", a->durationS, "Run time (s); 0 runs until Ctrl-C")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--report", a->report, "Write the JSON report here");
+    cmd->add_option("--record", a->record,
+                    "Record every device's ticks into DIR/<name>.trace (see `hapto trace export`)");
+    cmd->add_flag("--no-realtime", a->noRealtime, "Do not ask for SCHED_FIFO and CPU pinning");
+    cmd->add_option("--spin-us", a->spinUs, "Spin this long before each deadline (us)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1000.0));
+    cmd->add_option("--miss-limit", a->missLimit,
+                    "K: after K missed deadlines in a row, command zero force until caught up")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000000));
+    cmd->add_flag("--quiet", a->quiet, "No live view");
+    cmd->callback([a] {
+        const int rc = runSession(*a);
+        if (rc != 0) {
+            std::exit(rc);
+        }
+    });
+}
+
+} // namespace hapto::cli
