@@ -5,6 +5,7 @@
 #include <ctime>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/prctl.h>
 
 namespace hapto::rt {
 namespace {
@@ -32,8 +33,15 @@ void sleepUntilNs(std::uint64_t deadlineNs, std::uint64_t spinNs) noexcept {
     }
 }
 
+void tightenTimerSlack() noexcept {
+    // The kernel lets a normal thread's timed sleep end up to 50 us late (timer slack); a
+    // servo thread wants its deadline, so ask for 1 ns.
+    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+}
+
 RealtimeGrant makeCurrentThreadRealtime(int priority, int cpu) {
     RealtimeGrant g;
+    tightenTimerSlack();
     sched_param p{};
     p.sched_priority = priority;
     if (const int e = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p); e == 0) {

@@ -157,6 +157,7 @@ void Runtime::servoMain(Channel& ch) {
     if (mOptions.realtime) {
         ch.grant = rt::makeCurrentThreadRealtime(mOptions.fifoPriority, ch.cpu);
     } else {
+        rt::tightenTimerSlack();
         ch.grant.note = "real-time scheduling not requested";
     }
     Device& dev = *ch.rd.device;

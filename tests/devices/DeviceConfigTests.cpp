@@ -16,11 +16,11 @@ using namespace hapto;
 
 namespace {
 
-// The n-th ```json block of devices/README-devices.md.
+// The n-th ```json block of README.md's "Device configuration files" section.
 std::string readmeExample(int n) {
-    const std::string text =
-        test::readFile(std::string(HAPTO_SOURCE_DIR) + "/devices/README-devices.md");
-    std::size_t at = 0;
+    const std::string text = test::readFile(std::string(HAPTO_SOURCE_DIR) + "/README.md");
+    std::size_t at = text.find("### Device configuration files");
+    REQUIRE(at != std::string::npos);
     for (int i = 0; i <= n; ++i) {
         at = text.find("```json\n", at);
         REQUIRE(at != std::string::npos);

@@ -5,6 +5,7 @@
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/DeviceFactory.h"
 #include "hapto/devices/SimDevice.h"
+#include "hapto/index/Cursor.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/runtime/GraspController.h"
 #include "hapto/runtime/Runtime.h"
@@ -13,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -150,8 +152,20 @@ int runDemo(const DemoArgs& a) {
                 endPosition.x - startPosition.x, endPosition.y - startPosition.y,
                 endPosition.z - startPosition.z, endPosition.x, endPosition.y, endPosition.z,
                 world.isMoving(a.object) ? "no" : "yes");
-    std::printf("weight %.3f N (%.1f g); deepest overlap with another object %.2g m\n",
-                grasp.massKg() * 9.81, grasp.massKg() * 1000, grasp.worstPenetrationM());
+    // Ask the rebuilt index: the object must be found where it is now, not where it was.
+    const auto foundAt = [&](const Vec3& p) {
+        const WorldSnapshot& s = world.current();
+        Cursor cursor(*s.index);
+        const std::uint32_t slot = *s.scene->slotOf(a.object);
+        const LocateResult r = cursor.locate(p);
+        return std::find(r.candidates.begin(), r.candidates.end(), slot) != r.candidates.end();
+    };
+    const bool foundNew = foundAt(endPosition);
+    const bool foundOld = glm::length(endPosition - startPosition) > 1e-6 && foundAt(startPosition);
+    std::printf("weight %.3f N (%.1f g); the index finds it at its new place: %s, at its old "
+                "place: %s\n",
+                grasp.massKg() * 9.81, grasp.massKg() * 1000, foundNew ? "yes" : "no",
+                foundOld ? "yes" : "no");
     nlohmann::json devicesJson = nlohmann::json::array();
     for (int i = 0; i < 2; ++i) {
         const DeviceReport& d = r.devices[i];
@@ -191,6 +205,8 @@ int runDemo(const DemoArgs& a) {
             {"end_position", {endPosition.x, endPosition.y, endPosition.z}},
             {"mass_kg", grasp.massKg()},
             {"back_in_index", !world.isMoving(a.object)},
+            {"index_finds_it_at_end", foundNew},
+            {"index_finds_it_at_start", foundOld},
             {"path", path},
             {"devices", devicesJson}};
         std::ofstream out(a.report);

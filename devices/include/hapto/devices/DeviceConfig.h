@@ -95,7 +95,7 @@ struct DeviceConfig {
     std::variant<SimConfig, ReplayConfig, FalconConfig, PhantomConfig> params; ///< Per kind.
 };
 
-/// Loads a device configuration file (format "hapto-devices", devices/README-devices.md);
+/// Loads a device configuration file (format "hapto-devices", README.md "Device configuration files");
 /// relative trace and firmware paths are resolved against the file's folder. Throws InputError
 /// naming the file and the JSON path (e.g. `devices[1].transform.scale`). [control]
 std::vector<DeviceConfig> loadDeviceConfigFile(const std::filesystem::path& path);

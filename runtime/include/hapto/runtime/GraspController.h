@@ -64,9 +64,6 @@ public:
     const std::vector<GraspPathPoint>& path() const { return mPath; }
     /// Mass of the current object (kg).
     double massKg() const { return mMassKg; }
-    /// The largest overlap depth seen between the moved object and any other (m): 0 when it
-    /// never passed into anything (it may touch).
-    double worstPenetrationM() const { return mWorstPenetration; }
 
 private:
     bool opposed(const ContactReport& l, const ContactReport& r, ObjectId& id, double& fn) const;
@@ -92,7 +89,6 @@ private:
     std::uint64_t mGraspedSteps = 0;
     std::vector<double> mStarts, mEnds;
     std::vector<GraspPathPoint> mPath;
-    double mWorstPenetration = 0;
 };
 
 /// Mass of an object at a density (kg). [any thread]

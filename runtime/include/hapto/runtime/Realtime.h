@@ -13,6 +13,10 @@ std::uint64_t nowNs() noexcept;
 /// TIMER_ABSTIME; when spinNs > 0, sleeps until deadline - spinNs and spins the rest. [servo]
 void sleepUntilNs(std::uint64_t deadlineNs, std::uint64_t spinNs) noexcept;
 
+/// Sets the calling thread's timer slack to 1 ns, so absolute-deadline sleeps wake on time
+/// (Linux's default slack for normal threads is 50 us). [control]
+void tightenTimerSlack() noexcept;
+
 /// What the current thread got when it asked for real-time scheduling.
 struct RealtimeGrant {
     bool fifo = false;   ///< SCHED_FIFO granted.
@@ -20,7 +24,8 @@ struct RealtimeGrant {
     std::string note;    ///< Why not, for people (empty when both were granted).
 };
 
-/// Asks for SCHED_FIFO at `priority` and pins the calling thread to `cpu` (-1: no pinning).
+/// Tightens the timer slack, asks for SCHED_FIFO at `priority` and pins the calling thread to
+/// `cpu` (-1: no pinning).
 /// Never fails: returns what was granted. Call at thread start, before the loop. [control]
 RealtimeGrant makeCurrentThreadRealtime(int priority, int cpu);
 
