@@ -3,7 +3,8 @@
 # what is missing, builds, and then:
 #   tools/setup.sh main   runs the main job: a two-device simulated session over the
 #                         embedded default scene, printing each device's haptic load;
-#   tools/setup.sh test   runs the whole test suite through ctest.
+#   tools/setup.sh test   runs the whole test suite through ctest: in the release build, then
+#                         under AddressSanitizer + UBSan (asan) and ThreadSanitizer (tsan).
 # Both are idempotent: a second run installs nothing and rebuilds only what changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -42,10 +43,14 @@ build() {
 case "$mode" in
   main)
     build release
-    exec build/release/tools/hapto scene info "$@"
+    exec build/release/tools/hapto run "$@"
     ;;
   test)
-    build release
-    ctest --preset release -j "$jobs"
+    for preset in release asan tsan; do
+      echo "== $preset: build"
+      build "$preset"
+      echo "== $preset: ctest"
+      ctest --preset "$preset" -j "$jobs"
+    done
     ;;
 esac

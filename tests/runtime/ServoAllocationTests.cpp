@@ -10,6 +10,7 @@
 #include <catch2/catch.hpp>
 
 #include <atomic>
+#include <cstddef>
 #include <cstdlib>
 #include <new>
 #include <thread>
@@ -18,12 +19,21 @@ namespace {
 std::atomic<std::uint64_t> gServoAllocations{0};
 std::atomic<std::uint64_t> gAllAllocations{0};
 
-void* counted(std::size_t n) {
+// Every form of operator new comes here (plain, array, nothrow, over-aligned), so nothing a
+// servo thread allocates escapes the count, and every delete frees what its new allocated.
+void* counted(std::size_t n, std::size_t align = 0) noexcept {
     gAllAllocations.fetch_add(1, std::memory_order_relaxed);
     if (hapto::rt::inServoLoop()) {
         gServoAllocations.fetch_add(1, std::memory_order_relaxed);
     }
-    if (void* p = std::malloc(n ? n : 1)) {
+    n = n ? n : 1;
+    if (align > alignof(std::max_align_t)) {
+        return std::aligned_alloc(align, (n + align - 1) / align * align);
+    }
+    return std::malloc(n);
+}
+void* countedOrThrow(std::size_t n, std::size_t align = 0) {
+    if (void* p = counted(n, align)) {
         return p;
     }
     throw std::bad_alloc();
@@ -31,10 +41,28 @@ void* counted(std::size_t n) {
 } // namespace
 
 void* operator new(std::size_t n) {
-    return counted(n);
+    return countedOrThrow(n);
 }
 void* operator new[](std::size_t n) {
+    return countedOrThrow(n);
+}
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
     return counted(n);
+}
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
+    return counted(n);
+}
+void* operator new(std::size_t n, std::align_val_t a) {
+    return countedOrThrow(n, static_cast<std::size_t>(a));
+}
+void* operator new[](std::size_t n, std::align_val_t a) {
+    return countedOrThrow(n, static_cast<std::size_t>(a));
+}
+void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+    return counted(n, static_cast<std::size_t>(a));
+}
+void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+    return counted(n, static_cast<std::size_t>(a));
 }
 void operator delete(void* p) noexcept {
     std::free(p);
@@ -46,6 +74,30 @@ void operator delete(void* p, std::size_t) noexcept {
     std::free(p);
 }
 void operator delete[](void* p, std::size_t) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, const std::nothrow_t&) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, const std::nothrow_t&) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept {
     std::free(p);
 }
 

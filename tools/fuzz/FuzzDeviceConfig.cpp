@@ -1,0 +1,25 @@
+// libFuzzer target: the device configuration loader. Any input loads or is refused with an
+// InputError; nothing else may escape, crash, hang or leak.
+
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/scenes/InputError.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    try {
+        const auto configs = hapto::parseDeviceConfig(
+            std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json");
+        for (const hapto::DeviceConfig& c : configs) {
+            // What loaded is what the runtime relies on.
+            if (c.name.empty() || !(c.rateHz >= 100.0 && c.rateHz <= 100000.0) ||
+                !(c.transform.scale > 0.0) || !(c.maxForceN >= 0.0)) {
+                __builtin_trap();
+            }
+        }
+    } catch (const hapto::InputError&) {
+    }
+    return 0;
+}
