@@ -1,0 +1,109 @@
+// `hapto run` end to end: the report, recording and replaying, 20 kHz, Ctrl-C, bad input.
+
+#include "TestSupport.h"
+
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <spawn.h>
+#include <thread>
+#include <unistd.h>
+
+using namespace hapto::test;
+using nlohmann::json;
+
+extern char** environ;
+
+TEST_CASE("hapto run writes a report with every field for both default hands") {
+    TempDir dir;
+    const CommandResult r =
+        runHapto("run --duration 0.5 --no-realtime --quiet --report " + (dir / "r.json").string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK_THAT(r.output, Catch::Contains("left") && Catch::Contains("right") &&
+                             Catch::Contains("total: load"));
+    const json j = json::parse(readFile(dir / "r.json"));
+    REQUIRE(j["devices"].size() == 2);
+    for (const json& d : j["devices"]) {
+        CHECK(d["ticks"].get<int>() > 100);
+        CHECK(d["rate_hz"] == 1000.0);
+        CHECK(d["load"]["p50"].get<double>() <= d["load"]["max"].get<double>());
+        CHECK(d["faults"] == 0);
+    }
+    CHECK(j["total"].contains("load_per_core"));
+}
+
+TEST_CASE("a session recorded with --record replays as a device and exports as CSV") {
+    TempDir dir;
+    const CommandResult rec =
+        runHapto("run --duration 0.3 --no-realtime --quiet --record " + (dir / "runs").string());
+    INFO(rec.output);
+    REQUIRE(rec.exitCode == 0);
+    REQUIRE(std::filesystem::exists(dir / "runs/left.trace"));
+    const CommandResult csv = runHapto("trace export " + (dir / "runs/left.trace").string());
+    REQUIRE(csv.exitCode == 0);
+    CHECK(std::count(csv.output.begin(), csv.output.end(), '\n') > 100);
+    writeFile(dir / "replay.json",
+              R"({"format": "hapto-devices", "version": 1, "devices": [)"
+              R"({"name": "again", "kind": "replay", "transform": {"translation": [-0.02, 0, 0]},)"
+              R"( "replay": {"trace": "runs/left.trace"}}]})");
+    const CommandResult again =
+        runHapto("run --duration 0.2 --no-realtime --quiet --devices " +
+                 (dir / "replay.json").string() + " --report " + (dir / "again.json").string());
+    INFO(again.output);
+    REQUIRE(again.exitCode == 0);
+    const json j = json::parse(readFile(dir / "again.json"));
+    CHECK(j["devices"][0]["kind"] == "replay");
+    CHECK(j["devices"][0]["ticks"].get<int>() > 50);
+}
+
+TEST_CASE("hapto run drives devices at 20 kHz") {
+    TempDir dir;
+    const CommandResult r =
+        runHapto("run --rate 20000 --duration 0.3 --no-realtime --quiet --report " +
+                 (dir / "r.json").string());
+    REQUIRE(r.exitCode == 0);
+    const json j = json::parse(readFile(dir / "r.json"));
+    for (const json& d : j["devices"]) {
+        CHECK(d["rate_hz"] == 20000.0);
+        CHECK(d["ticks"].get<int>() > 1000); // 6000 nominal; a busy machine may miss some
+    }
+}
+
+TEST_CASE("Ctrl-C (SIGINT) stops the session cleanly and still writes the report") {
+    TempDir dir;
+    const std::string exe = std::string(HAPTO_BINARY_DIR) + "/tools/hapto";
+    const std::string report = (dir / "r.json").string();
+    const char* argv[] = {exe.c_str(), "run",      "--duration",   "0",    "--no-realtime",
+                          "--quiet",   "--report", report.c_str(), nullptr};
+    pid_t pid = 0;
+    REQUIRE(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, const_cast<char**>(argv), environ) ==
+            0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    REQUIRE(kill(pid, SIGINT) == 0);
+    int status = 0;
+    REQUIRE(waitpid(pid, &status, 0) == pid);
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+    const json j = json::parse(readFile(report));
+    CHECK(j["devices"][0]["ticks"].get<int>() > 0);
+}
+
+TEST_CASE("hapto run refuses bad input with exit code 2 and says where") {
+    TempDir dir;
+    writeFile(dir / "d.json", R"({"format": "hapto-devices", "version": 1, "devices": [)"
+                              R"({"name": "a", "kind": "sim", "transform": {"scale": -1}}]})");
+    CommandResult r = runHapto("run --devices " + (dir / "d.json").string());
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("devices[0].transform.scale"));
+    r = runHapto("run --index octree:0:0.005");
+    CHECK(r.exitCode == 2);
+    r = runHapto("run --rate 50");
+    CHECK(r.exitCode == 2);
+    r = runHapto("run --scene " + (dir / "missing.json").string());
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("missing.json"));
+}
