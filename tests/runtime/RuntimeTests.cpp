@@ -220,3 +220,38 @@ TEST_CASE("servo threads pick up a new snapshot at their next tick") {
     CHECK(rig.runtime->metrics(1).snapshotsSeen.load() >= 1);
     rig.runtime->stop();
 }
+
+TEST_CASE("a publisher flooding snapshot updates never stops or faults a servo thread") {
+    Rig rig(cubeScene(), 3, 2000.0);
+    rig.world.setRestDelay(std::chrono::milliseconds(2)); // re-index often, too
+    rig.runtime->start();
+    const std::uint64_t before = rig.runtime->metrics(0).ticks.load();
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(800);
+    int published = 0;
+    while (std::chrono::steady_clock::now() < until) {
+        // As fast as the control thread can: a move, and now and then an add and a remove.
+        rig.world.moveObject(7, Vec3(0, 1e-6 * (published % 100), 0), Quat(1, 0, 0, 0));
+        if (published % 50 == 0) {
+            rig.world.addObject(makeSphere(1000 + published, Vec3(0.1, 0.1, 0.1), 0.005));
+        }
+        if (published % 50 == 25) {
+            rig.world.removeObject(1000 + published - 25);
+        }
+        rig.runtime->maintain();
+        ++published;
+    }
+    rig.runtime->stop();
+    rig.world.settle();
+    INFO("published " << published);
+    CHECK(published > 1000);
+    const RunReport r = rig.runtime->report();
+    for (const DeviceReport& d : r.devices) {
+        CHECK(d.fault.empty());
+        CHECK(d.snapshotsSeen > 100); // they kept up with the stream
+    }
+    CHECK(rig.runtime->metrics(0).ticks.load() > before + 800); // ~1600 nominal at 2 kHz
+    CHECK(rig.world.retiredCount() == 0);                       // every old snapshot was freed
+    for (auto* d : rig.devices) {
+        CHECK(glm::length(d->lastForce()) == 0.0);
+    }
+}
