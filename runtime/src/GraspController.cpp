@@ -82,9 +82,15 @@ bool GraspController::opposed(const ContactReport& l, const ContactReport& r, Ob
 
 void GraspController::step(double dtS) {
     mTime += dtS;
-    ContactReport l, r;
-    const bool haveL = mRuntime.contact(mLeft, l);
-    const bool haveR = mRuntime.contact(mRight, r);
+    // A read that races a servo thread's write (the writer preempted mid-publish) keeps the
+    // last report: "no fresh news" is not "no contact".
+    ContactReport l = mLastLeft, r = mLastRight;
+    const bool haveL = mRuntime.contact(mLeft, l) || mHaveLeft;
+    const bool haveR = mRuntime.contact(mRight, r) || mHaveRight;
+    mLastLeft = l;
+    mLastRight = r;
+    mHaveLeft = haveL;
+    mHaveRight = haveR;
     ObjectId id = kNoObject;
     double fn = 0.0;
     const bool touching = haveL && haveR && opposed(l, r, id, fn);
@@ -220,20 +226,21 @@ void GraspController::moveTo(const SceneObject& object, Vec3 center, const Quat&
     SceneObject trial = object;
     trial.center = center;
     trial.rotation = rotation;
+    if (blocked(trial) && rotation != object.rotation) {
+        trial.rotation = object.rotation; // a move that only turns into something: translate
+    }
     if (blocked(trial)) {
         // Bisect along the straight path for the farthest pose that is free.
         double lo = 0.0, hi = 1.0;
         for (int i = 0; i < 20; ++i) {
             const double mid = 0.5 * (lo + hi);
             trial.center = glm::mix(object.center, center, mid);
-            trial.rotation = glm::slerp(object.rotation, rotation, mid);
             (blocked(trial) ? hi : lo) = mid;
         }
         if (lo == 0.0) {
             return; // cannot move at all this step
         }
         trial.center = glm::mix(object.center, center, lo);
-        trial.rotation = glm::slerp(object.rotation, rotation, lo);
     }
     mWorld.moveObject(object.id, trial.center, trial.rotation);
 }

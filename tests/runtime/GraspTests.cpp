@@ -33,8 +33,11 @@ ScriptedDevice::Path keyframes(std::vector<std::pair<std::uint64_t, Vec3>> keys)
 }
 
 // The grasp scene's cube (id 0) spans x -0.075..-0.025 at y -0.075. A hand on each side:
-// approach (0.3 s), squeeze 2 mm (about 1.6 N each at 800 N/m) until 0.7 s, lift by `lift`,
-// move by `carry`, move by `lower` (0.5 s each), then open: each hand moves `open` outwards.
+// approach (0.3 s), squeeze 2 mm (about 1.6 N each at 800 N/m) until 1.2 s, lift by `lift`
+// (1 s), move by `carry` (2 s), move by `lower` (1 s), then open: each hand moves `open`
+// outwards (0.3 s). Hand speeds stay at or under 5 cm/s, as in the simulated grasp scripts,
+// so the (non real-time) control thread lagging a few milliseconds behind the servo threads
+// moves the object a fraction of a millimetre behind the hands, well within the squeeze.
 struct Hands {
     ScriptedDevice::Path left, right;
 };
@@ -44,11 +47,11 @@ Hands graspPaths(Vec3 lift, Vec3 carry, Vec3 lower, double open) {
     const auto path = [&](Vec3 from, Vec3 in, double side) {
         return keyframes({{0, from},
                           {300, in},
-                          {700, in},
-                          {1200, in + lift},
-                          {1700, in + lift + carry},
-                          {2200, in + lift + carry + lower},
-                          {2500, in + lift + carry + lower + Vec3(side * open, 0, 0)}});
+                          {1200, in},
+                          {2200, in + lift},
+                          {4200, in + lift + carry},
+                          {5200, in + lift + carry + lower},
+                          {5500, in + lift + carry + lower + Vec3(side * open, 0, 0)}});
     };
     return {path(l0, lIn, -1.0), path(r0, rIn, 1.0)};
 }
@@ -74,6 +77,9 @@ struct GraspRig {
         }
         RuntimeOptions o;
         o.realtime = false;
+        // These tests are about grasping, not timing: under a sanitizer ticks run late, and
+        // the miss limit (tested in RuntimeTests) would zero the squeeze.
+        o.missLimit = 1'000'000;
         runtime = std::make_unique<Runtime>(world, std::move(rds), o);
         grasp = std::make_unique<GraspController>(world, *runtime, 0, 1);
     }
@@ -117,10 +123,10 @@ TEST_CASE("two hands lift, carry and put down the cube; the index then finds it 
     // Lift 5 cm, carry 10 cm along +x, lower 5 cm, then open the hands 3 cm each.
     GraspRig rig(makeGraspScene(),
                  graspPaths(Vec3(0, 0.05, 0), Vec3(0.10, 0, 0), Vec3(0, -0.05, 0), 0.03));
-    rig.run(2800);
+    rig.run(5800);
     CHECK(rig.grasp->graspStarts().size() == 1);
     CHECK(rig.grasp->graspEnds().size() == 1); // let go once, after putting it down
-    CHECK(rig.grasp->graspedSteps() > 1000);
+    CHECK(rig.grasp->graspedSteps() > 2500);
     const Vec3 end = rig.object().center;
     CHECK(end.x == Approx(start.x + 0.10).margin(0.004));
     CHECK(end.y == Approx(start.y).margin(0.004));
@@ -141,15 +147,15 @@ TEST_CASE("two hands lift, carry and put down the cube; the index then finds it 
 TEST_CASE("letting go in mid-air drops the cube onto the floor") {
     // Lift 5 cm, no carry, no lowering, then both hands open 3 cm in mid-air.
     GraspRig rig(makeGraspScene(), graspPaths(Vec3(0, 0.05, 0), Vec3(0), Vec3(0), 0.03));
-    rig.run(2800);
+    rig.run(5800);
     CHECK(rig.grasp->graspStarts().size() == 1);
     CHECK(rig.grasp->graspEnds().size() == 1);
     double top = -1;
     for (const Vec3& p : rig.positions) {
         top = std::max(top, p.y);
     }
-    CHECK(top > -0.075 + 0.04);                                  // it was up there
-    CHECK(rig.object().center.y == Approx(-0.075).margin(1e-3)); // and fell back to the floor
+    CHECK(top > -0.075 + 0.04);                                     // it was up there
+    CHECK(rig.object().aabb().min.y == Approx(-0.10).margin(5e-4)); // fell back to the floor
     CHECK(rig.object().center.x == Approx(-0.05).margin(0.003));
     CHECK(rig.grasp->state() == GraspState::Idle);
 }
@@ -158,7 +164,7 @@ TEST_CASE("a one-handed press never lifts the cube") {
     Hands hands = graspPaths(Vec3(0, 0.05, 0), Vec3(0.10, 0, 0), Vec3(0, -0.05, 0), 0.03);
     hands.right = [](std::uint64_t) { return Vec3(0.06, 0.05, 0.06); }; // far away, in free space
     GraspRig rig(makeGraspScene(), hands);
-    rig.run(2800);
+    rig.run(5800);
     CHECK(rig.grasp->graspStarts().empty());
     CHECK(rig.grasp->graspedSteps() == 0);
     CHECK(rig.object().center == Vec3(-0.05, -0.075, 0));
@@ -175,7 +181,7 @@ TEST_CASE("a carried cube never passes through another object: it comes to rest 
     objects.push_back(block);
     GraspRig rig(Scene(base.bounds(), objects),
                  graspPaths(Vec3(0, 0.05, 0), Vec3(0.10, 0, 0), Vec3(0, -0.05, 0), 0.03));
-    rig.run(2800);
+    rig.run(5800);
     CHECK(rig.grasp->graspStarts().size() == 1);
     // Never inside the block (nor the bar it crossed), at any step: test with the cube
     // shrunk by 50 um so resting contact does not count.
@@ -184,7 +190,7 @@ TEST_CASE("a carried cube never passes through another object: it comes to rest 
         CHECK_FALSE(overlapsObbObb(cube, block.obb()));
         CHECK_FALSE(overlapsObbObb(cube, base.object(1).obb()));
     }
-    // Resting on the block's top.
-    CHECK(rig.object().center.y == Approx(-0.07 + 0.025).margin(5e-4));
+    // Resting on the block's top: its lowest point there (it may rest a little tilted).
+    CHECK(rig.object().aabb().min.y == Approx(-0.07).margin(5e-4));
     CHECK(rig.object().center.x == Approx(0.05).margin(0.004));
 }

@@ -31,6 +31,10 @@ void addDeviceCommands(CLI::App& app);
 /// `hapto run`: a multi-device session with load report. [control]
 void addRunCommands(CLI::App& app);
 
+/// `hapto experiment paper1|paper2|devices`: the paper's experiments and load scaling,
+/// written as CSV, JSON, markdown and plots. [control]
+void addExperimentCommands(CLI::App& app);
+
 /// Loads `path`, or the embedded default scene when it is empty. Throws InputError. [control]
 Scene loadSceneOrDefault(const std::string& path);
 

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
     hapto::cli::addBenchCommands(app);
     hapto::cli::addIndexCommands(app);
     hapto::cli::addTraceCommands(app);
+    hapto::cli::addExperimentCommands(app);
 
     try {
         app.parse(argc, argv);

@@ -18,7 +18,8 @@ struct GraspOptions {
     double minOpposition = 0.5;    ///< Contact normals must satisfy n_left . n_right <= -this.
     double holdMargin = 1.0;       ///< Grasp when mu_s (Fn_left + Fn_right) >= margin x m g.
     int graspSteps = 20;           ///< Control steps the grasp condition must hold to grasp.
-    int releaseSteps = 5;          ///< Control steps it must fail to release.
+    int releaseSteps = 50;         ///< Control steps it must fail to release (~50 ms: a
+                                   ///< transient dip in contact does not drop the object).
     double clearanceM = 1e-4;      ///< Gap kept to other objects while carried or falling (m).
 };
 
@@ -89,6 +90,8 @@ private:
     std::uint64_t mGraspedSteps = 0;
     std::vector<double> mStarts, mEnds;
     std::vector<GraspPathPoint> mPath;
+    ContactReport mLastLeft, mLastRight; // the newest reports read
+    bool mHaveLeft = false, mHaveRight = false;
 };
 
 /// Mass of an object at a density (kg). [any thread]

@@ -1,0 +1,263 @@
+// `hapto experiment paper1|paper2|devices`: the paper's experiments and load scaling, measured
+// by the real Runtime, written as CSV, JSON, markdown and gnuplot figures.
+
+#include "Commands.h"
+
+#include "experiments/ExperimentSupport.h"
+#include "experiments/Experiments.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+namespace hapto::cli {
+namespace {
+
+using namespace hapto::experiments;
+
+/// The options every experiment has; `quick` values apply unless the option was given.
+struct CommonOptions {
+    CLI::Option* out = nullptr;
+    CLI::Option* duration = nullptr;
+    CLI::Option* repeats = nullptr;
+    bool noRealtime = false;
+};
+
+void addCommon(CLI::App* cmd, CommonArgs& a, CommonOptions& o, const std::string& name) {
+    a.out = "out/" + name;
+    o.out = cmd->add_option("--out", a.out,
+                            "Folder for the CSV, JSON, markdown and plot files (created)")
+                ->capture_default_str();
+    cmd->add_flag("--quick", a.quick,
+                  "A run of seconds: small sizes, 0.15 s per run, one repeat (options given "
+                  "explicitly still apply)");
+    o.duration = cmd->add_option("--duration", a.durationS,
+                                 "Timed servo run per measurement (s); --quick: 0.15")
+                     ->capture_default_str()
+                     ->check(CLI::Range(0.02, 60.0));
+    o.repeats = cmd->add_option("--repeats", a.repeats,
+                                "Runs per measurement; every figure is the median over them; "
+                                "--quick: 1")
+                    ->capture_default_str()
+                    ->check(CLI::Range(1, 99));
+    cmd->add_flag("--no-realtime", o.noRealtime,
+                  "Do not ask for SCHED_FIFO and CPU pinning (default: ask; the runtime falls "
+                  "back to normal scheduling when refused and says so)");
+}
+
+void applyQuick(CommonArgs& a, const CommonOptions& o) {
+    a.realtime = !o.noRealtime;
+    if (a.quick) {
+        if (o.duration->count() == 0) {
+            a.durationS = 0.15;
+        }
+        if (o.repeats->count() == 0) {
+            a.repeats = 1;
+        }
+    }
+}
+
+CLI::Option* addVerdict(CLI::App* cmd, std::string& verdict) {
+    return cmd
+        ->add_option("--verdict", verdict,
+                     "What stops a renderer's growth and names the first unstable size: design "
+                     "(DESIGN.md: p99.9 load < 100 % and <= 0.1 % deadlines missed) or load "
+                     "(p99.9 load < 100 % only, for machines whose wake-ups are late by "
+                     "themselves); both verdicts are reported either way")
+        ->capture_default_str();
+}
+
+} // namespace
+
+void addExperimentCommands(CLI::App& app) {
+    CLI::App* exp = app.add_subcommand(
+        "experiment",
+        "Run the paper's experiments and the load-scaling experiment through the real runtime "
+        "(servo threads, absolute deadlines); write CSV, JSON, markdown tables and gnuplot "
+        "figures");
+    exp->require_subcommand(1);
+
+    // paper1
+    {
+        auto a = std::make_shared<Paper1Args>();
+        auto o = std::make_shared<CommonOptions>();
+        auto rates = std::make_shared<std::string>("1000");
+        auto* cmd = exp->add_subcommand(
+            "paper1",
+            "Experiment 1: K x K x K lattices of 5 cm cubes (1 cm gaps) for growing K; renderers "
+            "standard (brute), grid 2x2x2, grid 5x5x5, octree M=2 and M=5 (min leaf 5 mm); hands "
+            "in the no touch / touch / sliding conditions (scripts free, touch, slide) just "
+            "outside the lattice's +z face. A renderer stops growing after its first unstable "
+            "K. Prints the analogue of the paper's Table 1 and the max stable objects");
+        addCommon(cmd, a->common, *o, "paper1");
+        auto verdict = std::make_shared<std::string>("design");
+        addVerdict(cmd, *verdict);
+        cmd->add_option("--rate", *rates,
+                        "Servo rate(s) (Hz, 100..100000), comma-separated for several, e.g. "
+                        "1000,10000")
+            ->capture_default_str();
+        auto* maxK = cmd->add_option("--max-per-side", a->maxPerSide,
+                                     "Largest K (cubes per lattice side; K^3 objects); sizes "
+                                     "2,3,4,5,6,8,10,13,16,20,25,32,40,50,64,80,100,... up to "
+                                     "it; --quick: 4")
+                         ->capture_default_str()
+                         ->check(CLI::Range(2, 400));
+        cmd->add_option("--max-index-mb", a->maxIndexMb,
+                        "Skip an index whose memory, extrapolated from the previous size, "
+                        "would pass this (MB)")
+            ->capture_default_str()
+            ->check(CLI::PositiveNumber);
+        cmd->callback([a, o, rates, maxK, verdict] {
+            applyQuick(a->common, *o);
+            a->verdict = parseVerdict(*verdict, "--verdict");
+            if (a->common.quick && maxK->count() == 0) {
+                a->maxPerSide = 4;
+            }
+            a->ratesHz = parseRates(*rates, "--rate");
+            const int rc = runPaper1(*a);
+            if (rc != 0) {
+                std::exit(rc);
+            }
+        });
+    }
+    // paper2
+    {
+        auto a = std::make_shared<Paper2Args>();
+        auto o = std::make_shared<CommonOptions>();
+        auto rates = std::make_shared<std::string>("1000");
+        auto counts = std::make_shared<std::string>("10,20,50,100,200,500");
+        auto decades = std::make_shared<bool>(false);
+        auto* cmd = exp->add_subcommand(
+            "paper2",
+            "Experiment 2: random scenes of 5 cm cubes in a 25 cm cube, several seeds per "
+            "count, clear around the centre where the hand starts; renderers standard, grid "
+            "2x2x2, grid 5x5x5 and octree M=2; conditions no touch / touch / sliding. Prints "
+            "the analogue of the paper's Table 2 (200-object scenes) and the max stable objects");
+        addCommon(cmd, a->common, *o, "paper2");
+        auto verdict = std::make_shared<std::string>("design");
+        addVerdict(cmd, *verdict);
+        auto* countsOpt = cmd->add_option("--counts", *counts,
+                                          "Objects per scene, comma-separated; --quick: 10,20,50")
+                              ->capture_default_str();
+        cmd->add_flag("--decades", *decades,
+                      "Also 1000, 10000, 100000 and 1000000 objects (a renderer still stops "
+                      "after its first unstable count)");
+        auto* seeds =
+            cmd->add_option("--seeds", a->seeds, "Scenes per count (seeds 1..N); --quick: 2")
+                ->capture_default_str()
+                ->check(CLI::Range(1, 100));
+        cmd->add_option("--rate", *rates,
+                        "Servo rate(s) (Hz, 100..100000), comma-separated for several")
+            ->capture_default_str();
+        cmd->add_option("--keep-clear", a->keepClearM,
+                        "No object within this distance of the centre, where the hand starts (m)")
+            ->capture_default_str()
+            ->check(CLI::Range(0.005, 0.1));
+        cmd->add_option("--max-index-mb", a->maxIndexMb,
+                        "Skip an index whose memory, extrapolated from the previous count, "
+                        "would pass this (MB)")
+            ->capture_default_str()
+            ->check(CLI::PositiveNumber);
+        cmd->callback([a, o, rates, counts, decades, countsOpt, seeds, verdict] {
+            applyQuick(a->common, *o);
+            a->verdict = parseVerdict(*verdict, "--verdict");
+            if (a->common.quick) {
+                if (countsOpt->count() == 0) {
+                    *counts = "10,20,50";
+                }
+                if (seeds->count() == 0) {
+                    a->seeds = 2;
+                }
+            }
+            a->counts = parseCounts(*counts, "--counts");
+            if (*decades) {
+                for (const std::size_t n : {1000, 10000, 100000, 1000000}) {
+                    a->counts.push_back(n);
+                }
+            }
+            a->ratesHz = parseRates(*rates, "--rate");
+            const int rc = runPaper2(*a);
+            if (rc != 0) {
+                std::exit(rc);
+            }
+        });
+    }
+    // devices
+    {
+        auto a = std::make_shared<DevicesArgs>();
+        auto o = std::make_shared<CommonOptions>();
+        auto rates = std::make_shared<std::string>("1000,4000");
+        auto cursorObjects = std::make_shared<std::string>("100,1000,10000,100000,1000000");
+        auto walkSteps = std::make_shared<std::string>("200000");
+        auto noCursor = std::make_shared<bool>(false);
+        auto* cmd = exp->add_subcommand(
+            "devices",
+            "Load scaling: 1, 2, 4, ... simulated hands (distinct seeds, clear start points) "
+            "over one scene and one World, one servo thread each, at several rates: per-device "
+            "and total load, misses, verdict. Then the three octree cursor strategies (root, "
+            "climb, neighbour links) along one hand-speed walk over K^3 lattices: mean steps "
+            "per locate against N (the paper's section 2.2.4)");
+        addCommon(cmd, a->common, *o, "devices");
+        auto* maxDevices = cmd->add_option("--max-devices", a->maxDevices,
+                                           "Largest device count; counts 1, 2, 4, ... up to it; "
+                                           "--quick: 2")
+                               ->capture_default_str()
+                               ->check(CLI::Range(1, 60));
+        auto* ratesOpt = cmd->add_option("--rates", *rates,
+                                         "Servo rates (Hz, 100..100000), comma-separated; "
+                                         "--quick: 1000")
+                             ->capture_default_str();
+        cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
+        cmd->add_option("--index", a->index,
+                        "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb; "
+                        "the cursor part uses it when it is an octree, else octree:2:0.005")
+            ->capture_default_str();
+        cmd->add_option("--script", a->script,
+                        "Hand script: walk (random hops through the scene) or slide (slide on "
+                        "the nearest surface)")
+            ->capture_default_str();
+        auto* objectsOpt = cmd->add_option("--cursor-objects", *cursorObjects,
+                                           "Cursor part: N values (objects; a K^3 lattice with "
+                                           "K = round(cbrt N)), comma-separated; --quick: "
+                                           "100,1000")
+                               ->capture_default_str();
+        auto* stepsOpt = cmd->add_option("--walk-steps", *walkSteps,
+                                         "Cursor part: walk length (1 ms steps, <= 0.5 mm "
+                                         "each), e.g. 2e5; --quick: 20000")
+                             ->capture_default_str();
+        cmd->add_flag("--no-cursor", *noCursor, "Skip the cursor part");
+        cmd->callback([a, o, rates, cursorObjects, walkSteps, noCursor, maxDevices, ratesOpt,
+                       objectsOpt, stepsOpt] {
+            applyQuick(a->common, *o);
+            if (a->common.quick) {
+                if (maxDevices->count() == 0) {
+                    a->maxDevices = 2;
+                }
+                if (ratesOpt->count() == 0) {
+                    *rates = "1000";
+                }
+                if (objectsOpt->count() == 0) {
+                    *cursorObjects = "100,1000";
+                }
+                if (stepsOpt->count() == 0) {
+                    *walkSteps = "20000";
+                }
+            }
+            a->ratesHz = parseRates(*rates, "--rates");
+            a->cursorObjects = parseCounts(*cursorObjects, "--cursor-objects");
+            a->walkSteps = parseCount(*walkSteps, "--walk-steps");
+            if (a->walkSteps == 0) {
+                throw InputError("--walk-steps: expected at least 1 step, got 0");
+            }
+            a->cursor = !*noCursor;
+            const int rc = runDevices(*a);
+            if (rc != 0) {
+                std::exit(rc);
+            }
+        });
+    }
+}
+
+} // namespace hapto::cli

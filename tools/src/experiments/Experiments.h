@@ -1,0 +1,61 @@
+#pragma once
+/// The three `hapto experiment` runs, as functions of their parsed arguments.
+
+#include "ExperimentSupport.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hapto::experiments {
+
+/// Settings every experiment takes.
+struct CommonArgs {
+    std::string out;        ///< Output folder.
+    bool quick = false;     ///< Seconds, small sizes (explicit options still win).
+    double durationS = 0.5; ///< Timed run per repeat (s).
+    int repeats = 3;        ///< Runs per cell; medians are reported.
+    bool realtime = true;   ///< Ask for SCHED_FIFO and pinning.
+};
+
+/// `hapto experiment paper1`: the paper's experiment 1 (lattices of K^3 cubes).
+struct Paper1Args {
+    CommonArgs common;
+    std::vector<double> ratesHz{1000.0}; ///< Servo rates (Hz).
+    int maxPerSide = 100;                ///< Largest K.
+    double maxIndexMb = 3000.0;          ///< Largest index the sweep builds (MB).
+    Verdict verdict = Verdict::Design;   ///< What stops a renderer's growth.
+};
+/// Runs experiment 1; returns the process exit code. [control]
+int runPaper1(const Paper1Args& args);
+
+/// `hapto experiment paper2`: the paper's experiment 2 (random scenes, several seeds).
+struct Paper2Args {
+    CommonArgs common;
+    std::vector<std::size_t> counts{10, 20, 50, 100, 200, 500}; ///< Objects per scene.
+    int seeds = 5;                       ///< Scenes per count (seeds 1..seeds).
+    std::vector<double> ratesHz{1000.0}; ///< Servo rates (Hz).
+    double keepClearM = 0.03;            ///< Clear radius around the start at the centre (m).
+    double maxIndexMb = 3000.0;          ///< Largest index the sweep builds (MB).
+    Verdict verdict = Verdict::Design;   ///< What stops a renderer's growth.
+};
+/// Runs experiment 2; returns the process exit code. [control]
+int runPaper2(const Paper2Args& args);
+
+/// `hapto experiment devices`: load against device count, and cursor steps against N.
+struct DevicesArgs {
+    CommonArgs common;
+    int maxDevices = 8;                          ///< Largest device count (1, 2, 4, ... up to it).
+    std::vector<double> ratesHz{1000.0, 4000.0}; ///< Servo rates (Hz).
+    std::string scene;                           ///< Scene file; empty = the default scene.
+    std::string index = "octree:2:0.005";        ///< Index spec.
+    std::string script = "walk";                 ///< Hand script: walk or slide.
+    std::vector<std::size_t> cursorObjects{100, 1000, 10000, 100000, 1000000}; ///< N values.
+    std::size_t walkSteps = 200000; ///< Cursor walk length (1 ms steps).
+    bool cursor = true;             ///< Run the cursor part.
+};
+/// Runs the device-scaling and cursor experiments; returns the process exit code. [control]
+int runDevices(const DevicesArgs& args);
+
+} // namespace hapto::experiments

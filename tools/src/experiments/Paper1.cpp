@@ -1,0 +1,160 @@
+// `hapto experiment paper1`: the paper's experiment 1, lattices of K x K x K cubes.
+
+#include "Experiments.h"
+#include "Sweep.h"
+
+#include "hapto/scenes/Generators.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+namespace hapto::experiments {
+namespace {
+
+constexpr double kCubeM = 0.05;     // the paper's e-Touch boxes
+constexpr double kGapM = 0.01;      // free space between neighbouring cubes
+constexpr double kPadM = 0.04;      // partitioned space beyond the lattice, on every side
+constexpr double kStandOffM = 0.02; // start this far outside the lattice's +z face
+
+/// The sizes: a geometric-ish sweep of K up to `maxPerSide` (which is always included).
+std::vector<int> perSideSweep(int maxPerSide) {
+    std::vector<int> ks;
+    for (const int k :
+         {2, 3, 4, 5, 6, 8, 10, 13, 16, 20, 25, 32, 40, 50, 64, 80, 100, 128, 160, 200, 256}) {
+        if (k <= maxPerSide) {
+            ks.push_back(k);
+        }
+    }
+    if (ks.empty() || ks.back() != maxPerSide) {
+        ks.push_back(maxPerSide);
+    }
+    return ks;
+}
+
+/// K^3 cubes of 5 cm with 1 cm gaps, centred on the origin; the partitioned space is the
+/// lattice plus 4 cm on every side ("slightly larger than the object grid"), so the hand
+/// has room outside the lattice's faces.
+Scene latticeScene(int k) {
+    LatticeOptions o;
+    o.perSide = k;
+    o.cubeSize = kCubeM;
+    o.gap = kGapM;
+    Scene lattice = makeLatticeScene(o);
+    const double half = 0.5 * (k * kCubeM + (k - 1) * kGapM) + kPadM;
+    std::vector<SceneObject> objects(lattice.objects().begin(), lattice.objects().end());
+    return Scene(Aabb{Vec3(-half), Vec3(half)}, std::move(objects));
+}
+
+/// In front of the middle of the +z face: 2 cm off the face of the cube nearest the face's
+/// centre, the stand-off the touch and slide scripts approach from. The free walk moves in the
+/// 4 cm slab between that face and the partitioned space's boundary.
+Vec3 latticeStart(int k) {
+    const double pitch = kCubeM + kGapM;
+    const double c = (k / 2 - 0.5 * (k - 1)) * pitch; // the centre cube's (or next one's) x, y
+    const double face = 0.5 * (k * kCubeM + (k - 1) * kGapM);
+    return Vec3(c, c, face + kStandOffM);
+}
+
+} // namespace
+
+int runPaper1(const Paper1Args& args) {
+    const std::filesystem::path out = prepareOutDir(args.common.out);
+    const std::vector<SweepRenderer> renderers = {
+        {"standard", IndexSpec::brute(), "27 (64 unstable)"},
+        {"grid 2x2x2", IndexSpec::grid(2), "216"},
+        {"grid 5x5x5", IndexSpec::grid(5), "1728"},
+        {"octree M=2", IndexSpec::octree(2, 0.005), ">= 8000 (stopped; load < 40 %)"},
+        {"octree M=5", IndexSpec::octree(5, 0.005), ">= 8000 (stopped; load < 40 %)"},
+    };
+    std::vector<SweepStep> steps;
+    for (const int k : perSideSweep(args.maxPerSide)) {
+        SweepStep step;
+        step.objects = static_cast<std::size_t>(k) * k * k;
+        step.size = k;
+        step.scenes.push_back({0, [k] { return latticeScene(k); },
+                               [k](const Scene&, Condition) { return latticeStart(k); }});
+        steps.push_back(std::move(step));
+    }
+    SweepOptions options;
+    options.experiment = "paper1";
+    options.ratesHz = args.ratesHz;
+    options.servo.durationS = args.common.durationS;
+    options.servo.repeats = args.common.repeats;
+    options.servo.realtime = args.common.realtime;
+    options.maxIndexMb = args.maxIndexMb;
+    options.verdict = args.verdict;
+
+    Progress progress("paper1", renderers.size() * args.ratesHz.size() * steps.size() * 3);
+    const std::vector<SweepRow> rows = runSweep(renderers, steps, options, progress);
+
+    // Files.
+    writeSweepCsv(out / "paper1.csv", rows, "per_side");
+    Json j;
+    j["experiment"] = "paper1";
+    j["machine"] = machineJson();
+    j["options"] = {{"rates_hz", args.ratesHz},
+                    {"max_per_side", args.maxPerSide},
+                    {"duration_s", args.common.durationS},
+                    {"repeats", args.common.repeats},
+                    {"realtime_requested", args.common.realtime},
+                    {"quick", args.common.quick},
+                    {"cube_m", kCubeM},
+                    {"gap_m", kGapM},
+                    {"pad_m", kPadM},
+                    {"max_index_mb", args.maxIndexMb},
+                    {"verdict", verdictName(args.verdict)}};
+    const Json body = sweepJson(renderers, args.ratesHz, rows, args.verdict, "per_side");
+    for (const char* key : {"verdict", "rows", "limits", "limits_by_verdict"}) {
+        j[key] = body[key];
+    }
+    writeText(out / "paper1.json", j.dump(2) + "\n");
+    const auto plots = plotSweep(out, "paper1", renderers, args.ratesHz, rows, progress);
+
+    // Tables.
+    std::string md = "## Experiment 1: K x K x K lattices of 5 cm cubes\n\n"
+                     "Load = wake-up to force written, % of the servo period: p50 / p99.9 / max,"
+                     " median of " +
+                     std::to_string(args.common.repeats) + " run(s) of " +
+                     fmt(args.common.durationS, 2) +
+                     " s. UNSTABLE: p99.9 >= 100 % or > 0.1 % deadlines missed.\n";
+    md += "\n" + platformNote(rows, args.verdict);
+    for (const double rate : args.ratesHz) {
+        for (const SweepRenderer& r : renderers) {
+            std::vector<std::vector<std::string>> table;
+            for (const SweepStep& step : steps) {
+                std::vector<std::string> line{std::to_string(step.objects),
+                                              std::to_string(step.size)};
+                bool any = false;
+                for (const Condition c : kConditions) {
+                    std::string cell = "-";
+                    for (const SweepRow& row : rows) {
+                        if (row.renderer == r.name && row.rateHz == rate && row.size == step.size &&
+                            row.condition == c) {
+                            cell = loadCell(row);
+                            any = true;
+                        }
+                    }
+                    line.push_back(cell);
+                }
+                if (any) {
+                    table.push_back(line);
+                }
+            }
+            md += "\n### " + r.name + " (" + r.spec.toString() + "), " + rateText(rate) + "\n\n";
+            md += markdownTable({"# objects", "K", "no touch", "touch", "sliding"}, table);
+        }
+    }
+    md += "\n### Max stable objects per renderer\n\n" +
+          limitsTable(renderers, args.ratesHz, rows, args.verdict, "K");
+    md += "\nFiles: " + (out / "paper1.csv").string() + ", " + (out / "paper1.json").string();
+    for (const auto& p : plots) {
+        md += ", " + p.string();
+    }
+    md += "\n";
+    writeText(out / "paper1.md", md);
+    std::cout << md << std::flush;
+    return 0;
+}
+
+} // namespace hapto::experiments

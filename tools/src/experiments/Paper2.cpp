@@ -1,0 +1,198 @@
+// `hapto experiment paper2`: the paper's experiment 2, random scenes of 5 cm cubes.
+
+#include "Experiments.h"
+#include "Sweep.h"
+
+#include "hapto/scenes/Generators.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+namespace hapto::experiments {
+namespace {
+
+constexpr double kWorkspaceM = 0.25; // the paper's 25 cm work cube
+constexpr double kCubeM = 0.05;      // 5 cm cubes
+
+const char* kTable2Grid = "grid 5x5x5";
+const char* kTable2Octree = "octree M=2";
+constexpr std::size_t kTable2Count = 200;
+
+std::string p999Cell(const SweepRow* row) {
+    if (!row) {
+        return "-";
+    }
+    if (row->skipped) {
+        return "skipped";
+    }
+    std::string cell = fmt(row->median.p999Pct, row->median.p999Pct < 10 ? 2 : 1) + "%";
+    if (!row->stable()) {
+        cell += " UNSTABLE";
+    }
+    return cell;
+}
+
+} // namespace
+
+int runPaper2(const Paper2Args& args) {
+    const std::filesystem::path out = prepareOutDir(args.common.out);
+    const std::vector<SweepRenderer> renderers = {
+        {"standard", IndexSpec::brute(), "20 (50 unstable)"},
+        {"grid 2x2x2", IndexSpec::grid(2), "100 (unstable when sliding)"},
+        {"grid 5x5x5", IndexSpec::grid(5), "200"},
+        {"octree M=2", IndexSpec::octree(2, 0.005), "200 (and some 500-object scenes)"},
+    };
+    std::vector<std::size_t> counts = args.counts;
+    std::sort(counts.begin(), counts.end());
+    counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
+    std::vector<SweepStep> steps;
+    const double keepClear = args.keepClearM;
+    for (const std::size_t n : counts) {
+        SweepStep step;
+        step.objects = n;
+        step.size = static_cast<int>(n);
+        if (n == kTable2Count) {
+            step.mustRun = {kTable2Grid, kTable2Octree};
+        }
+        for (int s = 1; s <= args.seeds; ++s) {
+            const auto seed = static_cast<std::uint64_t>(s);
+            step.scenes.push_back({seed,
+                                   [n, seed, keepClear] {
+                                       RandomOptions o;
+                                       o.count = n;
+                                       o.seed = seed;
+                                       o.workspace = kWorkspaceM;
+                                       o.cubeSize = kCubeM;
+                                       o.keepClear = keepClear;
+                                       return makeRandomScene(o);
+                                   },
+                                   [](const Scene&, Condition) { return Vec3(0.0); }});
+        }
+        steps.push_back(std::move(step));
+    }
+    SweepOptions options;
+    options.experiment = "paper2";
+    options.ratesHz = args.ratesHz;
+    options.servo.durationS = args.common.durationS;
+    options.servo.repeats = args.common.repeats;
+    options.servo.realtime = args.common.realtime;
+    options.maxIndexMb = args.maxIndexMb;
+    options.verdict = args.verdict;
+
+    Progress progress("paper2", renderers.size() * args.ratesHz.size() * counts.size() *
+                                    static_cast<std::size_t>(args.seeds) * 3);
+    const std::vector<SweepRow> rows = runSweep(renderers, steps, options, progress);
+
+    writeSweepCsv(out / "paper2.csv", rows, "count");
+    Json j;
+    j["experiment"] = "paper2";
+    j["machine"] = machineJson();
+    j["options"] = {{"rates_hz", args.ratesHz},
+                    {"counts", counts},
+                    {"seeds", args.seeds},
+                    {"duration_s", args.common.durationS},
+                    {"repeats", args.common.repeats},
+                    {"realtime_requested", args.common.realtime},
+                    {"quick", args.common.quick},
+                    {"workspace_m", kWorkspaceM},
+                    {"cube_m", kCubeM},
+                    {"keep_clear_m", keepClear},
+                    {"max_index_mb", args.maxIndexMb},
+                    {"verdict", verdictName(args.verdict)}};
+    const Json body = sweepJson(renderers, args.ratesHz, rows, args.verdict, "count");
+    for (const char* key : {"verdict", "rows", "limits", "limits_by_verdict"}) {
+        j[key] = body[key];
+    }
+    writeText(out / "paper2.json", j.dump(2) + "\n");
+    const auto plots = plotSweep(out, "paper2", renderers, args.ratesHz, rows, progress);
+
+    const auto find = [&](const std::string& renderer, double rate, std::size_t count,
+                          std::uint64_t seed, Condition c) -> const SweepRow* {
+        for (const SweepRow& row : rows) {
+            if (row.renderer == renderer && row.rateHz == rate && row.objects == count &&
+                row.seed == seed && row.condition == c) {
+                return &row;
+            }
+        }
+        return nullptr;
+    };
+
+    std::string md = "## Experiment 2: random scenes of 5 cm cubes in a 25 cm cube\n\n"
+                     "Load = wake-up to force written, % of the servo period; median of " +
+                     std::to_string(args.common.repeats) + " run(s) of " +
+                     fmt(args.common.durationS, 2) +
+                     " s per scene. UNSTABLE: p99.9 >= 100 % or > 0.1 % deadlines missed.\n";
+    md += "\n" + platformNote(rows, args.verdict);
+    for (const double rate : args.ratesHz) {
+        // Table 2: the 200-object scenes, grid 5x5x5 and octree, p99.9 load.
+        std::vector<std::vector<std::string>> t2;
+        for (int s = 1; s <= args.seeds; ++s) {
+            std::vector<std::string> line{std::to_string(s)};
+            for (const char* r : {kTable2Grid, kTable2Octree}) {
+                for (const Condition c : kConditions) {
+                    line.push_back(
+                        p999Cell(find(r, rate, kTable2Count, static_cast<std::uint64_t>(s), c)));
+                }
+            }
+            t2.push_back(line);
+        }
+        if (std::find(counts.begin(), counts.end(), kTable2Count) != counts.end()) {
+            md += "\n### Table 2 analogue: " + std::to_string(kTable2Count) +
+                  "-object scenes, p99.9 load, " + rateText(rate) + "\n\n";
+            md += markdownTable({"scene (seed)", "grid no touch", "grid touch", "grid sliding",
+                                 "octree no touch", "octree touch", "octree sliding"},
+                                t2);
+        }
+        // Per renderer: median over scenes of p99.9, and how many scenes were stable.
+        for (const SweepRenderer& r : renderers) {
+            std::vector<std::vector<std::string>> table;
+            for (const std::size_t n : counts) {
+                std::vector<std::string> line{std::to_string(n)};
+                bool any = false;
+                for (const Condition c : kConditions) {
+                    std::vector<double> p999;
+                    int stable = 0, measured = 0;
+                    for (int s = 1; s <= args.seeds; ++s) {
+                        if (const SweepRow* row =
+                                find(r.name, rate, n, static_cast<std::uint64_t>(s), c)) {
+                            ++measured;
+                            stable += row->stable() ? 1 : 0;
+                            if (!row->skipped) {
+                                p999.push_back(row->median.p999Pct);
+                            }
+                        }
+                    }
+                    if (measured == 0) {
+                        line.push_back("-");
+                        continue;
+                    }
+                    any = true;
+                    const double m = median(p999);
+                    line.push_back(
+                        (p999.empty() ? std::string("skipped") : fmt(m, m < 10 ? 2 : 1) + "%") +
+                        " (" + std::to_string(stable) + "/" + std::to_string(measured) +
+                        " stable)");
+                }
+                if (any) {
+                    table.push_back(line);
+                }
+            }
+            md += "\n### " + r.name + " (" + r.spec.toString() + "), " + rateText(rate) +
+                  ": median p99.9 load over scenes\n\n";
+            md += markdownTable({"# objects", "no touch", "touch", "sliding"}, table);
+        }
+    }
+    md += "\n### Max stable objects per renderer (every scene stable)\n\n" +
+          limitsTable(renderers, args.ratesHz, rows, args.verdict, "count");
+    md += "\nFiles: " + (out / "paper2.csv").string() + ", " + (out / "paper2.json").string();
+    for (const auto& p : plots) {
+        md += ", " + p.string();
+    }
+    md += "\n";
+    writeText(out / "paper2.md", md);
+    std::cout << md << std::flush;
+    return 0;
+}
+
+} // namespace hapto::experiments

@@ -1,0 +1,50 @@
+#pragma once
+/// Line plots through gnuplot (PNG via pngcairo and SVG), from generated scripts.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace hapto::experiments {
+
+/// One line of a panel: (x, y) points in the order drawn.
+struct PlotSeries {
+    std::string title;                             ///< Legend text.
+    std::vector<std::pair<double, double>> points; ///< (x, y) in the panel's units.
+};
+
+/// One set of axes.
+struct PlotPanel {
+    std::string title;               ///< Above the panel.
+    std::string xLabel, yLabel;      ///< Axis labels, with units.
+    bool logX = false, logY = false; ///< Log scales (non-positive values are dropped).
+    std::vector<PlotSeries> series;  ///< The lines.
+    std::optional<double> limitY;    ///< A dashed horizontal line (e.g. 100 % load).
+    std::string limitTitle;          ///< Its legend text.
+};
+
+/// A figure: panels side by side.
+struct PlotSpec {
+    std::string name;  ///< File stem: NAME.gp, NAME.png, NAME.svg.
+    std::string title; ///< Figure title.
+    std::vector<PlotPanel> panels;
+    int panelWidthPx = 520; ///< Width of one panel (px).
+    int heightPx = 420;     ///< Height (px).
+};
+
+/// What drawPlot made.
+struct PlotResult {
+    std::vector<std::filesystem::path> files; ///< The PNG and SVG written (empty on failure).
+    std::string problem; ///< Why nothing was drawn ("gnuplot not found", ...), else empty.
+};
+
+/// True when a `gnuplot` executable is on PATH. [control]
+bool gnuplotAvailable();
+
+/// Writes DIR/NAME.gp (data inline) and runs gnuplot on it to make DIR/NAME.png and
+/// DIR/NAME.svg. Never throws for a missing or failing gnuplot: says so in `problem`. [control]
+PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec);
+
+} // namespace hapto::experiments

@@ -1,0 +1,564 @@
+// The growing-scene sweep behind `hapto experiment paper1` and `paper2`.
+
+#include "Sweep.h"
+
+#include "Plot.h"
+
+#include "hapto/runtime/World.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+namespace hapto::experiments {
+namespace {
+
+/// Objects the script plans against: those within this distance of the start (m). The free
+/// walk stays within 8 cm of its start, touch and slide use the nearest surface.
+constexpr double kPlanRadiusM = 0.15;
+
+/// Probe ticks per (renderer, rate, scene).
+constexpr int kProbeTicks = 8;
+
+struct Key {
+    std::string renderer;
+    double rateHz;
+    bool operator<(const Key& o) const {
+        return renderer != o.renderer ? renderer < o.renderer : rateHz < o.rateHz;
+    }
+};
+
+} // namespace
+
+std::string rateText(double rateHz) {
+    char text[32];
+    if (rateHz >= 1000.0) {
+        std::snprintf(text, sizeof text, "%g kHz", rateHz / 1000.0);
+    } else {
+        std::snprintf(text, sizeof text, "%g Hz", rateHz);
+    }
+    return text;
+}
+
+std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
+                               const std::vector<SweepStep>& steps, const SweepOptions& options,
+                               Progress& progress) {
+    std::vector<SweepRow> rows;
+    std::map<Key, bool> active;
+    for (const SweepRenderer& r : renderers) {
+        for (const double rate : options.ratesHz) {
+            active[{r.name, rate}] = true;
+        }
+    }
+    // Index memory per object at the previous size, to extrapolate.
+    std::map<std::string, double> bytesPerObject;
+    const std::size_t perScene = std::size(kConditions);
+    for (const SweepStep& step : steps) {
+        const auto needed = [&](const SweepRenderer& r, double rate) {
+            return active[{r.name, rate}] || std::find(step.mustRun.begin(), step.mustRun.end(),
+                                                       r.name) != step.mustRun.end();
+        };
+        bool any = false;
+        for (const SweepRenderer& r : renderers) {
+            for (const double rate : options.ratesHz) {
+                if (needed(r, rate)) {
+                    any = true;
+                } else {
+                    progress.advance(step.scenes.size() * perScene, "");
+                }
+            }
+        }
+        if (!any) {
+            continue;
+        }
+        std::set<Key> unstableHere;
+        for (const SweepScene& sc : step.scenes) {
+            progress.show("generating " + std::to_string(step.objects) + " objects");
+            const Scene scene = sc.make();
+            std::vector<Vec3> starts;
+            std::vector<Scene> planScenes;
+            for (const Condition c : kConditions) {
+                starts.push_back(sc.start(scene, c));
+                requireClear(scene, starts.back(), 0.0, options.experiment + " start");
+                const Vec3 r(kPlanRadiusM);
+                planScenes.push_back(sceneNear(scene, {starts.back() - r, starts.back() + r}));
+            }
+            for (const SweepRenderer& r : renderers) {
+                std::vector<double> rates;
+                for (const double rate : options.ratesHz) {
+                    if (needed(r, rate)) {
+                        rates.push_back(rate);
+                    }
+                }
+                if (rates.empty()) {
+                    continue;
+                }
+                SweepRow base;
+                base.renderer = r.name;
+                base.index = r.spec.toString();
+                base.size = step.size;
+                base.objects = scene.size();
+                base.seed = sc.seed;
+                const auto skipAll = [&](const std::string& note) {
+                    for (const double rate : rates) {
+                        for (const Condition c : kConditions) {
+                            SweepRow row = base;
+                            row.rateHz = rate;
+                            row.condition = c;
+                            row.skipped = true;
+                            row.note = note;
+                            rows.push_back(row);
+                            unstableHere.insert({r.name, rate});
+                        }
+                        progress.advance(perScene, r.name);
+                    }
+                };
+                // Memory guard, from the previous size of this renderer.
+                if (const auto it = bytesPerObject.find(r.name); it != bytesPerObject.end()) {
+                    const double mb = it->second * static_cast<double>(scene.size()) / 1e6;
+                    if (mb > options.maxIndexMb) {
+                        skipAll("index would take about " + fmt(mb, 0) +
+                                " MB (extrapolated), over --max-index-mb");
+                        continue;
+                    }
+                }
+                progress.show("building " + base.index + " over " + std::to_string(scene.size()) +
+                              " objects");
+                std::unique_ptr<World> world;
+                try {
+                    world = std::make_unique<World>(scene, r.spec);
+                } catch (const std::exception& e) {
+                    skipAll(std::string("index build failed: ") + e.what());
+                    continue;
+                }
+                const IndexStats& stats = world->current().index->stats();
+                base.buildS = stats.buildSeconds;
+                base.indexMb = static_cast<double>(stats.bytes) / 1e6;
+                bytesPerObject[r.name] =
+                    static_cast<double>(stats.bytes) / std::max(1.0, double(scene.size()));
+                const double probeS = probeTickSeconds(*world, starts[0], kProbeTicks);
+                base.probeTickUs = probeS * 1e6;
+
+                for (const double rate : rates) {
+                    if (probeS * rate > options.skipTickPeriods) {
+                        for (const Condition c : kConditions) {
+                            SweepRow row = base;
+                            row.rateHz = rate;
+                            row.condition = c;
+                            row.skipped = true;
+                            row.note = "probe: one tick takes " + fmt(probeS * 1e6, 0) + " us, " +
+                                       fmt(probeS * rate, 1) + " periods";
+                            rows.push_back(row);
+                        }
+                        unstableHere.insert({r.name, rate});
+                        progress.advance(perScene, r.name);
+                        continue;
+                    }
+                    for (std::size_t ci = 0; ci < perScene; ++ci) {
+                        const Condition c = kConditions[ci];
+                        SweepRow row = base;
+                        row.rateHz = rate;
+                        row.condition = c;
+                        progress.show(r.name + " " + std::to_string(scene.size()) + " " +
+                                      std::string(conditionName(c)) + " " + rateText(rate));
+                        HandPlan hand{simHand("hand", rate, conditionScript(c), 1, starts[ci]),
+                                      &planScenes[ci]};
+                        for (int k = 0; k < options.servo.repeats; ++k) {
+                            const SessionResult s = runSession(*world, {hand}, options.servo);
+                            row.runs.push_back(figuresOf(s.report.devices.at(0)));
+                            row.reachedPhase = row.reachedPhase && s.reached.at(0);
+                        }
+                        row.median = medianOf(row.runs);
+                        if (!row.reachedPhase) {
+                            row.note = "the hand did not reach its " +
+                                       std::string(conditionName(c)) + " phase before timing";
+                        } else if (!row.median.fault.empty()) {
+                            row.note = "fault: " + row.median.fault;
+                        }
+                        if (!row.stable(options.verdict)) {
+                            unstableHere.insert({r.name, rate});
+                        }
+                        rows.push_back(std::move(row));
+                        progress.advance(1, r.name);
+                    }
+                }
+            }
+        }
+        for (const Key& k : unstableHere) {
+            active[k] = false;
+        }
+    }
+    return rows;
+}
+
+std::vector<SweepLimit> sweepLimits(const std::vector<SweepRenderer>& renderers,
+                                    const std::vector<double>& ratesHz,
+                                    const std::vector<SweepRow>& rows, Verdict verdict) {
+    std::vector<SweepLimit> limits;
+    for (const SweepRenderer& r : renderers) {
+        for (const double rate : ratesHz) {
+            SweepLimit l;
+            l.renderer = r.name;
+            l.rateHz = rate;
+            // Sizes measured, ascending, and per size: per scene seed, all cells stable?
+            std::map<std::size_t, std::pair<int, std::map<std::uint64_t, bool>>> bySize;
+            for (const SweepRow& row : rows) {
+                if (row.renderer == r.name && row.rateHz == rate) {
+                    auto& [size, scenes] = bySize[row.objects];
+                    size = row.size;
+                    auto [it, fresh] = scenes.try_emplace(row.seed, true);
+                    it->second = it->second && row.stable(verdict);
+                }
+            }
+            for (const auto& [objects, entry] : bySize) {
+                const auto& [size, scenes] = entry;
+                l.largestMeasuredObjects = objects;
+                int stableScenes = 0;
+                for (const auto& [seed, ok] : scenes) {
+                    stableScenes += ok ? 1 : 0;
+                }
+                if (l.firstUnstableObjects) {
+                    continue;
+                }
+                if (stableScenes == static_cast<int>(scenes.size())) {
+                    l.maxStableObjects = objects;
+                    l.maxStableSize = size;
+                } else {
+                    l.firstUnstableObjects = objects;
+                    l.firstUnstableSize = size;
+                    l.scenesStableAtFirstUnstable = stableScenes;
+                    l.scenesAtFirstUnstable = static_cast<int>(scenes.size());
+                }
+            }
+            limits.push_back(l);
+        }
+    }
+    return limits;
+}
+
+namespace {
+
+const std::vector<std::string>& csvHeader(const std::string& sizeColumn) {
+    static std::map<std::string, std::vector<std::string>> headers;
+    auto& h = headers[sizeColumn];
+    if (h.empty()) {
+        h = {"renderer",
+             "index",
+             "rate_hz",
+             sizeColumn,
+             "objects",
+             "seed",
+             "condition",
+             "script",
+             "repeats",
+             "ticks",
+             "load_mean_pct",
+             "load_p50_pct",
+             "load_p99_pct",
+             "load_p999_pct",
+             "load_max_pct",
+             "tick_p50_ns",
+             "tick_p999_ns",
+             "tick_max_ns",
+             "missed",
+             "missed_pct",
+             "late_wakeups",
+             "contact_pct",
+             "candidates_mean",
+             "locate_steps_mean",
+             "late_p999_us",
+             "late_max_us",
+             "stable",
+             "load_stable",
+             "skipped",
+             "reached_phase",
+             "realtime",
+             "index_build_s",
+             "index_mb",
+             "probe_tick_us",
+             "note"};
+    }
+    return h;
+}
+
+std::string g(double v) {
+    char text[48];
+    std::snprintf(text, sizeof text, "%.6g", v);
+    return text;
+}
+
+} // namespace
+
+void writeSweepCsv(const std::filesystem::path& path, const std::vector<SweepRow>& rows,
+                   const std::string& sizeColumn) {
+    std::vector<std::vector<std::string>> out;
+    for (const SweepRow& r : rows) {
+        const LoadFigures& m = r.median;
+        out.push_back({r.renderer,
+                       r.index,
+                       g(r.rateHz),
+                       std::to_string(r.size),
+                       std::to_string(r.objects),
+                       std::to_string(r.seed),
+                       std::string(conditionName(r.condition)),
+                       std::string(conditionScript(r.condition)),
+                       std::to_string(r.runs.size()),
+                       g(m.ticks),
+                       g(m.meanPct),
+                       g(m.p50Pct),
+                       g(m.p99Pct),
+                       g(m.p999Pct),
+                       g(m.maxPct),
+                       g(m.tickNsP50),
+                       g(m.tickNsP999),
+                       g(m.tickNsMax),
+                       g(m.missed),
+                       g(m.missedPct),
+                       g(m.lateWakeups),
+                       g(m.contactPct),
+                       g(m.candidatesMean),
+                       g(m.locateStepsMean),
+                       g(m.lateP999Us),
+                       g(m.lateMaxUs),
+                       r.stable() ? "1" : "0",
+                       r.loadStable() ? "1" : "0",
+                       r.skipped ? "1" : "0",
+                       r.reachedPhase ? "1" : "0",
+                       m.realtime ? "1" : "0",
+                       g(r.buildS),
+                       g(r.indexMb),
+                       g(r.probeTickUs),
+                       r.note});
+    }
+    writeCsv(path, csvHeader(sizeColumn), out);
+}
+
+namespace {
+
+Json figuresJson(const LoadFigures& m) {
+    Json j;
+    j["ticks"] = m.ticks;
+    j["load_mean_pct"] = m.meanPct;
+    j["load_p50_pct"] = m.p50Pct;
+    j["load_p99_pct"] = m.p99Pct;
+    j["load_p999_pct"] = m.p999Pct;
+    j["load_max_pct"] = m.maxPct;
+    j["tick_p50_ns"] = m.tickNsP50;
+    j["tick_p999_ns"] = m.tickNsP999;
+    j["tick_max_ns"] = m.tickNsMax;
+    j["missed"] = m.missed;
+    j["missed_pct"] = m.missedPct;
+    j["late_wakeups"] = m.lateWakeups;
+    j["contact_pct"] = m.contactPct;
+    j["candidates_mean"] = m.candidatesMean;
+    j["locate_steps_mean"] = m.locateStepsMean;
+    j["late_p999_us"] = m.lateP999Us;
+    j["late_max_us"] = m.lateMaxUs;
+    j["realtime"] = m.realtime;
+    j["stable"] = m.stable();
+    j["load_stable"] = m.loadStable();
+    j["fault"] = m.fault;
+    return j;
+}
+
+Json optionalJson(const auto& v) {
+    return v ? Json(*v) : Json(nullptr);
+}
+
+} // namespace
+
+Json sweepJson(const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
+               const std::vector<SweepRow>& rows, Verdict verdict, const std::string& sizeColumn) {
+    Json j;
+    Json jr = Json::array();
+    for (const SweepRow& r : rows) {
+        Json e;
+        e["renderer"] = r.renderer;
+        e["index"] = r.index;
+        e["rate_hz"] = r.rateHz;
+        e[sizeColumn] = r.size;
+        e["objects"] = r.objects;
+        e["seed"] = r.seed;
+        e["condition"] = conditionName(r.condition);
+        e["script"] = conditionScript(r.condition);
+        e["stable"] = r.stable();
+        e["load_stable"] = r.loadStable();
+        e["skipped"] = r.skipped;
+        e["reached_phase"] = r.reachedPhase;
+        e["index_build_s"] = r.buildS;
+        e["index_mb"] = r.indexMb;
+        e["probe_tick_us"] = r.probeTickUs;
+        e["note"] = r.note;
+        e["median"] = figuresJson(r.median);
+        Json runs = Json::array();
+        for (const LoadFigures& f : r.runs) {
+            runs.push_back(figuresJson(f));
+        }
+        e["runs"] = runs;
+        jr.push_back(e);
+    }
+    j["rows"] = jr;
+    j["verdict"] = verdictName(verdict);
+    const auto limitsJson = [&](Verdict v) {
+        Json jl = Json::array();
+        for (const SweepLimit& l : sweepLimits(renderers, ratesHz, rows, v)) {
+            Json e;
+            e["renderer"] = l.renderer;
+            e["rate_hz"] = l.rateHz;
+            e["max_stable_objects"] = optionalJson(l.maxStableObjects);
+            e["max_stable_" + sizeColumn] = optionalJson(l.maxStableSize);
+            e["first_unstable_objects"] = optionalJson(l.firstUnstableObjects);
+            e["first_unstable_" + sizeColumn] = optionalJson(l.firstUnstableSize);
+            e["scenes_stable_at_first_unstable"] = l.scenesStableAtFirstUnstable;
+            e["scenes_at_first_unstable"] = l.scenesAtFirstUnstable;
+            e["largest_measured_objects"] = l.largestMeasuredObjects;
+            jl.push_back(e);
+        }
+        return jl;
+    };
+    j["limits"] = limitsJson(verdict);
+    j["limits_by_verdict"] = {{"design", limitsJson(Verdict::Design)},
+                              {"load", limitsJson(Verdict::Load)}};
+    return j;
+}
+
+std::string limitsTable(const std::vector<SweepRenderer>& renderers,
+                        const std::vector<double>& ratesHz, const std::vector<SweepRow>& rows,
+                        Verdict verdict, const std::string& sizeName) {
+    const std::vector<SweepLimit> design = sweepLimits(renderers, ratesHz, rows, Verdict::Design);
+    const std::vector<SweepLimit> load = sweepLimits(renderers, ratesHz, rows, Verdict::Load);
+    const std::vector<SweepLimit>& chosen = verdict == Verdict::Design ? design : load;
+    std::vector<std::vector<std::string>> table;
+    for (std::size_t i = 0; i < chosen.size(); ++i) {
+        const SweepLimit& l = chosen[i];
+        std::string paper;
+        for (const SweepRenderer& r : renderers) {
+            if (r.name == l.renderer) {
+                paper = r.paperResult;
+            }
+        }
+        const auto objects = [&](const std::optional<std::size_t>& n,
+                                 const std::optional<int>& size) {
+            if (!n) {
+                return std::string("none");
+            }
+            return static_cast<std::size_t>(*size) == *n
+                       ? std::to_string(*n)
+                       : std::to_string(*n) + " (" + sizeName + " " + std::to_string(*size) + ")";
+        };
+        std::string firstUnstable = "none up to " + std::to_string(l.largestMeasuredObjects);
+        if (l.firstUnstableObjects) {
+            firstUnstable = objects(l.firstUnstableObjects, l.firstUnstableSize);
+            if (l.scenesAtFirstUnstable > 1) {
+                firstUnstable += ", " + std::to_string(l.scenesStableAtFirstUnstable) + "/" +
+                                 std::to_string(l.scenesAtFirstUnstable) + " scenes stable";
+            }
+        }
+        table.push_back({l.renderer, rateText(l.rateHz),
+                         objects(design[i].maxStableObjects, design[i].maxStableSize),
+                         objects(load[i].maxStableObjects, load[i].maxStableSize), firstUnstable,
+                         paper});
+    }
+    return markdownTable({"renderer", "rate", "max stable (DESIGN: p99.9 < 100 %, <= 0.1 % missed)",
+                          "max stable (load: p99.9 < 100 %)",
+                          "first unstable (" + std::string(verdictName(verdict)) + " verdict)",
+                          "paper (PHANToM, 1 kHz, PIII 800 MHz)"},
+                         table);
+}
+
+std::string platformNote(const std::vector<SweepRow>& rows, Verdict verdict) {
+    std::vector<double> late, missed;
+    std::size_t measured = 0, fifo = 0, loadOnly = 0;
+    for (const SweepRow& r : rows) {
+        if (r.skipped) {
+            continue;
+        }
+        ++measured;
+        fifo += r.median.realtime ? 1 : 0;
+        late.push_back(r.median.lateP999Us);
+        missed.push_back(r.median.missedPct);
+        loadOnly += r.loadStable() && !r.stable() ? 1 : 0;
+    }
+    return "Sweep verdict: " + std::string(verdictName(verdict)) +
+           (verdict == Verdict::Design ? " (p99.9 load < 100 % and <= 0.1 % deadlines missed)"
+                                       : " (p99.9 load < 100 %; missed deadlines reported, not "
+                                         "counted)") +
+           ". SCHED_FIFO granted in " + std::to_string(fifo) + " of " + std::to_string(measured) +
+           " measured cells. Wake-up lateness p99.9, median over "
+           "cells: " +
+           fmt(median(late), 0) +
+           " us; deadlines missed, median over cells: " + fmt(median(missed), 2) +
+           " %; cells within load but over 0.1 % missed: " + std::to_string(loadOnly) + ".\n";
+}
+
+std::string loadCell(const SweepRow& row) {
+    if (row.skipped) {
+        return "skipped";
+    }
+    const LoadFigures& m = row.median;
+    std::string cell = fmt(m.p50Pct, m.p50Pct < 10 ? 2 : 1) + " / " +
+                       fmt(m.p999Pct, m.p999Pct < 10 ? 2 : 1) + " / " +
+                       fmt(m.maxPct, m.maxPct < 10 ? 2 : 0);
+    if (!row.loadStable()) {
+        cell += " UNSTABLE (load)";
+    } else if (!row.stable()) {
+        cell += " UNSTABLE (" + fmt(m.missedPct, 1) + "% missed)";
+    }
+    if (!row.reachedPhase) {
+        cell += " (no contact)";
+    }
+    return cell;
+}
+
+std::vector<std::filesystem::path>
+plotSweep(const std::filesystem::path& dir, const std::string& experiment,
+          const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
+          const std::vector<SweepRow>& rows, Progress& progress) {
+    std::vector<std::filesystem::path> files;
+    for (const double rate : ratesHz) {
+        PlotSpec spec;
+        char name[64];
+        std::snprintf(name, sizeof name, "%s-load-%gHz", experiment.c_str(), rate);
+        spec.name = name;
+        spec.title = experiment + ": p99.9 haptic load against objects, " + rateText(rate) +
+                     " (median over repeats" +
+                     (experiment == "paper2" ? std::string(" and scenes)") : std::string(")"));
+        for (const Condition c : kConditions) {
+            PlotPanel panel;
+            panel.title = std::string(conditionName(c));
+            panel.xLabel = "objects";
+            panel.yLabel = "p99.9 load (% of the period)";
+            panel.logX = true;
+            panel.logY = true;
+            panel.limitY = 100.0;
+            panel.limitTitle = "100 % (one period)";
+            for (const SweepRenderer& r : renderers) {
+                std::map<std::size_t, std::vector<double>> byObjects;
+                for (const SweepRow& row : rows) {
+                    if (row.renderer == r.name && row.rateHz == rate && row.condition == c &&
+                        !row.skipped) {
+                        byObjects[row.objects].push_back(row.median.p999Pct);
+                    }
+                }
+                PlotSeries s;
+                s.title = r.name;
+                for (const auto& [n, loads] : byObjects) {
+                    s.points.emplace_back(static_cast<double>(n), median(loads));
+                }
+                panel.series.push_back(std::move(s));
+            }
+            spec.panels.push_back(std::move(panel));
+        }
+        const PlotResult pr = drawPlot(dir, spec);
+        if (!pr.problem.empty()) {
+            progress.note("hapto experiment: plot skipped: " + pr.problem);
+        }
+        files.insert(files.end(), pr.files.begin(), pr.files.end());
+    }
+    return files;
+}
+
+} // namespace hapto::experiments

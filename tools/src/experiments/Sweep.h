@@ -1,0 +1,142 @@
+#pragma once
+/// The sweep both paper experiments run: growing scenes, each renderer, each rate, each
+/// condition, measured until a renderer is no longer stable.
+///
+/// Design note. Work is ordered by size, then scene, then renderer (one World, so one index
+/// build, per renderer and scene), then rate and condition. A renderer stops growing at a rate
+/// after the first size at which any of its cells was unstable (DESIGN.md's verdict on the
+/// medians over repeats); that size is still measured in full, so "some of the 500-object
+/// scenes" shows. Two guards keep hopeless cells cheap: a probe times a few renderer ticks
+/// offline and skips the cell when one takes more than `skipTickPeriods` periods, and an
+/// index whose memory, extrapolated from the previous size, would pass `maxIndexMb` is not
+/// built. A skipped cell counts as unstable.
+
+#include "ExperimentSupport.h"
+#include "Progress.h"
+
+#include "hapto/index/IndexSpec.h"
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hapto::experiments {
+
+/// A renderer as the paper names it, and the index behind it.
+struct SweepRenderer {
+    std::string name;        ///< "standard", "grid 2x2x2", "octree M=2", ...
+    IndexSpec spec;          ///< The index.
+    std::string paperResult; ///< What the paper reports as its limit, for the summary.
+};
+
+/// One scene of a sweep step, and where each condition's hand starts in it.
+struct SweepScene {
+    std::uint64_t seed = 0;      ///< The generator seed (paper2), 0 when there is none.
+    std::function<Scene()> make; ///< Generates the scene (only when some renderer needs it).
+    std::function<Vec3(const Scene&, Condition)> start; ///< A clear start point (m, world).
+};
+
+/// One size of a sweep: the scenes of that size.
+struct SweepStep {
+    std::size_t objects = 0; ///< Objects in each scene.
+    int size = 0;            ///< K (paper1) or the count (paper2).
+    std::vector<SweepScene> scenes;
+    std::vector<std::string> mustRun; ///< Renderers measured here even once unstable.
+};
+
+/// How a sweep runs.
+struct SweepOptions {
+    std::string experiment;            ///< "paper1" or "paper2" (labels only).
+    std::vector<double> ratesHz;       ///< Servo rates (Hz).
+    ServoSettings servo;               ///< Duration, repeats, realtime.
+    double maxIndexMb = 3000.0;        ///< Largest index (MB, extrapolated) the sweep builds.
+    double skipTickPeriods = 10.0;     ///< Skip a cell whose probed tick exceeds this many periods.
+    Verdict verdict = Verdict::Design; ///< What "unstable" means for the stop rule.
+};
+
+/// One measured (or skipped) cell: renderer x rate x scene x condition.
+struct SweepRow {
+    std::string renderer;    ///< Paper name.
+    std::string index;       ///< IndexSpec text.
+    double rateHz = 0;       ///< Servo rate (Hz).
+    int size = 0;            ///< K or count.
+    std::size_t objects = 0; ///< Objects in the scene.
+    std::uint64_t seed = 0;  ///< Scene seed (paper2).
+    Condition condition = Condition::NoTouch;
+    LoadFigures median;            ///< Medians over the repeats.
+    std::vector<LoadFigures> runs; ///< Each repeat.
+    bool skipped = false;          ///< Not run (probe, memory or build failure); see note.
+    bool reachedPhase = true;      ///< Touch/slide hands were holding/sliding when timed.
+    double buildS = 0;             ///< Index build time (s).
+    double indexMb = 0;            ///< Index memory (MB).
+    double probeTickUs = 0;        ///< Offline probe: median tick (us).
+    std::string note;              ///< Why skipped, or anything odd.
+
+    /// DESIGN.md's verdict on the medians; a skipped cell is not stable. [any thread]
+    bool stable() const { return !skipped && median.stable(); }
+    /// p99.9 load < 100 % on the medians (late wake-ups forgiven); skipped is not. [any thread]
+    bool loadStable() const { return !skipped && median.loadStable(); }
+    /// The verdict asked for. [any thread]
+    bool stable(Verdict v) const { return v == Verdict::Design ? stable() : loadStable(); }
+};
+
+/// Per renderer and rate: how far it went.
+struct SweepLimit {
+    std::string renderer;
+    double rateHz = 0;
+    std::optional<std::size_t> maxStableObjects;     ///< Largest size with every cell stable.
+    std::optional<int> maxStableSize;                ///< Its K or count.
+    std::optional<std::size_t> firstUnstableObjects; ///< The first size with an unstable cell.
+    std::optional<int> firstUnstableSize;            ///< Its K or count.
+    int scenesStableAtFirstUnstable = 0;    ///< Scenes all of whose cells were stable there.
+    int scenesAtFirstUnstable = 0;          ///< Scenes measured there.
+    std::size_t largestMeasuredObjects = 0; ///< The largest size measured at all.
+};
+
+/// Runs the sweep; rows in measurement order. [control]
+std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
+                               const std::vector<SweepStep>& steps, const SweepOptions& options,
+                               Progress& progress);
+
+/// The limits under a verdict, per renderer (in `renderers` order) and rate, from the rows in
+/// size order. [control]
+std::vector<SweepLimit> sweepLimits(const std::vector<SweepRenderer>& renderers,
+                                    const std::vector<double>& ratesHz,
+                                    const std::vector<SweepRow>& rows, Verdict verdict);
+
+/// The CSV of the rows; `sizeColumn` names the size ("per_side" or "count"). [control]
+void writeSweepCsv(const std::filesystem::path& path, const std::vector<SweepRow>& rows,
+                   const std::string& sizeColumn);
+/// The rows, the verdict and the limits under both verdicts (`limits`: the sweep's verdict)
+/// as JSON. [control]
+Json sweepJson(const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
+               const std::vector<SweepRow>& rows, Verdict verdict, const std::string& sizeColumn);
+
+/// The markdown "max stable" table: both verdicts, the first unstable size under the sweep's
+/// verdict, and the paper's figure. [control]
+std::string limitsTable(const std::vector<SweepRenderer>& renderers,
+                        const std::vector<double>& ratesHz, const std::vector<SweepRow>& rows,
+                        Verdict verdict, const std::string& sizeName);
+
+/// A load cell as the tables show it: "p50 / p99.9 / max" in %, or UNSTABLE/skipped marks.
+std::string loadCell(const SweepRow& row);
+
+/// One figure per rate: p99.9 load (%) against objects, a panel per condition, a line per
+/// renderer (median over a size's scenes). Returns the files drawn; notes problems. [control]
+std::vector<std::filesystem::path> plotSweep(const std::filesystem::path& dir,
+                                             const std::string& experiment,
+                                             const std::vector<SweepRenderer>& renderers,
+                                             const std::vector<double>& ratesHz,
+                                             const std::vector<SweepRow>& rows, Progress& progress);
+
+/// A paragraph on how the cells were measured: the verdict driving the sweep, whether
+/// SCHED_FIFO was granted, and the platform's wake-up lateness and misses (medians over the
+/// measured cells), so that misses can be told apart from overload. [control]
+std::string platformNote(const std::vector<SweepRow>& rows, Verdict verdict);
+
+/// "1 kHz", "20 kHz", "500 Hz". [any thread]
+std::string rateText(double rateHz);
+
+} // namespace hapto::experiments
