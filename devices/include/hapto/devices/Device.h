@@ -24,11 +24,11 @@ std::string_view statusName(DeviceStatus status);
 
 /// One reading of a device, in the device's own frame.
 struct DeviceState {
-    Vec3 position{0.0};          ///< End-effector position (m), device frame.
-    Vec3 velocity{0.0};          ///< End-effector velocity (m/s), device frame, if hasVelocity.
-    bool hasVelocity = false;    ///< True when the device measured or estimated velocity.
-    std::uint32_t buttons = 0;   ///< Bit i set while button i is pressed.
-    std::uint64_t sequence = 0;  ///< Increases with every fresh sample from the device.
+    Vec3 position{0.0};         ///< End-effector position (m), device frame.
+    Vec3 velocity{0.0};         ///< End-effector velocity (m/s), device frame, if hasVelocity.
+    bool hasVelocity = false;   ///< True when the device measured or estimated velocity.
+    std::uint32_t buttons = 0;  ///< Bit i set while button i is pressed.
+    std::uint64_t sequence = 0; ///< Increases with every fresh sample from the device.
 };
 
 /// What a device can do, each with its unit.

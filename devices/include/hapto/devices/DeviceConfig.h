@@ -95,9 +95,9 @@ struct DeviceConfig {
     std::variant<SimConfig, ReplayConfig, FalconConfig, PhantomConfig> params; ///< Per kind.
 };
 
-/// Loads a device configuration file (format "hapto-devices", README.md "Device configuration files");
-/// relative trace and firmware paths are resolved against the file's folder. Throws InputError
-/// naming the file and the JSON path (e.g. `devices[1].transform.scale`). [control]
+/// Loads a device configuration file (format "hapto-devices", README.md "Device configuration
+/// files"); relative trace and firmware paths are resolved against the file's folder. Throws
+/// InputError naming the file and the JSON path (e.g. `devices[1].transform.scale`). [control]
 std::vector<DeviceConfig> loadDeviceConfigFile(const std::filesystem::path& path);
 /// Parses device configuration JSON; `sourceName` names it in messages; paths are kept as
 /// written. Throws InputError. [control]
