@@ -8,6 +8,7 @@
 #include <hapto/devices/DeviceFactory.h>
 #include <hapto/index/IndexSpec.h>
 #include <hapto/runtime/GraspController.h>
+#include <hapto/runtime/Realtime.h>
 #include <hapto/runtime/Runtime.h>
 #include <hapto/runtime/World.h>
 #include <hapto/scenes/Generators.h>
@@ -48,7 +49,13 @@ int main(int argc, char** argv) try {
         devices.push_back({makeDevice(config, scene), config, nullptr});
     }
 
-    // 3. One servo thread per device; grasping runs here, on the control thread.
+    // 3. One servo thread per device; grasping runs here, on the control thread, which must
+    //    keep pace with the hands: give it real-time priority too (below the servo threads'
+    //    80) when the process may; it runs anyway when it may not.
+    const rt::RealtimeGrant grant = rt::makeCurrentThreadRealtime(70, -1);
+    if (!grant.note.empty()) {
+        std::fprintf(stderr, "two_hands: %s\n", grant.note.c_str());
+    }
     Runtime runtime(world, std::move(devices));
     GraspController grasp(world, runtime, 0, 1);
     if (runtime.start() != configs.size()) {
