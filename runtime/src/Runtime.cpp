@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <unistd.h>
 
 namespace hapto {
 
@@ -76,6 +77,16 @@ struct alignas(64) Runtime::Channel {
     bool opened = false;
     std::string openError;
     rt::RealtimeGrant grant;
+
+    // Fault recovery, control thread only.
+    bool down = false;               // the thread ended on a fault; the device is closed
+    std::uint64_t downSinceNs = 0;   // when maintain() noticed the fault
+    std::uint64_t lastAttemptNs = 0; // last reopen attempt
+    std::uint64_t faults = 0, reopens = 0, downNs = 0;
+    std::string lastFault;       // what the last fault was, for the report
+    std::string lastReopenError; // so a device that stays away is logged once, not per try
+    std::vector<std::string> events;
+    std::uint64_t eventsDropped = 0;
 
     Channel(RuntimeDevice d, const RuntimeOptions& o, double maxForceN)
         : rd(std::move(d)), renderer(o.renderer), safety(safetyFor(maxForceN)) {}
@@ -144,12 +155,18 @@ std::size_t Runtime::start() {
             throw std::runtime_error("runtime: more devices than the world has reader slots (" +
                                      std::to_string(World::kMaxReaders) + ")");
         }
-        ch.metrics.running.store(true);
-        ch.metrics.heartbeatNs.store(rt::nowNs());
-        ch.thread = std::thread([this, &ch] { servoMain(ch); });
+        startThread(ch);
         ++started;
     }
     return started;
+}
+
+void Runtime::startThread(Channel& ch) {
+    ch.stop.store(false, std::memory_order_release);
+    ch.safety.reset(); // force grows from zero at the safety filter's rate
+    ch.metrics.running.store(true);
+    ch.metrics.heartbeatNs.store(rt::nowNs());
+    ch.thread = std::thread([this, &ch] { servoMain(ch); });
 }
 
 void Runtime::servoMain(Channel& ch) {
@@ -162,11 +179,16 @@ void Runtime::servoMain(Channel& ch) {
     }
     Device& dev = *ch.rd.device;
     DeviceMetrics& m = ch.metrics;
+    m.threadId.store(static_cast<int>(gettid()), std::memory_order_relaxed);
     const WorkspaceTransform& xf = ch.rd.config.transform;
     const std::uint64_t period = ch.periodNs;
     const double dt = static_cast<double>(period) * 1e-9;
     const std::uint64_t lateNs =
         static_cast<std::uint64_t>(mOptions.lateWakeupFraction * static_cast<double>(period));
+    // A wake-up this late means the thread could not run (starved by a CPU hog, or the host)
+    // for K periods while the device held its last force: that tick commands zero.
+    const std::uint64_t starvedNs =
+        static_cast<std::uint64_t>(std::max(1, mOptions.missLimit)) * period;
     const std::uint64_t startNs = mStartNs;
 
     const WorldSnapshot* snap = &mWorld.acquire(*ch.reader);
@@ -196,6 +218,9 @@ void Runtime::servoMain(Channel& ch) {
         if (st != DeviceStatus::Ok) {
             fault(FaultKind::ReadFailed, st);
             break;
+        }
+        if (ch.stop.load(std::memory_order_acquire)) {
+            break; // stopped (or the watchdog fired) while inside read(): zero, below
         }
         if (!finite(state.position) || (state.hasVelocity && !finite(state.velocity))) {
             fault(FaultKind::NonFinite, DeviceStatus::BadData);
@@ -233,7 +258,7 @@ void Runtime::servoMain(Channel& ch) {
         (void)ch.externalForce.read(external);
 
         Vec3 force = ch.safety.filter(out.force + vec(external));
-        if (consecutiveMisses >= mOptions.missLimit) {
+        if (consecutiveMisses >= mOptions.missLimit || lateness >= starvedNs) {
             force = Vec3(0.0);
             ch.safety.reset();
             DeviceMetrics::bump(m.zeroedForMisses);
@@ -308,6 +333,14 @@ void Runtime::servoMain(Channel& ch) {
     }
     (void)dev.write(Vec3(0.0));
     storeVec(m.forceN, Vec3(0.0));
+    // Tell the control thread this hand touches nothing now (a grasp must not hold on to it).
+    ch.contacts.publish(ContactWire{tick,
+                                    triple(lastPosition),
+                                    triple(lastPosition),
+                                    {0.0, 0.0, 0.0},
+                                    {kNoObject, kNoObject, kNoObject},
+                                    {},
+                                    0});
     rt::setInServoLoop(false);
     m.running.store(false, std::memory_order_release);
 }
@@ -317,6 +350,7 @@ void Runtime::maintain() {
     for (auto& chp : mChannels) {
         Channel& ch = *chp;
         if (!ch.metrics.running.load(std::memory_order_acquire)) {
+            recover(ch, now);
             continue;
         }
         const std::uint64_t beat = ch.metrics.heartbeatNs.load(std::memory_order_relaxed);
@@ -328,6 +362,66 @@ void Runtime::maintain() {
         }
     }
     mWorld.maintain();
+}
+
+void Runtime::addEvent(Channel& ch, std::uint64_t nowNs, const std::string& what) {
+    if (ch.events.size() >= kMaxEvents) {
+        ++ch.eventsDropped;
+        return;
+    }
+    char at[32];
+    std::snprintf(at, sizeof at, "%.3f s: ", static_cast<double>(nowNs - mStartNs) * 1e-9);
+    ch.events.push_back(at + what);
+}
+
+void Runtime::recover(Channel& ch, std::uint64_t now) {
+    const FaultKind f = ch.metrics.fault.load(std::memory_order_acquire);
+    if (!ch.opened || f == FaultKind::None) {
+        return; // never opened, or stopped cleanly
+    }
+    if (!ch.down) {
+        // The thread ended on a fault and already commanded zero force. Close the device.
+        if (ch.thread.joinable()) {
+            ch.thread.join();
+        }
+        ch.rd.device->close();
+        ch.down = true;
+        ch.downSinceNs = now;
+        ch.lastAttemptNs = now;
+        ++ch.faults;
+        const std::string status =
+            f == FaultKind::Watchdog
+                ? "no tick for " + std::to_string(mOptions.stallTimeoutNs / 1'000'000) + " ms"
+                : std::string(statusName(static_cast<DeviceStatus>(ch.metrics.faultStatus.load())));
+        ch.lastFault = std::string(faultName(f)) + ": " + status;
+        const std::string detail = ch.rd.device->errorMessage();
+        addEvent(ch, now,
+                 ch.lastFault + (detail.empty() ? "" : " (" + detail + ")") + "; force zeroed");
+        return;
+    }
+    if (mOptions.reopenAfterNs == 0 || now - ch.lastAttemptNs < mOptions.reopenAfterNs) {
+        return;
+    }
+    ch.lastAttemptNs = now;
+    const DeviceStatus st = ch.rd.device->open();
+    if (st != DeviceStatus::Ok) {
+        const std::string why = std::string(statusName(st)) + ": " + ch.rd.device->errorMessage();
+        if (why != ch.lastReopenError) {
+            addEvent(ch, now,
+                     "reopen failed, " + why + "; trying every " +
+                         std::to_string(mOptions.reopenAfterNs / 1'000'000) + " ms");
+            ch.lastReopenError = why;
+        }
+        return;
+    }
+    ch.down = false;
+    ch.lastReopenError.clear();
+    ++ch.reopens;
+    ch.downNs += now - ch.downSinceNs;
+    ch.metrics.fault.store(FaultKind::None);
+    ch.metrics.faultStatus.store(0);
+    addEvent(ch, now, "reopened; driving again from zero force");
+    startThread(ch);
 }
 
 void Runtime::stop() {
@@ -355,8 +449,10 @@ void Runtime::stop() {
 }
 
 bool Runtime::anyRunning() const {
-    return std::any_of(mChannels.begin(), mChannels.end(), [](auto& ch) {
-        return ch->metrics.running.load(std::memory_order_acquire);
+    const bool reopening = mOptions.reopenAfterNs > 0;
+    return std::any_of(mChannels.begin(), mChannels.end(), [reopening](auto& ch) {
+        return ch->metrics.running.load(std::memory_order_acquire) ||
+               (reopening && ch->down && !ch->stop.load(std::memory_order_acquire));
     });
 }
 
@@ -402,11 +498,20 @@ RunReport Runtime::report() const {
         const FaultKind f = m.fault.load();
         if (f == FaultKind::OpenFailed) {
             d.fault = std::string("open-failed: ") + ch.openError;
-        } else if (f != FaultKind::None) {
+        } else if (ch.down) {
+            d.fault = ch.lastFault;
+        } else if (f != FaultKind::None) { // faulted, not yet seen by maintain()
             d.fault = std::string(faultName(f)) + ": " +
                       std::string(statusName(static_cast<DeviceStatus>(m.faultStatus.load())));
         }
-        d.stable = d.fault.empty() && d.ticks > 0 && d.loadFraction.p999 < 1.0 &&
+        d.faults = ch.faults + (f != FaultKind::None && f != FaultKind::OpenFailed && !ch.down);
+        d.reopens = ch.reopens;
+        d.downS = static_cast<double>(ch.downNs) * 1e-9;
+        d.events = ch.events;
+        if (ch.eventsDropped > 0) {
+            d.events.push_back("... and " + std::to_string(ch.eventsDropped) + " more events");
+        }
+        d.stable = d.fault.empty() && d.faults == 0 && d.ticks > 0 && d.loadFraction.p999 < 1.0 &&
                    static_cast<double>(d.missedDeadlines) <= 0.001 * static_cast<double>(d.ticks);
         r.loadSum += d.loadFraction.mean;
         r.stable = r.stable && d.stable;
@@ -491,8 +596,11 @@ std::string reportToJson(const RunReport& r) {
              {{"clamped", d.safety.clamped},
               {"rate_limited", d.safety.rateLimited},
               {"non_finite", d.safety.nonFinite}}},
-            {"faults", d.fault.empty() ? 0 : 1},
+            {"faults", d.faults},
             {"fault", d.fault},
+            {"reopens", d.reopens},
+            {"down_s", d.downS},
+            {"events", d.events},
             {"realtime", d.realtime},
             {"stable", d.stable},
         });

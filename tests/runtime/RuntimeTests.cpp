@@ -1,5 +1,6 @@
 #include "ScriptedDevice.h"
 
+#include "hapto/devices/FaultInjectingDevice.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
 
@@ -7,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <functional>
 #include <thread>
 
 using namespace hapto;
@@ -25,6 +28,7 @@ Scene cubeScene() {
 struct Rig {
     World world;
     std::vector<ScriptedDevice*> devices;
+    std::vector<FaultInjectingDevice*> injectors; // wraps each device
     std::unique_ptr<Runtime> runtime;
 
     Rig(Scene scene, int count, double rateHz, std::function<void(int, ScriptedDevice&)> setup = {},
@@ -38,12 +42,14 @@ struct Rig {
                 setup(i, *d);
             }
             devices.push_back(d.get());
+            auto wrapped = std::make_unique<FaultInjectingDevice>(std::move(d));
+            injectors.push_back(wrapped.get());
             DeviceConfig c;
             c.name = "d" + std::to_string(i);
             c.kind = "scripted";
             c.rateHz = rateHz;
             c.maxForceN = 5.0;
-            rds.push_back({std::move(d), c, nullptr});
+            rds.push_back({std::move(wrapped), c, nullptr});
         }
         options.realtime = false; // tests share a noisy machine; SCHED_FIFO is for sessions
         runtime = std::make_unique<Runtime>(world, std::move(rds), options);
@@ -127,11 +133,16 @@ TEST_CASE("each injected fault zeroes that device and leaves the others running"
                             Case{Inject::NonFinite, FaultKind::NonFinite},
                             Case{Inject::Stall, FaultKind::Watchdog});
     INFO("inject " << static_cast<int>(c.inject));
-    Rig rig(cubeScene(), 3, 1000.0, [&](int i, ScriptedDevice& d) {
-        if (i == 1) {
-            d.inject(c.inject, 200);
-        }
-    });
+    RuntimeOptions never;
+    never.reopenAfterNs = 0; // the fault keeps the device down
+    Rig rig(
+        cubeScene(), 3, 1000.0,
+        [&](int i, ScriptedDevice& d) {
+            if (i == 1) {
+                d.inject(c.inject, 200);
+            }
+        },
+        never);
     rig.runtime->start();
     // Wait for the fault, then for the healthy devices to go on well past it.
     const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
@@ -159,12 +170,106 @@ TEST_CASE("each injected fault zeroes that device and leaves the others running"
     rig.runtime->stop();
     const RunReport r = rig.runtime->report();
     CHECK_FALSE(r.devices[1].fault.empty());
+    CHECK(r.devices[1].faults == 1);
+    CHECK(r.devices[1].reopens == 0);
     CHECK_FALSE(r.devices[1].stable);
     CHECK(r.devices[0].fault.empty());
+    CHECK(r.devices[0].faults == 0);
     CHECK(r.devices[0].ticks >= ticksAtFault + 300);
     for (auto* d : rig.devices) {
         CHECK(glm::length(d->lastForce()) == 0.0);
     }
+}
+
+namespace {
+
+// Presses into the cube, lifts off at read 400, presses again from read 500 on.
+ScriptedDevice::Path pressLiftPress(double x) {
+    const ScriptedDevice::Path press = test::pressIntoCube(x);
+    return [press](std::uint64_t t) {
+        if (t < 400) {
+            return press(t);
+        }
+        if (t < 500) {
+            return press(0); // 1 cm above the top face
+        }
+        return press(t - 500);
+    };
+}
+
+bool hasEvent(const DeviceReport& d, const std::string& text) {
+    return std::any_of(d.events.begin(), d.events.end(),
+                       [&](const std::string& e) { return e.find(text) != std::string::npos; });
+}
+
+} // namespace
+
+TEST_CASE("a device that disconnects and comes back is zeroed at once, reopened and driven again "
+          "while the others go on") {
+    RuntimeOptions opt;
+    opt.reopenAfterNs = 100'000'000; // try every 100 ms
+    Rig rig(
+        cubeScene(), 2, 1000.0,
+        [](int i, ScriptedDevice& d) {
+            if (i == 1) {
+                d.setPath(pressLiftPress(0.0));
+            }
+        },
+        opt);
+    Runtime& runtime = *rig.runtime;
+    runtime.start();
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    const auto pump = [&](const std::function<bool()>& done) {
+        while (!done() && std::chrono::steady_clock::now() < until) {
+            runtime.maintain();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        return done();
+    };
+    // Both press into the cube and feel it.
+    REQUIRE(pump([&] { return rig.devices[0]->reads() >= 200 && rig.devices[1]->reads() >= 200; }));
+    CHECK(glm::length(rig.devices[1]->lastForce()) > 0.0);
+
+    // Unplugged for 300 ms while pressing.
+    rig.injectors[1]->inject(InjectedFault::Disconnect, 300'000'000);
+    REQUIRE(pump([&] { return runtime.report().devices[1].faults == 1; }));
+    CHECK(rig.injectors[1]->injected() == 1);
+    CHECK(rig.injectors[1]->firstForceAfterFault() == 0.0); // zero in the tick it went away
+    CHECK(glm::length(rig.devices[1]->lastForce()) == 0.0);
+    CHECK(runtime.report().devices[1].fault == "read-failed: disconnected");
+    CHECK(runtime.anyRunning());
+    const std::uint64_t other = runtime.metrics(0).ticks.load();
+
+    // It comes back, is reopened, lifts off and presses again: the force returns.
+    REQUIRE(pump([&] { return runtime.report().devices[1].reopens == 1; }));
+    REQUIRE(pump([&] { return rig.devices[1]->reads() >= 700; }));
+    CHECK(glm::length(rig.devices[1]->lastForce()) > 0.0);
+    CHECK(runtime.metrics(0).ticks.load() > other); // the other hand never paused
+    CHECK(glm::length(rig.devices[0]->lastForce()) > 0.0);
+    runtime.stop();
+
+    const RunReport r = runtime.report();
+    const DeviceReport& back = r.devices[1];
+    INFO("events: " << nlohmann::json(back.events).dump());
+    CHECK(back.fault.empty());
+    CHECK(back.faults == 1);
+    CHECK(back.reopens == 1);
+    CHECK(back.downS >= 0.2); // away for 300 ms; noticed within a few ms
+    CHECK(hasEvent(back, "read-failed: disconnected"));
+    CHECK(hasEvent(back, "reopen failed, disconnected")); // tried while it was away
+    CHECK(hasEvent(back, "reopened"));
+    CHECK_FALSE(back.stable);
+    CHECK(r.devices[0].faults == 0);
+    CHECK(r.devices[0].fault.empty());
+    CHECK(r.devices[0].events.empty());
+    for (auto* d : rig.devices) {
+        CHECK(glm::length(d->lastForce()) == 0.0);
+    }
+    // The report names it all.
+    const auto j = nlohmann::json::parse(reportToJson(r));
+    CHECK(j["devices"][1]["faults"] == 1);
+    CHECK(j["devices"][1]["reopens"] == 1);
+    CHECK(j["devices"][1]["events"].size() == back.events.size());
 }
 
 TEST_CASE("a device that fails to open is reported and the others run") {

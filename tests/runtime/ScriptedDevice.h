@@ -22,6 +22,9 @@ public:
 
     ScriptedDevice(std::string name, Path path) : mName(std::move(name)), mPath(std::move(path)) {}
 
+    /// Replaces the position function (before start). [control]
+    void setPath(Path path) { mPath = std::move(path); }
+
     void inject(Inject what, std::uint64_t fromTick, std::uint64_t slowNs = 0) {
         mInject = what;
         mFromTick = fromTick;
@@ -88,11 +91,21 @@ public:
     std::uint64_t writes() const { return mWrites.load(); }
     Vec3 lastForce() const { return {mLast[0].load(), mLast[1].load(), mLast[2].load()}; }
     double maxForceSeen() const { return mMaxForce.load(); }
+    /// |force| of the first write that came more than 20 ms after the one before it (a thread
+    /// that could not run); negative if no such gap happened.
+    double forceAfterGap() const { return mForceAfterGap.load(); }
     /// Largest force magnitude written while reads >= tick (for "zero after K misses" checks).
     bool closed() const { return mClosed; }
 
 private:
     void recordForce(const Vec3& f) {
+        const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     std::chrono::steady_clock::now().time_since_epoch())
+                                     .count();
+        const auto last = mLastWriteNs.exchange(now);
+        if (last != 0 && now - last > 20'000'000 && mForceAfterGap.load() < 0) {
+            mForceAfterGap.store(glm::length(f));
+        }
         for (int i = 0; i < 3; ++i) {
             mLast[i].store(f[i]);
         }
@@ -110,6 +123,8 @@ private:
     std::atomic<std::uint64_t> mReads{0}, mWrites{0};
     std::atomic<double> mLast[3]{};
     std::atomic<double> mMaxForce{0};
+    std::atomic<double> mForceAfterGap{-1.0};
+    std::atomic<std::int64_t> mLastWriteNs{0};
     bool mOpen = false, mClosed = false;
 };
 

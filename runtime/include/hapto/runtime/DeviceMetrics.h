@@ -44,7 +44,8 @@ struct alignas(64) DeviceMetrics {
     std::atomic<FaultKind> fault{FaultKind::None}; ///< Set once when the thread faults.
     std::atomic<std::uint8_t> faultStatus{0};      ///< The DeviceStatus behind a read/write fault.
     std::atomic<bool> running{false};              ///< The servo loop is live.
-    std::atomic<double> forceN[3]{};    ///< Last force sent, world frame (N), for the live view.
+    std::atomic<int> threadId{0};    ///< Linux thread id of the servo thread (for chrt, taskset).
+    std::atomic<double> forceN[3]{}; ///< Last force sent, world frame (N), for the live view.
     std::atomic<double> positionM[3]{}; ///< Last device point, world frame (m), for the live view.
 
     /// Adds to a counter; the servo thread is the only writer. [servo]

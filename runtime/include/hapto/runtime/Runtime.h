@@ -46,7 +46,10 @@ struct RuntimeOptions {
                               ///< until a tick meets its deadline again.
     double lateWakeupFraction = 0.1; ///< A wake-up later than this fraction of the period is late.
     std::uint64_t stallTimeoutNs =
-        50'000'000;            ///< Watchdog: no tick for this long faults the device.
+        50'000'000; ///< Watchdog: no tick for this long faults the device.
+    std::uint64_t reopenAfterNs =
+        1'000'000'000;         ///< After a fault, close the device and try to open it again every
+                               ///< this long (ns), then drive it again from zero force; 0 = never.
     RendererConfig renderer{}; ///< Proxy settings for every device.
 };
 
@@ -68,10 +71,15 @@ struct DeviceReport {
     std::uint64_t lateWakeups = 0, missedDeadlines = 0, zeroedForMisses = 0;
     double locateStepsMean = 0, candidatesMean = 0;
     std::uint64_t outsideTicks = 0, contactTicks = 0, snapshotsSeen = 0;
-    SafetyCounters safety{}; ///< Clamps, rate limits, non-finite forces.
-    std::string fault;       ///< Empty, or what faulted the device.
-    bool realtime = false;   ///< SCHED_FIFO was granted.
-    bool stable = false;     ///< p99.9 load < 1 and misses <= 0.1 % of ticks, no fault.
+    SafetyCounters safety{};         ///< Clamps, rate limits, non-finite forces.
+    std::string fault;               ///< Empty, or what faulted the device and keeps it down now.
+    std::uint64_t faults = 0;        ///< Faults while running (each zeroed the device at once).
+    std::uint64_t reopens = 0;       ///< Times the device was opened again after a fault.
+    double downS = 0;                ///< Time between noticing a fault and the reopen (s).
+    std::vector<std::string> events; ///< "12.345 s: read-failed: disconnected", oldest first
+                                     ///< (the first kMaxEvents).
+    bool realtime = false;           ///< SCHED_FIFO was granted.
+    bool stable = false;             ///< p99.9 load < 1 and misses <= 0.1 % of ticks, no fault.
 };
 
 /// The whole run.
@@ -89,6 +97,9 @@ struct RunReport {
 /// Threading: every public member is [control] except where marked.
 class Runtime {
 public:
+    /// Events kept per device in the report; later ones are only counted.
+    static constexpr std::size_t kMaxEvents = 64;
+
     Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOptions options = {});
     ~Runtime();
     Runtime(const Runtime&) = delete;
@@ -97,11 +108,14 @@ public:
     /// Opens every device and starts its thread. A device that fails to open is reported as
     /// faulted and the others run. Returns the number of threads started. [control]
     std::size_t start();
-    /// Watchdog and world maintenance; call every few milliseconds while running. [control]
+    /// Watchdog, fault recovery and world maintenance; call every few milliseconds while
+    /// running. A device whose thread ended on a fault is closed here and, when
+    /// RuntimeOptions::reopenAfterNs allows, opened again and given a new servo thread. [control]
     void maintain();
     /// Stops every thread: each commands zero force, then the devices are closed. [control]
     void stop();
-    /// True while some servo thread is live. [any thread]
+    /// True while some servo thread is live or a faulted device waits to be reopened.
+    /// [control]
     bool anyRunning() const;
 
     /// Live metrics of device i. [any thread]
@@ -125,6 +139,9 @@ public:
 private:
     struct Channel;
     void servoMain(Channel& channel);
+    void startThread(Channel& channel);
+    void recover(Channel& channel, std::uint64_t nowNs);
+    void addEvent(Channel& channel, std::uint64_t nowNs, const std::string& what);
 
     World& mWorld;
     RuntimeOptions mOptions;
