@@ -202,6 +202,7 @@ void Runtime::servoMain(Channel& ch) {
     std::uint64_t tick = 0;
     const auto fault = [&](FaultKind k, DeviceStatus st) {
         m.faultStatus.store(static_cast<std::uint8_t>(st), std::memory_order_relaxed);
+        m.faultNs.store(rt::nowNs(), std::memory_order_relaxed);
         m.fault.store(k, std::memory_order_release);
         (void)dev.write(Vec3(0.0));
     };
@@ -357,6 +358,7 @@ void Runtime::maintain() {
         if (now > beat && now - beat > mOptions.stallTimeoutNs &&
             ch.metrics.fault.load() == FaultKind::None) {
             // The thread is stuck inside the device; when it returns it writes zero and ends.
+            ch.metrics.faultNs.store(beat);
             ch.metrics.fault.store(FaultKind::Watchdog);
             ch.stop.store(true, std::memory_order_release);
         }
@@ -386,7 +388,8 @@ void Runtime::recover(Channel& ch, std::uint64_t now) {
         }
         ch.rd.device->close();
         ch.down = true;
-        ch.downSinceNs = now;
+        const std::uint64_t at = ch.metrics.faultNs.load();
+        ch.downSinceNs = at != 0 && at <= now ? at : now; // down since the fault itself
         ch.lastAttemptNs = now;
         ++ch.faults;
         const std::string status =
@@ -420,6 +423,7 @@ void Runtime::recover(Channel& ch, std::uint64_t now) {
     ch.downNs += now - ch.downSinceNs;
     ch.metrics.fault.store(FaultKind::None);
     ch.metrics.faultStatus.store(0);
+    ch.metrics.faultNs.store(0);
     addEvent(ch, now, "reopened; driving again from zero force");
     startThread(ch);
 }
@@ -506,7 +510,8 @@ RunReport Runtime::report() const {
         }
         d.faults = ch.faults + (f != FaultKind::None && f != FaultKind::OpenFailed && !ch.down);
         d.reopens = ch.reopens;
-        d.downS = static_cast<double>(ch.downNs) * 1e-9;
+        const std::uint64_t downNow = ch.down ? rt::nowNs() - ch.downSinceNs : 0;
+        d.downS = static_cast<double>(ch.downNs + downNow) * 1e-9;
         d.events = ch.events;
         if (ch.eventsDropped > 0) {
             d.events.push_back("... and " + std::to_string(ch.eventsDropped) + " more events");

@@ -35,6 +35,10 @@ void addRunCommands(CLI::App& app);
 /// written as CSV, JSON, markdown and plots. [control]
 void addExperimentCommands(CLI::App& app);
 
+/// `hapto soak`: a long run with world updates and injected faults; drift, memory, misses.
+/// [control]
+void addSoakCommands(CLI::App& app);
+
 /// Loads `path`, or the embedded default scene when it is empty. Throws InputError. [control]
 Scene loadSceneOrDefault(const std::string& path);
 

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
     hapto::cli::addIndexCommands(app);
     hapto::cli::addTraceCommands(app);
     hapto::cli::addExperimentCommands(app);
+    hapto::cli::addSoakCommands(app);
 
     try {
         app.parse(argc, argv);

@@ -43,6 +43,7 @@ struct alignas(64) DeviceMetrics {
     std::atomic<std::uint64_t> heartbeatNs{0};     ///< Monotonic time of the last completed tick.
     std::atomic<FaultKind> fault{FaultKind::None}; ///< Set once when the thread faults.
     std::atomic<std::uint8_t> faultStatus{0};      ///< The DeviceStatus behind a read/write fault.
+    std::atomic<std::uint64_t> faultNs{0};         ///< Monotonic time of the fault (ns).
     std::atomic<bool> running{false};              ///< The servo loop is live.
     std::atomic<int> threadId{0};    ///< Linux thread id of the servo thread (for chrt, taskset).
     std::atomic<double> forceN[3]{}; ///< Last force sent, world frame (N), for the live view.

@@ -71,11 +71,12 @@ struct DeviceReport {
     std::uint64_t lateWakeups = 0, missedDeadlines = 0, zeroedForMisses = 0;
     double locateStepsMean = 0, candidatesMean = 0;
     std::uint64_t outsideTicks = 0, contactTicks = 0, snapshotsSeen = 0;
-    SafetyCounters safety{};         ///< Clamps, rate limits, non-finite forces.
-    std::string fault;               ///< Empty, or what faulted the device and keeps it down now.
-    std::uint64_t faults = 0;        ///< Faults while running (each zeroed the device at once).
-    std::uint64_t reopens = 0;       ///< Times the device was opened again after a fault.
-    double downS = 0;                ///< Time between noticing a fault and the reopen (s).
+    SafetyCounters safety{};   ///< Clamps, rate limits, non-finite forces.
+    std::string fault;         ///< Empty, or what faulted the device and keeps it down now.
+    std::uint64_t faults = 0;  ///< Faults while running (each zeroed the device at once).
+    std::uint64_t reopens = 0; ///< Times the device was opened again after a fault.
+    /// Time from each fault to its reopen, summed, the current outage included (s).
+    double downS = 0;
     std::vector<std::string> events; ///< "12.345 s: read-failed: disconnected", oldest first
                                      ///< (the first kMaxEvents).
     bool realtime = false;           ///< SCHED_FIFO was granted.
