@@ -39,6 +39,7 @@ struct RunArgs {
     bool noRealtime = false;
     double spinUs = 0;
     int missLimit = 3;
+    double reopenMs = 1000;
     bool quiet = false;
 };
 
@@ -53,6 +54,9 @@ void printSummary(const RunReport& r) {
             100 * d.loadFraction.max, static_cast<unsigned long long>(d.missedDeadlines),
             static_cast<unsigned long long>(d.lateWakeups), d.candidatesMean,
             d.fault.empty() ? (d.stable ? "stable" : "UNSTABLE") : ("FAULT " + d.fault).c_str());
+        for (const std::string& e : d.events) {
+            std::printf("  %s: %s\n", d.name.c_str(), e.c_str());
+        }
     }
     std::printf(
         "total: load %.2f%% of one core summed over %zu devices, %.2f%% per core (%d cores); %s\n",
@@ -101,6 +105,7 @@ int runSession(const RunArgs& a) {
     opt.realtime = !a.noRealtime;
     opt.spinNs = static_cast<std::uint64_t>(a.spinUs * 1000);
     opt.missLimit = a.missLimit;
+    opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
     Runtime runtime(world, std::move(devices), opt);
 
     std::signal(SIGINT, onStopSignal);
@@ -190,6 +195,11 @@ void addRunCommands(CLI::App& app) {
                     "K: after K missed deadlines in a row, command zero force until caught up")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000000));
+    cmd->add_option("--reopen-ms", a->reopenMs,
+                    "After a device fault (zero force at once), close the device and try to open "
+                    "it again this often, then drive it again from zero force (ms); 0 = never")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 3600000.0));
     cmd->add_flag("--quiet", a->quiet, "No live view");
     cmd->callback([a] {
         const int rc = runSession(*a);
