@@ -472,6 +472,53 @@ TEST_CASE("unplugged mid-run, the servo sees Disconnected and close does not han
     dev.close(); // twice is fine
 }
 
+TEST_CASE("unplugged and plugged back in, the same device opens again and drives the motors",
+          "[emulated]") {
+    requireEmulation();
+    FalconEmulator emu;
+    const Pose a = poseNear(Vec3(0.0, 0.01, 0.14));
+    emu.setEncoders(a.encoders);
+    FalconDevice dev("left", noHoming(), 5.0);
+    dev.setTimeouts(testTimeouts());
+    const auto drive = [&](DeviceStatus until) {
+        std::atomic<bool> stop{false};
+        std::atomic<DeviceStatus> last{DeviceStatus::NotOpen};
+        std::thread servo([&] {
+            while (!stop.load()) {
+                DeviceState s;
+                last = dev.read(s);
+                (void)dev.write(Vec3(0.5, 0.0, 0.0));
+                std::this_thread::sleep_for(1ms);
+            }
+        });
+        const bool seen = eventually([&] { return last.load() == until; });
+        stop = true;
+        servo.join();
+        return seen;
+    };
+    REQUIRE_OPEN(dev);
+    REQUIRE(drive(DeviceStatus::Ok));
+    emu.unplug();
+    REQUIRE(drive(DeviceStatus::Disconnected));
+    dev.close();
+    CHECK(dev.open() != DeviceStatus::Ok); // still away: open says so, and does not hang
+    dev.close();
+
+    emu.replug();
+    const std::size_t sentBefore = emu.commandCount();
+    REQUIRE_OPEN(dev);
+    REQUIRE(drive(DeviceStatus::Ok));
+    DeviceState s;
+    REQUIRE(dev.read(s) == DeviceStatus::Ok);
+    CHECK(glm::length(s.position - (a.mechPosition - kOrigin)) < 1e-9); // the same pose
+    CHECK(eventually([&] {
+        const auto c = emu.commands();
+        return c.size() > sentBefore && c.back().motor != MotorWords{0, 0, 0};
+    }));
+    dev.close();
+    CHECK(emu.commands().back().motor == MotorWords{0, 0, 0}); // zero at close
+}
+
 TEST_CASE("devices are picked by serial or bus/address, and listed for `hapto devices`",
           "[emulated]") {
     requireEmulation();

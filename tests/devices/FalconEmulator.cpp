@@ -142,6 +142,18 @@ void FalconEmulator::unplug() {
     umockdev_testbed_uevent(mTestbed, mSysPath.c_str(), "remove");
 }
 
+void FalconEmulator::replug() {
+    {
+        std::lock_guard lock(mMutex);
+        mUnplugged = false;
+        mInData.clear();
+        mBoot = Boot::Idle;
+        mDtr = false;
+        mFirmware = mOptions.firmwareLoaded;
+    }
+    umockdev_testbed_uevent(mTestbed, mSysPath.c_str(), "add");
+}
+
 std::vector<FtdiRequest> FalconEmulator::ftdiRequests() const {
     std::lock_guard lock(mMutex);
     return mFtdi;

@@ -77,6 +77,9 @@ public:
     /// Unplugs the device: in-flight URBs fail with ESHUTDOWN, later calls with ENODEV, and
     /// udev sees a "remove" event.
     void unplug();
+    /// Plugs it back in after unplug(): firmware state back to the options' (a power cycle),
+    /// and udev sees an "add" event.
+    void replug();
 
     /// FTDI vendor requests received so far, in order.
     std::vector<FtdiRequest> ftdiRequests() const;
