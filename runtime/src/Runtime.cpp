@@ -420,11 +420,12 @@ void Runtime::recover(Channel& ch, std::uint64_t now) {
     ch.down = false;
     ch.lastReopenError.clear();
     ++ch.reopens;
-    ch.downNs += now - ch.downSinceNs;
+    const std::uint64_t back = rt::nowNs(); // open() may take long (set-up, homing)
+    ch.downNs += back - ch.downSinceNs;
     ch.metrics.fault.store(FaultKind::None);
     ch.metrics.faultStatus.store(0);
     ch.metrics.faultNs.store(0);
-    addEvent(ch, now, "reopened; driving again from zero force");
+    addEvent(ch, back, "reopened; driving again from zero force");
     startThread(ch);
 }
 
