@@ -89,27 +89,13 @@ int runPaper1(const Paper1Args& args) {
     const std::vector<SweepRow> rows = runSweep(renderers, steps, options, progress);
 
     // Files.
-    writeSweepCsv(out / "paper1.csv", rows, "per_side");
-    Json j;
-    j["experiment"] = "paper1";
-    j["machine"] = machineJson();
-    j["options"] = {{"rates_hz", args.ratesHz},
-                    {"max_per_side", args.maxPerSide},
-                    {"duration_s", args.common.durationS},
-                    {"repeats", args.common.repeats},
-                    {"realtime_requested", args.common.realtime},
-                    {"quick", args.common.quick},
-                    {"cube_m", kCubeM},
-                    {"gap_m", kGapM},
-                    {"pad_m", kPadM},
-                    {"max_index_mb", args.maxIndexMb},
-                    {"verdict", verdictName(args.verdict)}};
-    const Json body = sweepJson(renderers, args.ratesHz, rows, args.verdict, "per_side");
-    for (const char* key : {"verdict", "rows", "limits", "limits_by_verdict"}) {
-        j[key] = body[key];
-    }
-    writeText(out / "paper1.json", j.dump(2) + "\n");
-    const auto plots = plotSweep(out, "paper1", renderers, args.ratesHz, rows, progress);
+    const auto plots = writeSweepFiles(out, "paper1",
+                                       Json{{"max_per_side", args.maxPerSide},
+                                            {"cube_m", kCubeM},
+                                            {"gap_m", kGapM},
+                                            {"pad_m", kPadM}},
+                                       args.common, args.maxIndexMb, renderers, args.ratesHz, rows,
+                                       args.verdict, "per_side", progress);
 
     // Tables.
     std::string md = "## Experiment 1: K x K x K lattices of 5 cm cubes\n\n"

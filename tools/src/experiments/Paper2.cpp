@@ -84,28 +84,14 @@ int runPaper2(const Paper2Args& args) {
                                     static_cast<std::size_t>(args.seeds) * 3);
     const std::vector<SweepRow> rows = runSweep(renderers, steps, options, progress);
 
-    writeSweepCsv(out / "paper2.csv", rows, "count");
-    Json j;
-    j["experiment"] = "paper2";
-    j["machine"] = machineJson();
-    j["options"] = {{"rates_hz", args.ratesHz},
-                    {"counts", counts},
-                    {"seeds", args.seeds},
-                    {"duration_s", args.common.durationS},
-                    {"repeats", args.common.repeats},
-                    {"realtime_requested", args.common.realtime},
-                    {"quick", args.common.quick},
-                    {"workspace_m", kWorkspaceM},
-                    {"cube_m", kCubeM},
-                    {"keep_clear_m", keepClear},
-                    {"max_index_mb", args.maxIndexMb},
-                    {"verdict", verdictName(args.verdict)}};
-    const Json body = sweepJson(renderers, args.ratesHz, rows, args.verdict, "count");
-    for (const char* key : {"verdict", "rows", "limits", "limits_by_verdict"}) {
-        j[key] = body[key];
-    }
-    writeText(out / "paper2.json", j.dump(2) + "\n");
-    const auto plots = plotSweep(out, "paper2", renderers, args.ratesHz, rows, progress);
+    const auto plots = writeSweepFiles(out, "paper2",
+                                       Json{{"counts", counts},
+                                            {"seeds", args.seeds},
+                                            {"workspace_m", kWorkspaceM},
+                                            {"cube_m", kCubeM},
+                                            {"keep_clear_m", keepClear}},
+                                       args.common, args.maxIndexMb, renderers, args.ratesHz, rows,
+                                       args.verdict, "count", progress);
 
     const auto find = [&](const std::string& renderer, double rate, std::size_t count,
                           std::uint64_t seed, Condition c) -> const SweepRow* {

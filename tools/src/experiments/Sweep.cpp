@@ -561,4 +561,30 @@ plotSweep(const std::filesystem::path& dir, const std::string& experiment,
     return files;
 }
 
+std::vector<std::filesystem::path>
+writeSweepFiles(const std::filesystem::path& out, const std::string& name, Json options,
+                const CommonArgs& common, double maxIndexMb,
+                const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
+                const std::vector<SweepRow>& rows, Verdict verdict, const std::string& sizeColumn,
+                Progress& progress) {
+    writeSweepCsv(out / (name + ".csv"), rows, sizeColumn);
+    options["rates_hz"] = ratesHz;
+    options["duration_s"] = common.durationS;
+    options["repeats"] = common.repeats;
+    options["realtime_requested"] = common.realtime;
+    options["quick"] = common.quick;
+    options["max_index_mb"] = maxIndexMb;
+    options["verdict"] = verdictName(verdict);
+    Json j;
+    j["experiment"] = name;
+    j["machine"] = machineJson();
+    j["options"] = std::move(options);
+    const Json body = sweepJson(renderers, ratesHz, rows, verdict, sizeColumn);
+    for (const char* key : {"verdict", "rows", "limits", "limits_by_verdict"}) {
+        j[key] = body[key];
+    }
+    writeText(out / (name + ".json"), j.dump(2) + "\n");
+    return plotSweep(out, name, renderers, ratesHz, rows, progress);
+}
+
 } // namespace hapto::experiments

@@ -12,6 +12,7 @@
 /// built. A skipped cell counts as unstable.
 
 #include "ExperimentSupport.h"
+#include "Experiments.h"
 #include "Progress.h"
 
 #include "hapto/index/IndexSpec.h"
@@ -119,6 +120,16 @@ Json sweepJson(const std::vector<SweepRenderer>& renderers, const std::vector<do
 std::string limitsTable(const std::vector<SweepRenderer>& renderers,
                         const std::vector<double>& ratesHz, const std::vector<SweepRow>& rows,
                         Verdict verdict, const std::string& sizeName);
+
+/// The files every sweep experiment writes besides its tables: NAME.csv, NAME.json (the
+/// machine, `options` with the common settings added, the rows, the verdict and the limits)
+/// and the plots. Returns the plots drawn. [control]
+std::vector<std::filesystem::path>
+writeSweepFiles(const std::filesystem::path& out, const std::string& name, Json options,
+                const CommonArgs& common, double maxIndexMb,
+                const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
+                const std::vector<SweepRow>& rows, Verdict verdict, const std::string& sizeColumn,
+                Progress& progress);
 
 /// A load cell as the tables show it: "p50 / p99.9 / max" in %, or UNSTABLE/skipped marks.
 std::string loadCell(const SweepRow& row);
