@@ -230,13 +230,13 @@ std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_v
     checkKeys(w, root, top, {"format", "version", "devices"});
     const Json& format = required(w, root, top, "format");
     if (!format.is_string() || format.get<std::string>() != "hapto-devices") {
-        w.fail(top / "format", "expected \"hapto-devices\", got " + format.dump());
+        w.fail(top / "format", "expected \"hapto-devices\", got " + describe(format));
     }
     const Json& version = required(w, root, top, "version");
     if (!version.is_number_integer() || version.get<std::int64_t>() != kDeviceConfigFormatVersion) {
         w.fail(top / "version", "this build reads version " +
                                     std::to_string(kDeviceConfigFormatVersion) + ", got " +
-                                    version.dump());
+                                    describe(version));
     }
     const Path devicesPath = top / "devices";
     const Json& devices = required(w, root, top, "devices");

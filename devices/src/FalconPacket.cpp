@@ -77,8 +77,8 @@ std::optional<FalconCommand> decodeCommand(std::span<const std::uint8_t> bytes) 
 }
 
 Packet encodeReading(const FalconReading& r) {
-    const std::uint8_t flags =
-        static_cast<std::uint8_t>((r.buttons & 0xF) | ((r.homedMask & 0x7) << 4));
+    const std::uint8_t flags = static_cast<std::uint8_t>(
+        (r.buttons & 0xF) | ((r.homedMask & 0x7) << 4) | (r.flagBit7 ? 0x80 : 0));
     return frameWith(r.encoder, flags);
 }
 
@@ -92,6 +92,7 @@ std::optional<FalconReading> decode(std::span<const std::uint8_t> bytes) {
         ((bytes[kFlagByte] - kNibbleBase) & 0xFu) | (((bytes[14] - kNibbleBase) & 0xFu) << 4);
     r.buttons = static_cast<std::uint8_t>(flags & 0xFu);
     r.homedMask = static_cast<std::uint8_t>((flags >> 4) & 0x7u);
+    r.flagBit7 = (flags & 0x80u) != 0;
     return r;
 }
 

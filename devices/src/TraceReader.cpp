@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 namespace hapto {
@@ -96,11 +97,18 @@ TraceReader::TraceReader(const std::filesystem::path& path) : mPath(path) {
             mHeader.finished = true;
             mHeader.sampleCount = h.sampleCount;
             if (h.sampleCount > body / kTraceSampleBytes) {
-                fail(size,
-                     "truncated: the header announces " + std::to_string(h.sampleCount) +
-                         " samples (" +
-                         std::to_string(kTraceHeaderBytes + h.sampleCount * kTraceSampleBytes) +
-                         " bytes) but the file ends after " + std::to_string(size) + " bytes");
+                // A corrupt count can be so large that the byte count would not fit 64 bits.
+                constexpr std::uint64_t kMaxCount =
+                    (std::numeric_limits<std::uint64_t>::max() - kTraceHeaderBytes) /
+                    kTraceSampleBytes;
+                const std::string need =
+                    h.sampleCount <= kMaxCount
+                        ? std::to_string(kTraceHeaderBytes + h.sampleCount * kTraceSampleBytes) +
+                              " bytes"
+                        : "more bytes than a file can hold";
+                fail(size, "truncated: the header announces " + std::to_string(h.sampleCount) +
+                               " samples (" + need + ") but the file ends after " +
+                               std::to_string(size) + " bytes");
             }
             if (body != h.sampleCount * kTraceSampleBytes) {
                 fail(kTraceHeaderBytes + h.sampleCount * kTraceSampleBytes,

@@ -100,6 +100,22 @@ std::string show(double v) {
     return s.str();
 }
 
+std::string describe(const Json& j) {
+    if (j.is_structured()) {
+        return typeName(j);
+    }
+    std::string text = j.dump();
+    constexpr std::size_t kMax = 64;
+    if (text.size() > kMax) {
+        std::size_t cut = kMax;
+        while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) {
+            --cut; // not inside a UTF-8 sequence
+        }
+        text = text.substr(0, cut) + "...";
+    }
+    return text;
+}
+
 double number(const Source& s, const Json& j, const Path& path) {
     if (!j.is_number()) {
         s.fail(path, "expected a number, got " + typeName(j));

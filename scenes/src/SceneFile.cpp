@@ -54,6 +54,18 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path) {
                "unknown shape '" + shapeText + "' (expected \"box\" or \"sphere\")");
     }
     o.center = vec3(w, required(w, j, path, "center"), path / "center");
+    // The bounding box must be finite too: a box reaches at most the sum of its half extents
+    // from its centre along any axis, whatever its rotation.
+    const double reach = o.shape == Shape::Sphere
+                             ? o.halfExtents.x
+                             : o.halfExtents.x + o.halfExtents.y + o.halfExtents.z;
+    for (int i = 0; i < 3; ++i) {
+        if (!std::isfinite(std::abs(o.center[i]) + reach)) {
+            w.fail(path, "the object reaches past the largest finite coordinate (centre " +
+                             show(o.center[i]) + " on axis " + std::to_string(i) + ", size " +
+                             show(reach) + ")");
+        }
+    }
     if (const Json* v = optional(j, "rotation")) {
         o.rotation = quaternion(w, *v, path / "rotation");
     }
@@ -135,8 +147,9 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
         case Json::parse_event_t::array_end:
             if (depth == 1) {
                 inObjects = false;
+                return true;
             }
-            return true;
+            [[fallthrough]]; // an array as an element of "objects": refused by parseObject
         case Json::parse_event_t::object_end:
         case Json::parse_event_t::value:
             if (inObjects && depth == 2) {
@@ -157,12 +170,12 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
     checkKeys(w, root, top, {"format", "version", "bounds", "objects"});
     const Json& format = required(w, root, top, "format");
     if (!format.is_string() || format.get<std::string>() != "hapto-scene") {
-        w.fail(top / "format", "expected \"hapto-scene\", got " + format.dump());
+        w.fail(top / "format", "expected \"hapto-scene\", got " + describe(format));
     }
     const Json& version = required(w, root, top, "version");
     if (!version.is_number_integer() || version.get<std::int64_t>() != kSceneFormatVersion) {
         w.fail(top / "version", "this build reads version " + std::to_string(kSceneFormatVersion) +
-                                    ", got " + version.dump());
+                                    ", got " + describe(version));
     }
     const Json* objectsJson = optional(root, "objects");
     if (!objectsJson) {
@@ -188,8 +201,21 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
     }
 
     const Json* boundsJson = optional(root, "bounds");
-    const Aabb bounds =
-        boundsJson ? parseBounds(w, *boundsJson, top / "bounds") : Scene::defaultBounds(objects);
+    if (boundsJson) {
+        return Scene(parseBounds(w, *boundsJson, top / "bounds"), std::move(objects));
+    }
+    // Default bounds pad the objects' union by 5 % (at least 1 mm). Far enough from the origin
+    // that margin is lost to rounding or overflows; refuse here, with the file and the reason,
+    // rather than let the Scene refuse the bounds.
+    const Aabb bounds = Scene::defaultBounds(objects);
+    for (int i = 0; i < 3; ++i) {
+        if (!(std::isfinite(bounds.min[i]) && std::isfinite(bounds.max[i]) &&
+              bounds.min[i] < bounds.max[i])) {
+            w.fail(objectsPath, "the objects lie too far out on axis " + std::to_string(i) +
+                                    " to pad default bounds around them (the margin is lost to "
+                                    "rounding or overflows); give \"bounds\" explicitly");
+        }
+    }
     return Scene(bounds, std::move(objects));
 }
 
@@ -234,6 +260,14 @@ void writeSceneJson(const Scene& scene, std::ostream& os) {
         } else {
             out += ", \"radius\": ";
             appendNumber(out, o.halfExtents.x);
+            // A sphere's orientation does not change its shape, but it is part of the object
+            // (a grasp turns it): written when it is not the identity, so the file reads back
+            // to the same scene.
+            if (o.rotation != Quat(1, 0, 0, 0)) {
+                const double q[4] = {o.rotation.w, o.rotation.x, o.rotation.y, o.rotation.z};
+                out += ", \"rotation\": ";
+                appendVec(out, q, 4);
+            }
         }
         out += ", \"stiffness\": ";
         appendNumber(out, o.material.stiffness);

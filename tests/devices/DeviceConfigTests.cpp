@@ -203,6 +203,22 @@ TEST_CASE("every bad input names the file and its JSON path") {
     }
 }
 
+TEST_CASE("a deeply nested wrong value is named by its type, not printed") {
+    // The message used to dump() the value, which recurses once per level: 12000 levels
+    // overflowed the stack under ASan (corpus crash-deep-version-dump.json).
+    const std::string deep = std::string(12000, '[') + std::string(12000, ']');
+    CHECK(errorOf(R"({"format": "hapto-devices", "version": )" + deep + R"(, "devices": []})") ==
+          "bad.json: version: this build reads version 1, got an array");
+    CHECK(errorOf(R"({"format": {"a": )" + deep + R"(}, "version": 1, "devices": []})") ==
+          "bad.json: format: expected \"hapto-devices\", got an object");
+    // A long wrong string is cut short.
+    const std::string e =
+        errorOf(R"({"format": ")" + std::string(5000, 'x') + R"(", "version": 1, "devices": []})");
+    CHECK_THAT(e, Catch::StartsWith("bad.json: format: expected \"hapto-devices\", got \"xxx"));
+    CHECK_THAT(e, Catch::EndsWith("xxx..."));
+    CHECK(e.size() < 200);
+}
+
 TEST_CASE("a missing file is refused with its name") {
     CHECK_THROWS_WITH(loadDeviceConfigFile("/nonexistent/d.json"),
                       Catch::Contains("/nonexistent/d.json: cannot open"));

@@ -122,6 +122,11 @@ TEST_CASE("trace: truncated and corrupt files are refused with the byte offset")
     CHECK_THAT(errorReading(p), Catch::Contains("t.trace: byte 888: truncated: the header "
                                                 "announces 10 samples"));
     fresh();
+    patch(p, 32, std::string("\xfe") + std::string(7, '\xff')); // 2^64 - 2 samples
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 928: truncated: the header announces "
+                                                "18446744073709551614 samples (more bytes than "
+                                                "a file can hold)"));
+    fresh();
     std::filesystem::resize_file(p, 50);
     CHECK_THAT(errorReading(p), Catch::Contains("byte 50: truncated: the header needs 128"));
     test::writeFile(p, "");

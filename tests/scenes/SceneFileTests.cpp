@@ -88,6 +88,20 @@ TEST_CASE("save then load gives the same scene, and ids need not be dense") {
     CHECK(loaded.slotOf(4000000000u) == 2u);
 }
 
+TEST_CASE("a sphere's rotation survives save and load") {
+    // Failed fuzz_scene_file's round-trip check (corpus crash-sphere-rotation-lost.json):
+    // spheres accept a "rotation" (a grasp turns them too) but the writer left it out.
+    const Scene original = parseScene(
+        withObject(
+            R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "rotation": [0, 1, 0, 0]})"),
+        "x.json");
+    REQUIRE(original.object(1).rotation == Quat(0, 1, 0, 0));
+    CHECK(parseScene(sceneToJson(original), "again.json") == original);
+    // An unturned sphere is written as before, without a rotation.
+    const Scene plain(Aabb{Vec3(-1), Vec3(1)}, {makeSphere(2, Vec3(0), 0.5)});
+    CHECK(sceneToJson(plain).find("rotation") == std::string::npos);
+}
+
 TEST_CASE("generated scenes round-trip through files bit for bit") {
     test::TempDir dir;
     RandomOptions opt;
@@ -127,6 +141,8 @@ TEST_CASE("every class of bad file is refused with the file, the JSON path and t
          R"({"format": "hapto-scene", "version": 1, "objects": [], "lights": []})",
          "unknown field 'lights'"},
         {"object not an object", withObject("42"), R"(objects\[1\]: expected an object)"},
+        {"array as an object", withObject("[1, 2]"),
+         R"(objects\[1\]: expected an object, got an array)"},
         {"missing id",
          withObject(R"({"shape": "box", "center": [0,0,0], "half_extents": [1,1,1]})"),
          R"(objects\[1\]: missing required field 'id')"},
@@ -191,6 +207,18 @@ TEST_CASE("every class of bad file is refused with the file, the JSON path and t
         {"bounds missing max",
          R"({"format": "hapto-scene", "version": 1, "bounds": {"min": [0,0,0]}, "objects": []})",
          R"(bounds: missing required field 'max')"},
+        // Found by fuzz_scene_file (corpus crash-default-bounds-collapse.json): 1 mm of margin
+        // is lost to rounding at 1e19 m, and the Scene threw std::invalid_argument.
+        {"objects too far out for default bounds",
+         R"({"format": "hapto-scene", "version": 1, "objects": [{"id": 1, "shape": "sphere", "center": [0, 0, 1e19], "radius": 1}]})",
+         R"(bad\.json: objects: the objects lie too far out on axis 2 .*give "bounds" explicitly)"},
+        {"default bounds overflow",
+         R"({"format": "hapto-scene", "version": 1, "objects": [{"id": 1, "shape": "sphere", "center": [1e308, 0, 0], "radius": 1}, {"id": 2, "shape": "sphere", "center": [-1e308, 0, 0], "radius": 1}]})",
+         R"(bad\.json: objects: the objects lie too far out on axis 0)"},
+        {"object reaching past the largest double",
+         withObject(
+             R"({"id": 1, "shape": "box", "center": [0, 1.7e308, 0], "half_extents": [1e308, 1, 1]})"),
+         R"(objects\[1\]: the object reaches past the largest finite coordinate)"},
     };
     for (const Case& c : cases) {
         INFO(c.name);
@@ -198,6 +226,18 @@ TEST_CASE("every class of bad file is refused with the file, the JSON path and t
         INFO(message);
         CHECK(std::regex_search(message, std::regex(c.expected)));
     }
+}
+
+TEST_CASE("a deeply nested wrong value is named by its type, not printed") {
+    // The message used to dump() the value, which recurses once per level: 12000 levels
+    // overflowed the stack under ASan (corpus crash-deep-version-dump.json).
+    const std::string deep = std::string(12000, '[') + std::string(12000, ']');
+    CHECK(errorOf(R"({"format": "hapto-scene", "version": )" + deep + R"(, "objects": []})") ==
+          "bad.json: version: this build reads version 1, got an array");
+    CHECK(errorOf(R"({"format": )" + deep + R"(, "version": 1, "objects": []})") ==
+          "bad.json: format: expected \"hapto-scene\", got an array");
+    CHECK(errorOf(R"({"format": "hapto-scene", "version": 1.5, "objects": []})") ==
+          "bad.json: version: this build reads version 1, got 1.5");
 }
 
 TEST_CASE("a missing file is named in the message") {

@@ -9,7 +9,8 @@
 // two bytes and scans the remaining stream for valid frames, skipping garbage byte by byte.
 // The device's flag byte has 8 bits but a frame byte carries one nibble, so it is read like the
 // words, least significant nibble first: byte 13 holds the buttons (bits 0-3), byte 14 the homed
-// flags (bits 4-6). Host commands put their flag nibble in byte 13 and 'A' (0) in byte 14.
+// flags (bits 4-6); its top bit (flag bit 7) has no known meaning and is carried through as is.
+// Host commands put their flag nibble in byte 13 and 'A' (0) in byte 14.
 // (Our reading of the protocol notes; to be confirmed on hardware.)
 // Invariant: every function here is pure or works on a fixed-size buffer; nothing allocates,
 // throws or reads outside the span it is given, whatever the input (these are fuzz targets).
@@ -50,6 +51,8 @@ struct FalconReading {
     std::array<std::int16_t, 3> encoder{}; ///< Encoder counts per motor.
     std::uint8_t buttons = 0;              ///< Grip buttons, bits 0-3.
     std::uint8_t homedMask = 0;            ///< Bit i set once motor i is homed, bits 0-2.
+    bool flagBit7 = false; ///< Bit 7 of the flag byte (top bit of byte 14), unused as far as we
+                           ///< know; kept so that a decoded frame re-encodes to its own bytes.
 
     /// True when all three motors report homed. [any thread]
     bool allHomed() const { return homedMask == 0x7; }

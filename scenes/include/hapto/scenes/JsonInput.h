@@ -58,6 +58,9 @@ std::string readFile(const std::filesystem::path& path, std::string_view what);
 std::string typeName(const Json& j);
 /// A number in shortest form for messages.
 std::string show(double v);
+/// A value for messages: a scalar as JSON text (a long string cut short), an array or object
+/// only by its type, so a deeply nested value cannot exhaust the stack (dump() recurses).
+std::string describe(const Json& j);
 
 /// A finite number.
 double number(const Source& s, const Json& j, const Path& path);
