@@ -464,7 +464,8 @@ void addSoakCommands(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--fault-every", a->faultEveryS,
                     "Inject a fault every this many seconds, into the hands in turn: disconnect "
-                    "(0.5 s), short stall, non-finite sample, long stall, read error (s)")
+                    "(0.5 s), stall of 0.4 watchdog timeouts (a miss, not a fault), non-finite "
+                    "sample, stall of 3 watchdog timeouts, read error (s)")
         ->capture_default_str()
         ->check(CLI::Range(0.1, 1e6));
     cmd->add_option("--window", a->windowS, "Report rate, drift, misses and memory per window (s)")
@@ -478,7 +479,8 @@ void addSoakCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(1.0, 60000.0));
     cmd->add_option("--memory-tolerance", a->memoryToleranceMiB,
-                    "Resident memory may grow this much after the first window (MiB)")
+                    "Resident memory may grow this much: median of the last third of the "
+                    "windows against the first third, the first window left out (MiB)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--report", a->report, "Write the JSON soak report here");
