@@ -283,6 +283,7 @@ SessionResult runSession(World& world, const std::vector<HandPlan>& hands,
     }
     RuntimeOptions options;
     options.realtime = settings.realtime;
+    options.reopenAfterNs = 0; // a fault spoils the measurement: the cell reports it
     Runtime runtime(world, std::move(devices), options);
     if (runtime.start() > 0) {
         const auto start = std::chrono::steady_clock::now();
