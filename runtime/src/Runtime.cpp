@@ -180,6 +180,7 @@ void Runtime::servoMain(Channel& ch) {
     Device& dev = *ch.rd.device;
     DeviceMetrics& m = ch.metrics;
     m.threadId.store(static_cast<int>(gettid()), std::memory_order_relaxed);
+    m.realtime.store(ch.grant.fifo, std::memory_order_relaxed);
     const WorkspaceTransform& xf = ch.rd.config.transform;
     const std::uint64_t period = ch.periodNs;
     const double dt = static_cast<double>(period) * 1e-9;
@@ -499,7 +500,7 @@ RunReport Runtime::report() const {
         d.contactTicks = m.contactTicks.load();
         d.snapshotsSeen = m.snapshotsSeen.load();
         d.safety = ch.safety.counters();
-        d.realtime = ch.grant.fifo;
+        d.realtime = m.realtime.load(std::memory_order_relaxed);
         const FaultKind f = m.fault.load();
         if (f == FaultKind::OpenFailed) {
             d.fault = std::string("open-failed: ") + ch.openError;

@@ -81,31 +81,48 @@ TEST_CASE("a servo thread starved by a CPU hog gets zero force when it runs agai
     REQUIRE(hands[0]->forceAfterGap() < 0.0);        // no 20 ms gap so far
 
     // The hog: FIFO 50 > the servo threads' 20, spinning 300 ms on device 0's core.
-    std::atomic<bool> hogging{false};
-    std::string hogError;
+    enum class Hog { Starting, Spinning, Done };
+    std::atomic<Hog> hogState{Hog::Starting};
+    std::string hogError; // written by the hog before Done, read after join
     std::thread hog([&] {
         hogError = becomeHog(0, 50);
-        if (!hogError.empty()) {
-            return;
+        if (hogError.empty()) {
+            hogState.store(Hog::Spinning);
+            const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
+            while (std::chrono::steady_clock::now() < end) {
+            }
         }
-        hogging.store(true);
-        const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
-        while (std::chrono::steady_clock::now() < end) {
-        }
-        hogging.store(false);
+        hogState.store(Hog::Done);
     });
-    while (!hogging.load() && hogError.empty() && hog.joinable() &&
-           std::chrono::steady_clock::now() < until) {
+    while (hogState.load() == Hog::Starting && std::chrono::steady_clock::now() < until) {
         std::this_thread::yield();
     }
     const std::uint64_t otherBefore = runtime.metrics(1).ticks.load();
-    // The control thread (this one, not pinned) runs on the other core meanwhile.
-    pump([&] { return !hogging.load(); });
+    // The control thread (this one) runs the watchdog on the other core meanwhile; pinned
+    // there, so the scheduler cannot leave it queued behind the hog.
+    cpu_set_t saved, other;
+    REQUIRE(pthread_getaffinity_np(pthread_self(), sizeof saved, &saved) == 0);
+    CPU_ZERO(&other);
+    CPU_SET(1, &other);
+    REQUIRE(pthread_setaffinity_np(pthread_self(), sizeof other, &other) == 0);
+    pump([&] { return hogState.load() == Hog::Done; });
     hog.join();
+    REQUIRE(pthread_setaffinity_np(pthread_self(), sizeof saved, &saved) == 0);
     REQUIRE(hogError.empty());
     const std::uint64_t otherAfter = runtime.metrics(1).ticks.load();
 
-    REQUIRE(pump([&] { return runtime.report().devices[0].reopens == 1; }));
+    const bool reopened = pump([&] { return runtime.report().devices[0].reopens == 1; });
+    if (!reopened) {
+        const RunReport now = runtime.report();
+        for (const DeviceReport& d : now.devices) {
+            UNSCOPED_INFO(d.name << ": ticks " << d.ticks << ", faults " << d.faults << ", fault '"
+                                 << d.fault << "', events " << d.events.size()
+                                 << (d.events.empty() ? "" : ", first: " + d.events[0]));
+        }
+        UNSCOPED_INFO("device 0 running " << runtime.metrics(0).running.load() << ", fault "
+                                          << faultName(runtime.metrics(0).fault.load()));
+    }
+    REQUIRE(reopened);
     REQUIRE(pump([&] { return runtime.metrics(0).ticks.load() > 0 && hands[0]->reads() >= 800; }));
     runtime.stop();
 

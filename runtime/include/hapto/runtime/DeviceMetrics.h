@@ -45,8 +45,9 @@ struct alignas(64) DeviceMetrics {
     std::atomic<std::uint8_t> faultStatus{0};      ///< The DeviceStatus behind a read/write fault.
     std::atomic<std::uint64_t> faultNs{0};         ///< Monotonic time of the fault (ns).
     std::atomic<bool> running{false};              ///< The servo loop is live.
-    std::atomic<int> threadId{0};    ///< Linux thread id of the servo thread (for chrt, taskset).
-    std::atomic<double> forceN[3]{}; ///< Last force sent, world frame (N), for the live view.
+    std::atomic<int> threadId{0};      ///< Linux thread id of the servo thread (for chrt, taskset).
+    std::atomic<bool> realtime{false}; ///< The servo thread was granted SCHED_FIFO.
+    std::atomic<double> forceN[3]{};   ///< Last force sent, world frame (N), for the live view.
     std::atomic<double> positionM[3]{}; ///< Last device point, world frame (m), for the live view.
 
     /// Adds to a counter; the servo thread is the only writer. [servo]
