@@ -78,13 +78,19 @@ struct Rig {
 } // namespace
 
 TEST_CASE("D devices tick, feel the cube, and the report agrees with what they saw") {
-    Rig rig(cubeScene(), 4, 2000.0);
+    // A sanitizer build under a parallel ctest can stall a thread for tens of ms: a generous
+    // watchdog here, and no reopen, so a real fault shows.
+    RuntimeOptions opt;
+    opt.stallTimeoutNs = 250'000'000;
+    opt.reopenAfterNs = 0;
+    Rig rig(cubeScene(), 4, 2000.0, {}, opt);
     rig.runFor(3000);
     const RunReport r = rig.runtime->report();
     REQUIRE(r.devices.size() == 4);
     for (std::size_t i = 0; i < 4; ++i) {
         const DeviceReport& d = r.devices[i];
-        INFO(d.name);
+        INFO(d.name << " fault '" << d.fault << "' missed " << d.missedDeadlines << " zeroed "
+                    << d.zeroedForMisses);
         CHECK(d.fault.empty());
         CHECK(d.ticks >= 3000);
         CHECK(d.ticks == rig.runtime->metrics(i).ticks.load());
