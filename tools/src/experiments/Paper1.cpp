@@ -133,13 +133,7 @@ int runPaper1(const Paper1Args& args) {
     }
     md += "\n### Max stable objects per renderer\n\n" +
           limitsTable(renderers, args.ratesHz, rows, args.verdict, "K");
-    md += "\nFiles: " + (out / "paper1.csv").string() + ", " + (out / "paper1.json").string();
-    for (const auto& p : plots) {
-        md += ", " + p.string();
-    }
-    md += "\n";
-    writeText(out / "paper1.md", md);
-    std::cout << md << std::flush;
+    finishSweepReport(out, "paper1", md, plots);
     return 0;
 }
 

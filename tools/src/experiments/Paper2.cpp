@@ -171,13 +171,7 @@ int runPaper2(const Paper2Args& args) {
     }
     md += "\n### Max stable objects per renderer (every scene stable)\n\n" +
           limitsTable(renderers, args.ratesHz, rows, args.verdict, "count");
-    md += "\nFiles: " + (out / "paper2.csv").string() + ", " + (out / "paper2.json").string();
-    for (const auto& p : plots) {
-        md += ", " + p.string();
-    }
-    md += "\n";
-    writeText(out / "paper2.md", md);
-    std::cout << md << std::flush;
+    finishSweepReport(out, "paper2", md, plots);
     return 0;
 }
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -585,6 +586,18 @@ writeSweepFiles(const std::filesystem::path& out, const std::string& name, Json 
     }
     writeText(out / (name + ".json"), j.dump(2) + "\n");
     return plotSweep(out, name, renderers, ratesHz, rows, progress);
+}
+
+void finishSweepReport(const std::filesystem::path& out, const std::string& name,
+                       std::string markdown, const std::vector<std::filesystem::path>& plots) {
+    markdown +=
+        "\nFiles: " + (out / (name + ".csv")).string() + ", " + (out / (name + ".json")).string();
+    for (const auto& p : plots) {
+        markdown += ", " + p.string();
+    }
+    markdown += "\n";
+    writeText(out / (name + ".md"), markdown);
+    std::cout << markdown << std::flush;
 }
 
 } // namespace hapto::experiments

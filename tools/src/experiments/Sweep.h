@@ -131,6 +131,11 @@ writeSweepFiles(const std::filesystem::path& out, const std::string& name, Json 
                 const std::vector<SweepRow>& rows, Verdict verdict, const std::string& sizeColumn,
                 Progress& progress);
 
+/// Appends the list of files written to `markdown`, writes it as NAME.md and prints it.
+/// [control]
+void finishSweepReport(const std::filesystem::path& out, const std::string& name,
+                       std::string markdown, const std::vector<std::filesystem::path>& plots);
+
 /// A load cell as the tables show it: "p50 / p99.9 / max" in %, or UNSTABLE/skipped marks.
 std::string loadCell(const SweepRow& row);
 
