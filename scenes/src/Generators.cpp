@@ -1,6 +1,7 @@
 #include "hapto/scenes/Generators.h"
 
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/JsonInput.h"
 #include "hapto/scenes/Random.h"
 
 #include <algorithm>
@@ -42,6 +43,25 @@ double distanceTo(const SceneObject& o, const Vec3& p) {
     return glm::length(glm::max(local - o.halfExtents, Vec3(0.0)));
 }
 
+// Refuses a length (m) that is NaN, infinite, out of its range or above kMaxGeneratedLength,
+// naming the generator and the option.
+void checkLength(const char* generator, const char* option, double v, bool zeroAllowed) {
+    if (!std::isfinite(v) || (zeroAllowed ? v < 0.0 : !(v > 0.0)) || v > kMaxGeneratedLength) {
+        throw InputError(std::string(generator) + " scene: " + option + " must be a finite " +
+                         (zeroAllowed ? "length >= 0" : "length > 0") + " of at most " +
+                         json::show(kMaxGeneratedLength) + " m, got " + json::show(v));
+    }
+}
+
+void checkCount(const char* generator, const char* option, double count) {
+    if (count > static_cast<double>(kMaxGeneratedObjects)) {
+        throw InputError(std::string(generator) + " scene: " + option + " asks for " +
+                         json::show(count) + " objects; a generated scene holds at most " +
+                         json::show(static_cast<double>(kMaxGeneratedObjects)) +
+                         " (about 110 bytes each in memory, 184 in the file)");
+    }
+}
+
 } // namespace
 
 Material generatedMaterial() {
@@ -52,9 +72,13 @@ Material generatedMaterial() {
 }
 
 Scene makeLatticeScene(const LatticeOptions& opt) {
-    if (opt.perSide < 1 || !(opt.cubeSize > 0.0) || !(opt.gap >= 0.0)) {
-        throw InputError("lattice scene: need per-side >= 1, size > 0 and gap >= 0");
+    if (opt.perSide < 1) {
+        throw InputError("lattice scene: --per-side must be >= 1, got " +
+                         std::to_string(opt.perSide));
     }
+    checkCount("lattice", "--per-side (cubed)", std::pow(static_cast<double>(opt.perSide), 3));
+    checkLength("lattice", "--size", opt.cubeSize, false);
+    checkLength("lattice", "--gap", opt.gap, true);
     const double pitch = opt.cubeSize + opt.gap;
     const int k = opt.perSide;
     std::vector<SceneObject> objects;
@@ -71,13 +95,19 @@ Scene makeLatticeScene(const LatticeOptions& opt) {
             }
         }
     }
-    const double half = quantise(0.5 * k * pitch);
+    // At least 1 µm: a lattice smaller than the rounding would otherwise get empty bounds.
+    const double half = std::max(quantise(0.5 * k * pitch), 1e-6);
     return Scene({Vec3(-half), Vec3(half)}, std::move(objects));
 }
 
 Scene makeRandomScene(const RandomOptions& opt) {
-    if (!(opt.workspace > 0.0) || !(opt.cubeSize > 0.0) || opt.cubeSize >= opt.workspace) {
-        throw InputError("random scene: need 0 < size < workspace");
+    checkCount("random", "--count", static_cast<double>(opt.count));
+    checkLength("random", "--workspace", opt.workspace, false);
+    checkLength("random", "--size", opt.cubeSize, false);
+    checkLength("random", "--keep-clear", opt.keepClear, true);
+    if (opt.cubeSize >= opt.workspace) {
+        throw InputError("random scene: need --size < --workspace, got " +
+                         json::show(opt.cubeSize) + " and " + json::show(opt.workspace));
     }
     Random rng(opt.seed);
     std::vector<SceneObject> objects;
@@ -108,9 +138,18 @@ Scene makeRandomScene(const RandomOptions& opt) {
 }
 
 Scene makeClusterScene(const ClusterOptions& opt) {
-    if (opt.clusters < 1 || !(opt.workspace > 0.0) || !(opt.cubeSize > 0.0) ||
-        opt.cubeSize >= opt.workspace || !(opt.spread >= 0.0)) {
-        throw InputError("cluster scene: need clusters >= 1, 0 < size < workspace, spread >= 0");
+    checkCount("cluster", "--count", static_cast<double>(opt.count));
+    if (opt.clusters < 1) {
+        throw InputError("cluster scene: --clusters must be >= 1, got " +
+                         std::to_string(opt.clusters));
+    }
+    checkCount("cluster", "--clusters", static_cast<double>(opt.clusters));
+    checkLength("cluster", "--workspace", opt.workspace, false);
+    checkLength("cluster", "--size", opt.cubeSize, false);
+    checkLength("cluster", "--spread", opt.spread, true);
+    if (opt.cubeSize >= opt.workspace) {
+        throw InputError("cluster scene: need --size < --workspace, got " +
+                         json::show(opt.cubeSize) + " and " + json::show(opt.workspace));
     }
     Random rng(opt.seed);
     const double w = 0.5 * opt.workspace;

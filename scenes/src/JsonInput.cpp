@@ -1,11 +1,13 @@
 #include "hapto/scenes/JsonInput.h"
 
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/InputFile.h"
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
+#include <unordered_set>
+#include <vector>
 
 namespace hapto::json {
 
@@ -44,10 +46,106 @@ std::pair<std::size_t, std::size_t> lineColumn(std::string_view text, std::size_
 
 } // namespace
 
+namespace {
+
+// Refuses a key that appears twice in one object (nlohmann would keep the last one silently),
+// naming the JSON path of the object. It follows the parser's callback events: a frame per open
+// object or array, holding the keys seen so far (an object) or the index of the element being
+// read (an array). Depths as nlohmann reports them: a container's start and end, and a scalar,
+// at the value's own depth (the document is depth 0); a key at its object's depth + 1. Every
+// event must be seen, so the wrapped callback must not discard a container at its start or a
+// key (events inside are then not reported); discarding at the end, as the scene loader does,
+// is fine.
+class DuplicateKeyCheck {
+public:
+    explicit DuplicateKeyCheck(const Source& source) : mSource(source) {}
+
+    void onEvent(Json::parse_event_t event, const Json& parsed) {
+        switch (event) {
+        case Json::parse_event_t::object_start:
+        case Json::parse_event_t::array_start:
+            mFrames.push_back(Frame{event == Json::parse_event_t::object_start, 0, {}, {}, {}});
+            return;
+        case Json::parse_event_t::key:
+            if (!mFrames.empty() && mFrames.back().object) {
+                addKey(parsed.get_ref<const std::string&>());
+            }
+            return;
+        case Json::parse_event_t::object_end:
+        case Json::parse_event_t::array_end:
+            if (!mFrames.empty()) {
+                mFrames.pop_back();
+            }
+            elementDone();
+            return;
+        case Json::parse_event_t::value:
+            elementDone();
+            return;
+        }
+    }
+
+private:
+    struct Frame {
+        bool object = false;
+        long index = 0;                       // array: the element being read
+        std::string key;                      // object: the field being read
+        std::vector<std::string> keys;        // object: keys so far (few: a linear search)
+        std::unordered_set<std::string> many; // object: all keys, once there are many
+    };
+    static constexpr std::size_t kLinearKeys = 32;
+
+    void elementDone() {
+        if (!mFrames.empty() && !mFrames.back().object) {
+            ++mFrames.back().index;
+        }
+    }
+
+    void addKey(const std::string& key) {
+        Frame& f = mFrames.back();
+        bool seen = false;
+        if (f.many.empty()) {
+            seen = std::find(f.keys.begin(), f.keys.end(), key) != f.keys.end();
+            if (!seen) {
+                f.keys.push_back(key);
+                if (f.keys.size() > kLinearKeys) {
+                    f.many.insert(f.keys.begin(), f.keys.end());
+                    f.keys.clear();
+                }
+            }
+        } else {
+            seen = !f.many.insert(key).second;
+        }
+        if (seen) {
+            std::string path;
+            for (std::size_t i = 0; i + 1 < mFrames.size(); ++i) {
+                const Frame& up = mFrames[i];
+                path += up.object ? (path.empty() ? "" : ".") + up.key
+                                  : "[" + std::to_string(up.index) + "]";
+            }
+            throw InputError(std::string(mSource.name()) + ": " +
+                             (path.empty() ? "(top level)" : path) + ": duplicate field '" + key +
+                             "' (each field may appear once; JSON readers differ on which copy "
+                             "they keep)");
+        }
+        f.key = key;
+    }
+
+    const Source& mSource;
+    std::vector<Frame> mFrames;
+};
+
+} // namespace
+
 Json parseText(std::string_view text, const Source& source,
                const Json::parser_callback_t& callback) {
+    DuplicateKeyCheck duplicates(source);
+    const Json::parser_callback_t checked = [&](int depth, Json::parse_event_t event,
+                                                Json& parsed) {
+        duplicates.onEvent(event, parsed);
+        return callback ? callback(depth, event, parsed) : true;
+    };
     try {
-        return Json::parse(text.begin(), text.end(), callback);
+        return Json::parse(text.begin(), text.end(), checked);
     } catch (const Json::parse_error& e) {
         const auto [line, col] = lineColumn(text, e.byte == 0 ? 0 : e.byte - 1);
         std::string what = e.what();
@@ -63,24 +161,7 @@ Json parseText(std::string_view text, const Source& source,
 }
 
 std::string readFile(const std::filesystem::path& path, std::string_view what) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        throw InputError(path.string() + ": cannot open the " + std::string(what) +
-                         " (does it exist?)");
-    }
-    std::string text;
-    in.seekg(0, std::ios::end);
-    const auto size = in.tellg();
-    if (size < 0) {
-        throw InputError(path.string() + ": cannot read the " + std::string(what));
-    }
-    text.resize(static_cast<std::size_t>(size));
-    in.seekg(0);
-    in.read(text.data(), size);
-    if (!in) {
-        throw InputError(path.string() + ": cannot read the " + std::string(what));
-    }
-    return text;
+    return InputFile(path, what).readAll();
 }
 
 std::string typeName(const Json& j) {

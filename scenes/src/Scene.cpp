@@ -1,6 +1,7 @@
 #include "hapto/scenes/Scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -14,6 +15,10 @@ Scene::Scene(Aabb bounds, std::vector<SceneObject> objects)
     if (!(bounds.min.x < bounds.max.x && bounds.min.y < bounds.max.y &&
           bounds.min.z < bounds.max.z)) {
         throw std::invalid_argument("scene bounds must have min < max on every axis");
+    }
+    const Vec3 size = bounds.max - bounds.min;
+    if (!std::isfinite(size.x) || !std::isfinite(size.y) || !std::isfinite(size.z)) {
+        throw std::invalid_argument("scene bounds must have a finite size on every axis");
     }
     if (mObjects.size() >= std::numeric_limits<std::uint32_t>::max()) {
         throw std::invalid_argument("a scene holds at most 2^32 - 1 objects");

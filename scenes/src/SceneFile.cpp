@@ -12,6 +12,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <span>
 #include <sstream>
 
 namespace hapto {
@@ -55,7 +56,8 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path) {
     }
     o.center = vec3(w, required(w, j, path, "center"), path / "center");
     // The bounding box must be finite too: a box reaches at most the sum of its half extents
-    // from its centre along any axis, whatever its rotation.
+    // from its centre along any axis, whatever its rotation. (Its size, and its distance from
+    // the bounds, are checked once the bounds are known: checkSpan.)
     const double reach = o.shape == Shape::Sphere
                              ? o.halfExtents.x
                              : o.halfExtents.x + o.halfExtents.y + o.halfExtents.z;
@@ -70,14 +72,15 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path) {
         o.rotation = quaternion(w, *v, path / "rotation");
     }
     if (const Json* v = optional(j, "stiffness")) {
-        o.material.stiffness =
-            ranged(w, *v, path / "stiffness", 0.0, kUnbounded, true, "stiffness (N/m)");
+        o.material.stiffness = ranged(w, *v, path / "stiffness", 0.0, Material::kMaxStiffness, true,
+                                      "stiffness (N/m)");
     }
     if (const Json* v = optional(j, "friction")) {
         const Path fp = path / "friction";
         const auto f = numbers<2>(w, *v, fp);
         for (std::size_t i = 0; i < 2; ++i) {
-            checkRange(w, f[i], fp[i], 0.0, kUnbounded, false, "a friction coefficient");
+            checkRange(w, f[i], fp[i], 0.0, Material::kMaxFriction, false,
+                       "a friction coefficient");
         }
         if (f[1] > f[0]) {
             w.fail(fp, "the dynamic coefficient (second) must not exceed the static one (first)");
@@ -99,8 +102,32 @@ Aabb parseBounds(const Source& w, const Json& j, const Path& path) {
         if (!(b.min[i] < b.max[i])) {
             w.fail(path, "min must be < max on every axis (axis " + std::to_string(i) + ")");
         }
+        if (!std::isfinite(b.max[i] - b.min[i])) {
+            w.fail(path, "the bounds are too large: max - min overflows on axis " +
+                             std::to_string(i) + " (" + show(b.min[i]) + " .. " + show(b.max[i]) +
+                             "); every size must be a finite number of metres");
+        }
     }
     return b;
+}
+
+// Every distance an index computes between an object and the bounds must be finite: refuses
+// the first object whose AABB, together with the bounds, spans an overflowing size.
+void checkSpan(const Source& w, const Aabb& bounds, std::span<const SceneObject> objects,
+               const Path& objectsPath) {
+    for (std::size_t k = 0; k < objects.size(); ++k) {
+        const Aabb box = objects[k].aabb();
+        for (int i = 0; i < 3; ++i) {
+            const double lo = std::min(box.min[i], bounds.min[i]);
+            const double hi = std::max(box.max[i], bounds.max[i]);
+            if (!std::isfinite(hi - lo)) {
+                w.fail(objectsPath[k], "the object lies too far from the bounds: the space "
+                                       "spanning both overflows on axis " +
+                                           std::to_string(i) + " (" + show(lo) + " .. " + show(hi) +
+                                           ")");
+            }
+        }
+    }
 }
 
 void appendNumber(std::string& out, double v) {
@@ -202,7 +229,9 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
 
     const Json* boundsJson = optional(root, "bounds");
     if (boundsJson) {
-        return Scene(parseBounds(w, *boundsJson, top / "bounds"), std::move(objects));
+        const Aabb bounds = parseBounds(w, *boundsJson, top / "bounds");
+        checkSpan(w, bounds, objects, objectsPath);
+        return Scene(bounds, std::move(objects));
     }
     // Default bounds pad the objects' union by 5 % (at least 1 mm). Far enough from the origin
     // that margin is lost to rounding or overflows; refuse here, with the file and the reason,
@@ -210,7 +239,7 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
     const Aabb bounds = Scene::defaultBounds(objects);
     for (int i = 0; i < 3; ++i) {
         if (!(std::isfinite(bounds.min[i]) && std::isfinite(bounds.max[i]) &&
-              bounds.min[i] < bounds.max[i])) {
+              std::isfinite(bounds.max[i] - bounds.min[i]) && bounds.min[i] < bounds.max[i])) {
             w.fail(objectsPath, "the objects lie too far out on axis " + std::to_string(i) +
                                     " to pad default bounds around them (the margin is lost to "
                                     "rounding or overflows); give \"bounds\" explicitly");

@@ -4,6 +4,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <limits>
+
 using namespace hapto;
 
 TEST_CASE("a lattice has K^3 cubes with gaps, inside bounds a little larger") {
@@ -77,4 +80,75 @@ TEST_CASE("a keep-clear region larger than the work cube is refused") {
     opt.count = 10;
     opt.keepClear = 1.0;
     CHECK_THROWS_AS(makeRandomScene(opt), InputError);
+}
+
+TEST_CASE("generators refuse lengths that would write non-finite numbers, naming the option") {
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    LatticeOptions lattice;
+    lattice.cubeSize = 1e308;
+    lattice.gap = 1e308; // size + gap overflows
+    CHECK_THROWS_WITH(makeLatticeScene(lattice),
+                      "lattice scene: --size must be a finite length > 0 of at most 1e+06 m, "
+                      "got 1e+308");
+    lattice = {};
+    lattice.gap = inf;
+    CHECK_THROWS_WITH(makeLatticeScene(lattice), Catch::StartsWith("lattice scene: --gap must"));
+    lattice = {};
+    lattice.gap = nan;
+    CHECK_THROWS_AS(makeLatticeScene(lattice), InputError);
+
+    RandomOptions random;
+    random.count = 10;
+    random.workspace = 1e308; // 1 µm rounding of such coordinates overflows
+    CHECK_THROWS_WITH(makeRandomScene(random), Catch::StartsWith("random scene: --workspace"));
+    random = {};
+    random.count = 10;
+    random.keepClear = nan;
+    CHECK_THROWS_WITH(makeRandomScene(random), Catch::StartsWith("random scene: --keep-clear"));
+
+    ClusterOptions cluster;
+    cluster.count = 10;
+    cluster.spread = inf;
+    CHECK_THROWS_WITH(makeClusterScene(cluster), Catch::StartsWith("cluster scene: --spread"));
+    cluster = {};
+    cluster.count = 10;
+    cluster.cubeSize = -1.0;
+    CHECK_THROWS_WITH(makeClusterScene(cluster), Catch::StartsWith("cluster scene: --size"));
+
+    // The largest allowed lengths give finite scenes.
+    lattice = {};
+    lattice.perSide = 2;
+    lattice.cubeSize = kMaxGeneratedLength;
+    lattice.gap = kMaxGeneratedLength;
+    const Scene big = makeLatticeScene(lattice);
+    for (const SceneObject& o : big.objects()) {
+        CHECK(std::isfinite(o.center.x + o.center.y + o.center.z));
+    }
+    CHECK(std::isfinite(big.bounds().max.x - big.bounds().min.x));
+}
+
+TEST_CASE("impossible counts are refused before anything is allocated") {
+    RandomOptions random;
+    random.count = 4'000'000'000; // 448 GB of objects: must fail at once, not in reserve()
+    CHECK_THROWS_WITH(makeRandomScene(random),
+                      Catch::StartsWith("random scene: --count asks for 4e+09 objects; a "
+                                        "generated scene holds at most 1e+08"));
+    ClusterOptions cluster;
+    cluster.count = kMaxGeneratedObjects + 1;
+    CHECK_THROWS_WITH(makeClusterScene(cluster), Catch::StartsWith("cluster scene: --count"));
+    LatticeOptions lattice;
+    lattice.perSide = 465; // 465^3 > 10^8
+    CHECK_THROWS_WITH(makeLatticeScene(lattice),
+                      Catch::StartsWith("lattice scene: --per-side (cubed) asks for"));
+}
+
+TEST_CASE("a lattice smaller than the 1 um rounding still gets non-empty bounds") {
+    LatticeOptions lattice;
+    lattice.perSide = 1;
+    lattice.cubeSize = 1e-7;
+    lattice.gap = 0.0;
+    const Scene s = makeLatticeScene(lattice);
+    CHECK(s.bounds().max.x == 1e-6);
+    CHECK(s.bounds().min.x == -1e-6);
 }

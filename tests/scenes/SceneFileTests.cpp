@@ -1,5 +1,6 @@
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/InputFile.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include "TestSupport.h"
@@ -7,6 +8,10 @@
 #include <catch2/catch.hpp>
 
 #include <regex>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
 
 using namespace hapto;
 
@@ -215,6 +220,40 @@ TEST_CASE("every class of bad file is refused with the file, the JSON path and t
         {"default bounds overflow",
          R"({"format": "hapto-scene", "version": 1, "objects": [{"id": 1, "shape": "sphere", "center": [1e308, 0, 0], "radius": 1}, {"id": 2, "shape": "sphere", "center": [-1e308, 0, 0], "radius": 1}]})",
          R"(bad\.json: objects: the objects lie too far out on axis 0)"},
+        {"stiffness that would overflow a force",
+         withObject(
+             R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "stiffness": 1e200})"),
+         R"(bad\.json: objects\[1\]\.stiffness: stiffness \(N/m\) must be <= 1e\+06 \(got 1e\+200\))"},
+        {"stiffness just above the limit",
+         withObject(
+             R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "stiffness": 1000001})"),
+         R"(objects\[1\]\.stiffness: stiffness \(N/m\) must be <= 1e\+06)"},
+        {"friction that would overflow",
+         withObject(
+             R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "friction": [1e300, 0]})"),
+         R"(objects\[1\]\.friction\[0\]: a friction coefficient must be <= 10)"},
+        {"bounds whose size overflows",
+         R"({"format": "hapto-scene", "version": 1, "bounds": {"min": [-1e308, 0, 0], "max": [1e308, 1, 1]}, "objects": []})",
+         R"(bad\.json: bounds: the bounds are too large: max - min overflows on axis 0)"},
+        {"object too far from explicit bounds",
+         R"({"format": "hapto-scene", "version": 1, "bounds": {"min": [-1e308, 0, 0], "max": [0, 1, 1]}, "objects": [{"id": 4, "shape": "sphere", "center": [0, 0, 0], "radius": 1}, {"id": 5, "shape": "sphere", "center": [1e308, 0, 0], "radius": 1}]})",
+         R"(bad\.json: objects\[1\]: the object lies too far from the bounds: .* overflows on axis 0)"},
+        {"sphere whose own size overflows",
+         R"({"format": "hapto-scene", "version": 1, "bounds": {"min": [0, 0, 0], "max": [1, 1, 1]}, "objects": [{"id": 4, "shape": "sphere", "center": [0, 0, 0], "radius": 1e308}]})",
+         R"(bad\.json: objects\[0\]: the object lies too far from the bounds)"},
+        {"duplicate top-level key",
+         R"({"format": "hapto-scene", "version": 1, "version": 1, "objects": []})",
+         R"(bad\.json: \(top level\): duplicate field 'version')"},
+        {"duplicate key in an object",
+         withObject(
+             R"({"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "stiffness": 900, "stiffness": 1})"),
+         R"(bad\.json: objects\[1\]: duplicate field 'stiffness')"},
+        {"duplicate key in the bounds",
+         R"({"format": "hapto-scene", "version": 1, "bounds": {"min": [0,0,0], "max": [1,1,1], "min": [-1,-1,-1]}, "objects": []})",
+         R"(bad\.json: bounds: duplicate field 'min')"},
+        {"duplicate key deep inside",
+         R"({"format": "hapto-scene", "version": 1, "objects": [], "x": [[1, {"a": 1}], [2, {"b": 1, "b": 2}]]})",
+         R"(bad\.json: x\[1\]\[1\]: duplicate field 'b')"},
         {"object reaching past the largest double",
          withObject(
              R"({"id": 1, "shape": "box", "center": [0, 1.7e308, 0], "half_extents": [1e308, 1, 1]})"),
@@ -243,4 +282,99 @@ TEST_CASE("a deeply nested wrong value is named by its type, not printed") {
 TEST_CASE("a missing file is named in the message") {
     CHECK_THROWS_WITH(loadSceneFile("/nonexistent/scene.json"),
                       Catch::Contains("/nonexistent/scene.json") && Catch::Contains("cannot open"));
+}
+
+TEST_CASE("the same key in two different objects is no duplicate") {
+    const Scene s = parseScene(
+        R"({"format": "hapto-scene", "version": 1, "objects": [
+            {"id": 1, "shape": "sphere", "center": [0,0,0], "radius": 1, "stiffness": 900},
+            {"id": 2, "shape": "sphere", "center": [0,0,0], "radius": 1, "stiffness": 1e6}]})",
+        "ok.json");
+    REQUIRE(s.size() == 2);
+    CHECK(s.object(1).material.stiffness == 1e6); // the limit itself is allowed
+}
+
+TEST_CASE("an object with many fields is checked for duplicates past the short list") {
+    std::string fields;
+    for (int i = 0; i < 100; ++i) {
+        fields += "\"k" + std::to_string(i) + "\": 1, ";
+    }
+    const std::string text = R"({"format": "hapto-scene", "version": 1, "objects": [], "x": {)" +
+                             fields + R"("k7": 2}})";
+    CHECK(errorOf(text) == "bad.json: x: duplicate field 'k7' (each field may appear once; JSON "
+                           "readers differ on which copy they keep)");
+    // Without the repeat only the unknown top-level field is refused.
+    const std::string ok = R"({"format": "hapto-scene", "version": 1, "objects": [], "x": {)" +
+                           fields + R"("k100": 2}})";
+    CHECK_THAT(errorOf(ok), Catch::Contains("unknown field 'x'"));
+}
+
+namespace {
+
+std::string loadError(const std::filesystem::path& path) {
+    try {
+        loadSceneFile(path);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+} // namespace
+
+TEST_CASE("special files are refused at once, naming what they are") {
+    test::TempDir dir;
+    CHECK(loadError(dir.path()) ==
+          dir.path().string() +
+              ": is a directory, not a regular file (give the scene file as a file on disk)");
+
+    // A FIFO with no writer: opening it for reading would block; it must be refused at once.
+    const auto fifo = dir / "scene.fifo";
+    REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+    CHECK_THAT(loadError(fifo),
+               Catch::StartsWith(fifo.string() + ": is a FIFO, not a regular file"));
+
+    CHECK_THAT(loadError("/dev/zero"),
+               Catch::StartsWith("/dev/zero: is a character device, not a regular file"));
+
+    // A process substitution: /dev/fd/N naming a pipe, here with a writer that never ends.
+    int fds[2];
+    REQUIRE(::pipe(fds) == 0);
+    const std::string byFd = "/dev/fd/" + std::to_string(fds[0]);
+    CHECK_THAT(loadError(byFd), Catch::StartsWith(byFd + ": is a FIFO, not a regular file"));
+    ::close(fds[0]);
+    ::close(fds[1]);
+
+    // A socket cannot even be opened; it is still named for what it is.
+    const auto sock = dir / "s.sock";
+    const int sfd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    REQUIRE(sfd >= 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", sock.c_str());
+    if (sock.string().size() < sizeof addr.sun_path &&
+        ::bind(sfd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0) {
+        CHECK_THAT(loadError(sock), Catch::StartsWith(sock.string() + ": is a socket"));
+    }
+    ::close(sfd);
+
+    // A symbolic link to a regular file is followed.
+    const auto real = dir / "real.json";
+    test::writeFile(real, R"({"format": "hapto-scene", "version": 1, "objects": []})");
+    std::filesystem::create_symlink(real, dir / "link.json");
+    CHECK(loadSceneFile(dir / "link.json").size() == 0);
+}
+
+TEST_CASE("input files are read whole up to a size limit, and refused above it") {
+    test::TempDir dir;
+    const auto path = dir / "ten.txt";
+    test::writeFile(path, "0123456789");
+    CHECK(InputFile(path, "test file", 10).readAll() == "0123456789");
+    CHECK(InputFile(path, "test file").size() == 10);
+    CHECK_THROWS_WITH(InputFile(path, "test file", 9),
+                      Catch::StartsWith(path.string() + ": the test file is 10 bytes, more than "
+                                                        "the 9 bytes limit for input files"));
+    // Files that report size 0 (as /proc does) are still read to their end.
+    CHECK_THAT(InputFile("/proc/self/status", "test file").readAll(), Catch::Contains("Name:"));
+    CHECK(kMaxInputFileBytes == std::uint64_t(4) << 30);
 }

@@ -8,6 +8,14 @@
 
 namespace hapto {
 
+/// The most objects a generator makes: 10^8 (about 11 GB of objects in memory, 18 GB of scene
+/// file). Larger counts are refused before anything is allocated.
+inline constexpr std::size_t kMaxGeneratedObjects = 100'000'000;
+/// The largest length a generator takes (m): 10^6. Every generated coordinate then stays far
+/// from overflow (and from losing the 1 µm rounding); larger, NaN or infinite lengths are
+/// refused.
+inline constexpr double kMaxGeneratedLength = 1e6;
+
 /// The material generated scenes use: default stiffness, mu_s 0.3, mu_d 0.2.
 Material generatedMaterial();
 
@@ -17,7 +25,9 @@ struct LatticeOptions {
     double cubeSize = 0.05; ///< Cube edge (m); the paper's e-Touch boxes are 5 cm.
     double gap = 0.01;      ///< Free space between neighbouring cubes (m).
 };
-/// Bounds are the lattice padded by half a gap on every side. [control]
+/// Bounds are the lattice padded by half a gap on every side (at least 1 µm from the centre).
+/// Throws InputError, naming the option, for K < 1, K^3 > kMaxGeneratedObjects, or a length
+/// that is not finite, out of range or above kMaxGeneratedLength. [control]
 Scene makeLatticeScene(const LatticeOptions& options);
 
 /// Experiment 2: cubes placed uniformly at random in a work cube centred on the origin.
@@ -29,7 +39,8 @@ struct RandomOptions {
     bool rotate = false;     ///< Give each cube a uniformly random orientation.
     double keepClear = 0.0;  ///< No object within this distance of the centre (m).
 };
-/// Bounds are the work cube. Throws InputError when keepClear leaves no room. [control]
+/// Bounds are the work cube. Throws InputError when keepClear leaves no room, and for the
+/// counts and lengths makeLatticeScene refuses. [control]
 Scene makeRandomScene(const RandomOptions& options);
 
 /// A strongly non-uniform scene: cubes in Gaussian clusters.
@@ -42,7 +53,8 @@ struct ClusterOptions {
     double spread = 0.01;     ///< Standard deviation of each cluster (m).
     bool rotate = false;      ///< Random orientations.
 };
-/// Bounds are the work cube. [control]
+/// Bounds are the work cube. Throws InputError for the counts and lengths makeLatticeScene
+/// refuses, and for clusters < 1 or > kMaxGeneratedObjects. [control]
 Scene makeClusterScene(const ClusterOptions& options);
 
 /// The two-handed grasp demo (y is up; the floor is the bounds' lowest y, -0.10 m): a rubbery

@@ -47,11 +47,14 @@ private:
     std::string_view mName;
 };
 
-/// Parses JSON text; a syntax error becomes "name:line:column: not valid JSON: ...".
-/// `callback` is nlohmann's parser callback (may be empty). [control]
+/// Parses JSON text; a syntax error becomes "name:line:column: not valid JSON: ...", and a key
+/// repeated in one object "name: path: duplicate field 'key' ...". `callback` is nlohmann's
+/// parser callback (may be empty); it must not discard a container at its start or a key
+/// (discarding at the end is fine). [control]
 Json parseText(std::string_view text, const Source& source,
                const Json::parser_callback_t& callback = nullptr);
-/// Reads a whole file; throws InputError naming it when it cannot be opened or read. [control]
+/// Reads a whole regular file of at most kMaxInputFileBytes (InputFile.h); throws InputError
+/// naming it when it cannot be opened or read, or is a directory, FIFO, device... [control]
 std::string readFile(const std::filesystem::path& path, std::string_view what);
 
 /// "a number", "an integer", "a string", "an array", ... for messages.

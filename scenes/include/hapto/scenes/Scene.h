@@ -17,8 +17,8 @@ class Scene {
 public:
     /// An empty scene over the paper's 25 cm work cube.
     Scene();
-    /// Takes the objects; throws std::invalid_argument on a duplicate id, an empty bounds box,
-    /// or more objects than 32-bit slots allow. [control]
+    /// Takes the objects; throws std::invalid_argument on a duplicate id, an empty bounds box
+    /// or one whose size overflows, or more objects than 32-bit slots allow. [control]
     Scene(Aabb bounds, std::vector<SceneObject> objects);
 
     /// The partitioned space (m). Objects may reach outside it. [any thread]

@@ -24,6 +24,13 @@ std::string_view shapeName(Shape shape);
 struct Material {
     /// Default surface stiffness (N/m): firm but well inside what a PHANToM 1.0 renders stably.
     static constexpr double kDefaultStiffness = 800.0;
+    /// Largest stiffness a scene file may give (N/m): 10^6, far above what any desktop device
+    /// renders stably (a PHANToM Premium manages a few thousand N/m), low enough that k times
+    /// any penetration inside a scene stays a finite force for ForceSafety to clamp.
+    static constexpr double kMaxStiffness = 1e6;
+    /// Largest Coulomb coefficient a scene file may give: 10 (real materials stay below about
+    /// 2; rubber on rubber); the friction cone's radius mu * |F| then stays finite.
+    static constexpr double kMaxFriction = 10.0;
 
     double stiffness = kDefaultStiffness; ///< Surface stiffness k (N/m), > 0.
     double staticFriction = 0.0;          ///< Coulomb static coefficient mu_s (unitless), >= 0.
