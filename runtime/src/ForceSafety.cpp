@@ -1,5 +1,6 @@
 #include "hapto/runtime/ForceSafety.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -33,6 +34,7 @@ ForceSafety::ForceSafety(const ForceSafety& other) noexcept
     mClamped.store(c.clamped, std::memory_order_relaxed);
     mRateLimited.store(c.rateLimited, std::memory_order_relaxed);
     mNonFinite.store(c.nonFinite, std::memory_order_relaxed);
+    mOverflowed.store(c.overflowed, std::memory_order_relaxed);
 }
 
 ForceSafety& ForceSafety::operator=(const ForceSafety& other) noexcept {
@@ -44,27 +46,43 @@ ForceSafety& ForceSafety::operator=(const ForceSafety& other) noexcept {
         mClamped.store(c.clamped, std::memory_order_relaxed);
         mRateLimited.store(c.rateLimited, std::memory_order_relaxed);
         mNonFinite.store(c.nonFinite, std::memory_order_relaxed);
+        mOverflowed.store(c.overflowed, std::memory_order_relaxed);
     }
     return *this;
 }
 
 Vec3 ForceSafety::filter(const Vec3& forceN) noexcept {
     bump(mFiltered);
-    if (!isFinite(forceN)) {
-        bump(mNonFinite);
-        mLast = Vec3(0.0);
-        return mLast;
-    }
     Vec3 f = forceN;
-    const double magnitude = glm::length(f);
-    if (!std::isfinite(magnitude)) { // components finite but the length overflows
-        bump(mNonFinite);
-        mLast = Vec3(0.0);
-        return mLast;
-    }
-    if (magnitude > mConfig.maxForceN) {
-        f *= mConfig.maxForceN / magnitude;
+    if (!isFinite(f)) {
+        const bool anyNan = std::isnan(f.x) || std::isnan(f.y) || std::isnan(f.z);
+        if (anyNan) { // no direction: nothing safe to send but zero
+            bump(mNonFinite);
+            mLast = Vec3(0.0);
+            return mLast;
+        }
+        // An overflow (k times a penetration beyond double range): the direction is that of
+        // the infinite components, so the force is the maximum that way, not zero, which would
+        // drop the hardest wall of all.
+        f = Vec3(std::isinf(f.x) ? std::copysign(1.0, f.x) : 0.0,
+                 std::isinf(f.y) ? std::copysign(1.0, f.y) : 0.0,
+                 std::isinf(f.z) ? std::copysign(1.0, f.z) : 0.0);
+        f *= mConfig.maxForceN / glm::length(f);
+        bump(mOverflowed);
         bump(mClamped);
+    } else {
+        const double magnitude = glm::length(f);
+        if (!std::isfinite(magnitude)) {
+            // Finite components whose length overflows: scale down first, then clamp.
+            const double largest = std::max({std::abs(f.x), std::abs(f.y), std::abs(f.z)});
+            const Vec3 direction = f / largest;
+            f = direction * (mConfig.maxForceN / glm::length(direction));
+            bump(mOverflowed);
+            bump(mClamped);
+        } else if (magnitude > mConfig.maxForceN) {
+            f *= mConfig.maxForceN / magnitude;
+            bump(mClamped);
+        }
     }
     // Both mLast and f lie in the ball of radius maxForceN, so any point between them does too.
     // A release (a smaller force, not reversed) passes at once: letting go is never the danger,
@@ -91,7 +109,8 @@ void ForceSafety::reset() noexcept {
 SafetyCounters ForceSafety::counters() const noexcept {
     return {mFiltered.load(std::memory_order_relaxed), mClamped.load(std::memory_order_relaxed),
             mRateLimited.load(std::memory_order_relaxed),
-            mNonFinite.load(std::memory_order_relaxed)};
+            mNonFinite.load(std::memory_order_relaxed),
+            mOverflowed.load(std::memory_order_relaxed)};
 }
 
 } // namespace hapto

@@ -2,6 +2,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <limits>
 
 using namespace hapto;
@@ -62,19 +63,47 @@ TEST_CASE("a release passes at once: letting go is never rate-limited") {
     CHECK(safety.filter(Vec3(0.0, 4.0, 0.0)).y == Approx(0.5)); // growing again ramps
 }
 
-TEST_CASE("NaN and inf give zero force, are counted, and the next force ramps from zero") {
+TEST_CASE("NaN gives zero force, is counted, and the next force ramps from zero") {
     ForceSafety safety({8.5, 1.0});
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const double inf = std::numeric_limits<double>::infinity();
     safety.filter(Vec3(0.0, 0.9, 0.0));
     CHECK(safety.filter(Vec3(nan, 0.0, 0.0)) == Vec3(0.0));
-    CHECK(safety.filter(Vec3(0.0, inf, 0.0)) == Vec3(0.0));
-    CHECK(safety.filter(Vec3(0.0, 0.0, -inf)) == Vec3(0.0));
-    CHECK(safety.filter(Vec3(1e300, 1e300, 1e300)) == Vec3(0.0)); // |f| overflows
+    CHECK(safety.filter(Vec3(inf, nan, 0.0)) == Vec3(0.0)); // inf with NaN: no direction
     const SafetyCounters c = safety.counters();
-    CHECK(c.nonFinite == 4);
-    CHECK(c.filtered == 5);
+    CHECK(c.nonFinite == 2);
+    CHECK(c.overflowed == 0);
+    CHECK(c.filtered == 3);
     CHECK(safety.filter(Vec3(0.0, 5.0, 0.0)).y == Approx(1.0));
+}
+
+TEST_CASE("an overflowing force is the maximum in its direction, not zero") {
+    const double inf = std::numeric_limits<double>::infinity();
+    // Rate limiting off: the clamp alone decides.
+    ForceSafety safety({8.5, inf});
+    CHECK(safety.filter(Vec3(0.0, inf, 0.0)) == Vec3(0.0, 8.5, 0.0));
+    CHECK(safety.filter(Vec3(0.0, 0.0, -inf)) == Vec3(0.0, 0.0, -8.5));
+    const Vec3 diagonal = safety.filter(Vec3(inf, -inf, 3.0)); // the finite part is negligible
+    CHECK(diagonal.x == Approx(8.5 / std::sqrt(2.0)));
+    CHECK(diagonal.y == Approx(-8.5 / std::sqrt(2.0)));
+    CHECK(diagonal.z == 0.0);
+    // Finite components whose length overflows (a 1e200 N/m wall met 1e108 m deep).
+    const Vec3 big = safety.filter(Vec3(3e307, 4e307, 0.0));
+    CHECK(big.x == Approx(8.5 * 0.6));
+    CHECK(big.y == Approx(8.5 * 0.8));
+    CHECK(glm::length(big) <= 8.5 + 1e-12);
+    const SafetyCounters c = safety.counters();
+    CHECK(c.overflowed == 4);
+    CHECK(c.clamped == 4);
+    CHECK(c.nonFinite == 0);
+}
+
+TEST_CASE("an overflowing force still ramps at the rate limit from the last force") {
+    const double inf = std::numeric_limits<double>::infinity();
+    ForceSafety safety({8.5, 1.0});
+    CHECK(safety.filter(Vec3(inf, 0.0, 0.0)).x == Approx(1.0));
+    CHECK(safety.filter(Vec3(inf, 0.0, 0.0)).x == Approx(2.0));
+    CHECK(safety.counters().rateLimited == 2);
 }
 
 TEST_CASE("the output never exceeds the maximum, whatever comes in") {

@@ -31,13 +31,17 @@ struct SafetyCounters {
     std::uint64_t filtered = 0;    ///< Forces seen.
     std::uint64_t clamped = 0;     ///< Forces whose magnitude was cut to maxForceN.
     std::uint64_t rateLimited = 0; ///< Forces whose change was cut to maxForceStepN.
-    std::uint64_t nonFinite = 0;   ///< NaN/inf inputs (or outputs) replaced by zero force.
+    std::uint64_t nonFinite = 0;   ///< NaN inputs (or outputs) replaced by zero force.
+    std::uint64_t overflowed = 0;  ///< Infinite or overflowing forces, sent as the maximum in
+                                   ///< their direction (also counted in `clamped`).
 };
 
-/// Per-device force filter: non-finite -> zero (immediately, and the next force ramps up from
-/// zero), then magnitude clamp, then a per-tick change limit. The output magnitude never
-/// exceeds maxForceN. One instance per device; filter() and reset() belong to its servo thread,
-/// counters() may be read from any thread (relaxed atomics, single writer).
+/// Per-device force filter: NaN -> zero (immediately, and the next force ramps up from zero);
+/// an infinite force, or one whose magnitude overflows, -> maxForceN in its direction (a wall
+/// so stiff its force overflowed is the last place to feel nothing); then magnitude clamp, then
+/// a per-tick change limit. The output magnitude never exceeds maxForceN. One instance per device;
+/// filter() and reset() belong to its servo thread, counters() may be read from any thread (relaxed
+/// atomics, single writer).
 class ForceSafety {
 public:
     /// Checks the limits; throws std::invalid_argument when one is not > 0 (or NaN). [control]
@@ -69,6 +73,7 @@ private:
     std::atomic<std::uint64_t> mClamped{0};
     std::atomic<std::uint64_t> mRateLimited{0};
     std::atomic<std::uint64_t> mNonFinite{0};
+    std::atomic<std::uint64_t> mOverflowed{0};
 };
 
 } // namespace hapto
