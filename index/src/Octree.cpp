@@ -24,6 +24,7 @@
 #include "hapto/index/Octree.h"
 
 #include "BuildTimer.h"
+#include "IndexMemory.h"
 #include "Parallel.h"
 
 #include "hapto/scenes/InputError.h"
@@ -118,7 +119,7 @@ LocateResult Octree::descend(std::uint32_t node, const Vec3& p,
 
 LocateResult Octree::locate(const Vec3& p) const noexcept {
     if (!inBounds(p)) {
-        return {};
+        return outsideResult();
     }
     return descend(0, p, 0);
 }
@@ -181,7 +182,7 @@ LocateResult Octree::followLinks(std::uint32_t leaf, const Vec3& p) const noexce
 LocateResult Octree::locateFrom(std::uint32_t leaf, const Vec3& p,
                                 CursorStrategy strategy) const noexcept {
     if (!inBounds(p)) {
-        return {};
+        return outsideResult();
     }
     if (leaf >= mNodes.size() || strategy == CursorStrategy::FromRoot) {
         return descend(0, p, 0);
@@ -197,6 +198,7 @@ std::unique_ptr<Octree> Octree::build(const Scene& scene, const IndexSpec& spec)
     }
     const BuildTimer timer;
     std::unique_ptr<Octree> tree(new Octree(spec, partitionBounds(scene.bounds()), scene.size()));
+    tree->recordOutsideObjects(scene);
     tree->buildNodes(scene);
 
     IndexStats& st = tree->mStats;
@@ -210,8 +212,8 @@ std::unique_ptr<Octree> Octree::build(const Scene& scene, const IndexSpec& spec)
         }
     }
     st.recordLeaves(perLeaf);
-    st.bytes =
-        tree->mNodes.size() * sizeof(OctreeNode) + tree->mSlots.size() * sizeof(std::uint32_t);
+    st.bytes = tree->mNodes.size() * sizeof(OctreeNode) +
+               (tree->mSlots.size() + tree->outsideObjects().size()) * sizeof(std::uint32_t);
     st.bytesPerObject = scene.size() == 0 ? 0.0 : static_cast<double>(st.bytes) / scene.size();
     timer.finish(st);
     return tree;
@@ -340,6 +342,25 @@ void Octree::buildNodes(const Scene& scene) {
         for (std::size_t k = 0; k < width; ++k) {
             splitCount += splits[k];
         }
+        // Memory, before this level is allocated: nodes so far and new, leaf slots so far,
+        // this level's lists and masks, the per-object arrays; the lists of the next level and
+        // the new leaves' slots are added once known, below.
+        const std::uint64_t perObject =
+            std::uint64_t(count) * (sizeof(std::uint32_t) + sizeof(OverlapShape));
+        const auto memory = [&](std::uint64_t nodes, std::uint64_t slots, std::uint64_t next) {
+            return nodes * sizeof(OctreeNode) + (slots + next) * sizeof(std::uint32_t) +
+                   entries.size() * (sizeof(std::uint32_t) + 1) + perObject;
+        };
+        const auto checkMemory = [&](std::uint64_t bytes) {
+            if (bytes > sp.maxBytes) {
+                detail::refuseIndexMemory(sp, bytes,
+                                          std::to_string(mNodes.size() + 8 * splitCount) +
+                                              " nodes by depth " + std::to_string(level + 1) +
+                                              " and still splitting",
+                                          true);
+            }
+        };
+        checkMemory(memory(mNodes.size() + 8 * splitCount, mSlots.size(), 0));
         if (mNodes.size() + 8 * splitCount > kMaxNodes) {
             throw InputError("octree " + sp.toString() + ": more than " +
                              std::to_string(kMaxNodes) +
@@ -381,6 +402,7 @@ void Octree::buildNodes(const Scene& scene) {
             throw InputError("octree " + sp.toString() +
                              ": more than 2^32 object-leaf pairs; raise MIN or M");
         }
+        checkMemory(memory(mNodes.size(), slotBase + leafTotal, nextTotal));
         mSlots.resize(slotBase + leafTotal);
         next.resize(nextTotal);
 

@@ -4,8 +4,14 @@
 #include "hapto/index/Octree.h"
 #include "hapto/index/UniformGrid.h"
 
+#include "IndexMemory.h"
+#include "Parallel.h"
+
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 namespace hapto {
 
@@ -34,7 +40,115 @@ Aabb partitionBounds(const Aabb& sceneBounds) {
     return b;
 }
 
+void SpatialIndex::recordOutsideObjects(const Scene& scene) {
+    const std::uint32_t count = scene.size();
+    std::vector<std::uint8_t> reaches(count, 0);
+    const Aabb& b = mBounds;
+    parallel::forEach(0, count, 4096, [&](std::size_t i) {
+        const Aabb box = scene.object(static_cast<std::uint32_t>(i)).aabb();
+        // Widened like the overlap tests, so rounding in an AABB never hides a sticking-out
+        // part (a spurious entry costs one candidate, and only outside the bounds).
+        const double scale =
+            std::max({std::abs(box.min.x), std::abs(box.min.y), std::abs(box.min.z),
+                      std::abs(box.max.x), std::abs(box.max.y), std::abs(box.max.z)});
+        const double tol = kOverlapTolerance * scale;
+        bool out = false;
+        for (int a = 0; a < 3; ++a) {
+            out = out || box.min[a] - tol < b.min[a] || box.max[a] + tol > b.max[a];
+        }
+        reaches[i] = out;
+    });
+    mOutside.clear();
+    for (std::uint32_t i = 0; i < count; ++i) {
+        if (reaches[i]) {
+            mOutside.push_back(i);
+        }
+    }
+    mOutside.shrink_to_fit();
+    mStats.outsideObjects = mOutside.size();
+}
+
+namespace detail {
+
+namespace {
+
+std::string megabytes(std::uint64_t bytes) {
+    const double mb = static_cast<double>(bytes) / (1 << 20);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, mb < 10.0 ? "%.1f" : "%.0f", mb);
+    return buf;
+}
+
+} // namespace
+
+void refuseIndexMemory(const IndexSpec& spec, std::uint64_t bytes, const std::string& detail,
+                       bool atLeast) {
+    throw IndexTooLargeError("index " + spec.toString() + " would need " +
+                             (atLeast ? "more than " : "about ") + megabytes(bytes) +
+                             " MB of memory (" + detail + "), more than the " +
+                             megabytes(spec.maxBytes) +
+                             " MB limit; choose a coarser index (fewer grid cells, a "
+                             "larger octree MIN or M) or raise the limit with --max-index-mb");
+}
+
+} // namespace detail
+
+std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec) {
+    const std::uint64_t count = scene.size();
+    switch (spec.kind) {
+    case IndexSpec::Kind::BruteForce:
+        return count * sizeof(std::uint32_t);
+    case IndexSpec::Kind::Octree:
+        // Per object: Morton key, slot, shape, root flag and list entry; plus the root node.
+        return count *
+                   (sizeof(std::uint64_t) + 2 * sizeof(std::uint32_t) + sizeof(OverlapShape) + 1) +
+               sizeof(OctreeNode);
+    case IndexSpec::Kind::Grid:
+        break;
+    }
+    const std::uint64_t n = static_cast<std::uint64_t>(std::max(spec.gridCells, 1));
+    const Aabb b = partitionBounds(scene.bounds());
+    const Vec3 step = (b.max - b.min) / static_cast<double>(n);
+    const double last = static_cast<double>(n - 1);
+    std::uint64_t pairs = 0;
+    for (const SceneObject& o : scene.objects()) {
+        const Aabb box = o.aabb();
+        const double scale =
+            std::max({std::abs(box.min.x), std::abs(box.min.y), std::abs(box.min.z),
+                      std::abs(box.max.x), std::abs(box.max.y), std::abs(box.max.z)}) +
+            std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x),
+                      std::abs(b.max.y), std::abs(b.max.z)});
+        const double tol = 2.0 * kOverlapTolerance * scale;
+        std::uint64_t cells = 1;
+        for (int a = 0; a < 3 && cells > 0; ++a) {
+            const double lo = std::floor((box.min[a] - tol - b.min[a]) / step[a]);
+            const double hi = std::floor((box.max[a] + tol - b.min[a]) / step[a]);
+            if (!(hi >= 0.0) || !(lo <= last)) {
+                cells = 0; // wholly outside on this axis (or NaN): in no cell
+                break;
+            }
+            cells *= static_cast<std::uint64_t>(std::min(hi, last) - std::max(lo, 0.0)) + 1;
+        }
+        pairs += cells;
+    }
+    const std::uint64_t cellCount = n * n * n;
+    // Cell offsets and the per-cell counts of the stats; per object its shape and pair offset;
+    // per pair the (cell, slot) sort key and the slot.
+    return (2 * cellCount + 1) * sizeof(std::uint32_t) +
+           count * (sizeof(OverlapShape) + sizeof(std::uint64_t)) +
+           pairs * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+}
+
 std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec) {
+    const std::uint64_t need = estimateIndexBytes(scene, spec);
+    if (need > spec.maxBytes) {
+        const std::string detail =
+            spec.kind == IndexSpec::Kind::Grid
+                ? std::to_string(std::uint64_t(spec.gridCells) * spec.gridCells * spec.gridCells) +
+                      " cells over " + std::to_string(scene.size()) + " objects"
+                : std::to_string(scene.size()) + " objects";
+        detail::refuseIndexMemory(spec, need, detail, spec.kind == IndexSpec::Kind::Octree);
+    }
     switch (spec.kind) {
     case IndexSpec::Kind::BruteForce:
         return BruteForce::build(scene, spec);

@@ -52,6 +52,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         bounds.max[a] = sb.min[a] + static_cast<double>(n) * step[a];
     }
     std::unique_ptr<UniformGrid> grid(new UniformGrid(spec, bounds, step, scene.size()));
+    grid->recordOutsideObjects(scene);
     const UniformGrid& g = *grid;
 
     const std::uint32_t count = scene.size();
@@ -140,7 +141,8 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         perCell[c] = grid->mCellStart[c + 1] - grid->mCellStart[c];
     }
     st.recordLeaves(perCell);
-    st.bytes = (grid->mCellStart.size() + grid->mSlots.size()) * sizeof(std::uint32_t);
+    st.bytes = (grid->mCellStart.size() + grid->mSlots.size() + grid->outsideObjects().size()) *
+               sizeof(std::uint32_t);
     st.bytesPerObject = count == 0 ? 0.0 : static_cast<double>(st.bytes) / count;
     timer.finish(st);
     return grid;
@@ -148,7 +150,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
 
 LocateResult UniformGrid::locate(const Vec3& p) const noexcept {
     if (!inBounds(p)) {
-        return {};
+        return outsideResult();
     }
     const std::uint32_t id = cellId(cellIndex(p.x, 0), cellIndex(p.y, 1), cellIndex(p.z, 2));
     return {leafObjects(id), id, 0, false};

@@ -100,7 +100,8 @@ TEST_CASE("cursor: unbound, outside and back, reset to another index, FromRoot s
     CHECK(same.steps == 0);
     const LocateResult out = cursor.locate({1.0, 0.0, 0.0});
     CHECK(out.outside);
-    CHECK(out.candidates.empty());
+    CHECK(out.candidates.data() == tree->outsideObjects().data());
+    CHECK(out.candidates.size() == tree->outsideObjects().size());
     CHECK(out.leaf == kNoLeaf);
     const LocateResult back = cursor.locate({0.0101, 0.01, 0.01});
     CHECK_FALSE(back.outside);

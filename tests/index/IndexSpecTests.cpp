@@ -34,3 +34,12 @@ TEST_CASE("bad index specs are refused with a message saying what is expected") 
     CHECK_THROWS_WITH(IndexSpec::parse("octree:2:x"), Catch::Contains("metres"));
     CHECK_THROWS_WITH(IndexSpec::parse("kd"), Catch::Contains("octree:M:MIN"));
 }
+
+TEST_CASE("a parsed spec carries the default memory limit, 1024 MB") {
+    CHECK(IndexSpec::kDefaultMaxBytes == 1024ull * 1024 * 1024);
+    CHECK(IndexSpec::parse("grid:5").maxBytes == IndexSpec::kDefaultMaxBytes);
+    CHECK(IndexSpec::octree(2, 0.005).maxBytes == IndexSpec::kDefaultMaxBytes);
+    IndexSpec limited = IndexSpec::grid(5);
+    limited.maxBytes = 1;
+    CHECK(limited.toString() == "grid:5"); // not part of the text form
+}

@@ -142,6 +142,14 @@ inline std::vector<Vec3> queryPoints(const Scene& scene, std::uint64_t seed, int
         }
     }
     addBoxPoints(b, p);
+    // Outside the bounds, in a shell a fifth of their size deep: objects reach out there too.
+    for (int i = 0; i < randomCount / 4; ++i) {
+        Vec3 q;
+        for (int a = 0; a < 3; ++a) {
+            q[a] = rng.uniform(b.min[a] - 0.2 * size[a], b.max[a] + 0.2 * size[a]);
+        }
+        p.push_back(q);
+    }
     // Object corners and face centres: on the surface, so inside the closed solid.
     for (std::uint32_t s = 0; s < scene.size() && s < 400; ++s) {
         const Obb o = scene.object(s).obb();

@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <numeric>
 
 using namespace hapto;
@@ -53,7 +54,13 @@ TEST_CASE("every object holding the query point is a candidate: every index, mod
                         // The standard renderer tests every object, in the bounds or not.
                         ok = ok && r.candidates.size() == scene.size() && r.leaf == kNoLeaf;
                     } else {
-                        ok = ok && r.candidates.empty() && r.leaf == kNoLeaf;
+                        // Outside: the objects reaching outside the bounds, which include every
+                        // object holding the point (index ⊇ brute force out here too).
+                        const auto outside = index->outsideObjects();
+                        ok = ok && r.leaf == kNoLeaf && includesAll(r.candidates, want[i]) &&
+                             includesAll(fresh.candidates, want[i]) &&
+                             std::equal(r.candidates.begin(), r.candidates.end(), outside.begin(),
+                                        outside.end());
                     }
                     if (!ok && ++failures <= 3) {
                         INFO(name << " " << spec.toString() << " strategy " << int(strategy)
@@ -211,5 +218,89 @@ TEST_CASE("stats add up; brute force lists everything; an empty scene works") {
         const LocateResult r = index->locate(Vec3(0.0));
         CHECK_FALSE(r.outside);
         CHECK(r.candidates.empty());
+    }
+}
+
+TEST_CASE("a point outside the bounds but inside an object that reaches out gets that object") {
+    // Bounds +-0.1 m; object 7 straddles the +x face, 9 lies wholly outside, 8 wholly inside.
+    const Scene scene({Vec3(-0.1), Vec3(0.1)},
+                      {makeBox(7, {0.1, 0.0, 0.0}, Vec3(0.02)), makeBox(8, Vec3(0.0), Vec3(0.01)),
+                       makeSphere(9, {0.0, -0.2, 0.0}, 0.03),
+                       makeBox(10, {-0.05, 0.05, 0.0}, Vec3(0.01, 0.01, 0.01),
+                               glm::angleAxis(0.6, glm::normalize(Vec3(1, 2, 3))))});
+    const Vec3 outsideIn7(0.11, 0.005, -0.005);
+    const Vec3 outsideIn9(0.0, -0.21, 0.01);
+    REQUIRE(scene.object(0).contains(outsideIn7));
+    REQUIRE(scene.object(2).contains(outsideIn9));
+    for (const IndexSpec& spec :
+         {IndexSpec::grid(4), IndexSpec::grid(1), IndexSpec::octree(1, 0.01),
+          IndexSpec::octree(2, 0.005, OverlapMode::Aabb)}) {
+        INFO(spec.toString());
+        const auto index = buildIndex(scene, spec);
+        const std::vector<std::uint32_t> reaching{0, 2}; // slots of ids 7 and 9
+        CHECK(std::vector<std::uint32_t>(index->outsideObjects().begin(),
+                                         index->outsideObjects().end()) == reaching);
+        CHECK(index->stats().outsideObjects == 2);
+        for (const CursorStrategy strategy :
+             {CursorStrategy::FromRoot, CursorStrategy::Climb, CursorStrategy::NeighbourLinks}) {
+            Cursor cursor(*index, strategy);
+            // Inside first, so the cursor has a cached leaf when the point leaves the bounds.
+            const LocateResult inside = cursor.locate({0.095, 0.0, 0.0});
+            CHECK_FALSE(inside.outside);
+            CHECK(includesAll(inside.candidates, {0}));
+            const LocateResult out = cursor.locate(outsideIn7);
+            CHECK(out.outside);
+            CHECK(out.leaf == kNoLeaf);
+            CHECK(includesAll(out.candidates, {0}));
+            CHECK(includesAll(cursor.locate(outsideIn9).candidates, {2}));
+            // Back inside: the leaf's own candidates again, same as a fresh locate.
+            const LocateResult back = cursor.locate(Vec3(0.0));
+            CHECK_FALSE(back.outside);
+            CHECK(back.leaf == index->locate(Vec3(0.0)).leaf);
+            CHECK(includesAll(back.candidates, {1}));
+        }
+    }
+}
+
+TEST_CASE("an index that would exceed its memory limit is refused before it is built") {
+    // Three boxes filling the bounds: every one of them in every cell of a fine grid.
+    const Scene scene({Vec3(-0.1), Vec3(0.1)},
+                      {makeBox(1, Vec3(0.0), Vec3(0.1)), makeBox(2, Vec3(0.0), Vec3(0.099)),
+                       makeBox(3, Vec3(0.001), Vec3(0.098))});
+    IndexSpec fine = IndexSpec::grid(256);
+    // 2 * 256^3 cell counters and 3 * 256^3 pairs of 12 bytes each: about 700 MB.
+    const std::uint64_t need = estimateIndexBytes(scene, fine);
+    CHECK(need >= 3ull * 256 * 256 * 256 * 12);
+    CHECK(need < 800ull << 20);
+    fine.maxBytes = 256ull << 20;
+    CHECK_THROWS_AS(buildIndex(scene, fine), IndexTooLargeError);
+    CHECK_THROWS_AS(buildIndex(scene, fine), InputError); // reported as bad input (exit 2)
+    CHECK_THROWS_WITH(buildIndex(scene, fine),
+                      Catch::StartsWith("index grid:256 would need about ") &&
+                          Catch::Contains("more than the 256 MB limit") &&
+                          Catch::Contains("--max-index-mb"));
+
+    // The octree's size is known only while it is built: it stops at the level that would pass
+    // the limit. Identical objects never separate, so M = 1 splits them down to MIN.
+    std::vector<SceneObject> same;
+    for (ObjectId id = 0; id < 4; ++id) {
+        same.push_back(makeBox(id, Vec3(0.0123), Vec3(0.03)));
+    }
+    const Scene stacked({Vec3(-0.1), Vec3(0.1)}, std::move(same));
+    IndexSpec deep = IndexSpec::octree(1, 1e-9);
+    deep.maxBytes = 8ull << 20;
+    CHECK_THROWS_WITH(buildIndex(stacked, deep),
+                      Catch::StartsWith("index octree:1:1e-09 would need more than ") &&
+                          Catch::Contains("nodes by depth") && Catch::Contains("--max-index-mb"));
+
+    // Within the limit, the estimate bounds what the grid really holds.
+    for (const auto& [name, s] : testScenes()) {
+        for (const IndexSpec& spec : testSpecs()) {
+            const auto index = buildIndex(s, spec);
+            if (spec.kind != IndexSpec::Kind::Octree) {
+                INFO(name << " " << spec.toString());
+                CHECK(index->stats().bytes <= estimateIndexBytes(s, spec));
+            }
+        }
     }
 }

@@ -34,8 +34,9 @@ public:
     /// Rebinds to another index (the world snapshot changed) and forgets the leaf; keeps the
     /// strategy. No allocation. [servo]
     void reset(const SpatialIndex& index) noexcept;
-    /// The leaf holding the point and its candidates; "outside" (no candidates) for a point
-    /// outside the bounds, after which the cursor recovers when the point comes back. [servo]
+    /// The leaf holding the point and its candidates; for a point outside the bounds,
+    /// "outside" with the objects that reach outside them as candidates (the cached leaf is
+    /// kept, so the cursor recovers when the point comes back). [servo]
     LocateResult locate(const Vec3& point) noexcept;
 
     /// Changes the strategy used when the point leaves the cached leaf. [servo]

@@ -17,12 +17,17 @@ struct IndexSpec {
 
     static constexpr int kMaxGridCells = 256;       ///< Largest n of an n^3 grid.
     static constexpr int kMaxLeafObjects = 1 << 20; ///< Largest M of an octree.
+    /// Default memory limit of a build (bytes): 1024 MB (2^20 bytes each), `--max-index-mb`.
+    static constexpr std::uint64_t kDefaultMaxBytes = std::uint64_t(1024) << 20;
 
     Kind kind = Kind::BruteForce; ///< Which index.
     int gridCells = 0;            ///< Grid only: n, cells per side (1..kMaxGridCells).
     int maxObjects = 0;           ///< Octree only: M, objects a leaf may hold above min size.
     double minLeafSize = 0.0;     ///< Octree only: minimum leaf edge (m), > 0.
     OverlapMode mode = OverlapMode::Obb; ///< How objects are placed into cells.
+    /// The most memory the build may take (bytes); a larger index is refused with an
+    /// IndexTooLargeError (SpatialIndex.h). Not part of the text form: parse() sets the default.
+    std::uint64_t maxBytes = kDefaultMaxBytes;
 
     /// The brute-force "index" (every object is a candidate). [any thread]
     static IndexSpec brute();

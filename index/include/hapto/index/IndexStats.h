@@ -29,6 +29,8 @@ struct IndexStats {
     std::uint32_t maxObjectsPerLeaf = 0;   ///< Fullest leaf.
     double meanObjectsPerLeaf = 0.0;       ///< objectCellPairs / leaves.
     std::vector<Bin> objectsPerLeaf;       ///< Histogram: bins 0, 1, 2, 3-4, 5-8, 9-16, ...
+    std::uint64_t outsideObjects = 0;      ///< Objects reaching outside the bounds (grid and
+                                           ///< octree: the candidates of outside points).
     std::uint64_t bytes = 0;               ///< Memory of the index's arrays (bytes).
     double bytesPerObject = 0.0;           ///< bytes / objects.
     double buildSeconds = 0.0;             ///< Wall-clock build time (s).

@@ -7,11 +7,14 @@
 
 #include "hapto/index/IndexSpec.h"
 #include "hapto/index/IndexStats.h"
+#include "hapto/scenes/InputError.h"
 #include "hapto/scenes/Scene.h"
 
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
+#include <vector>
 
 namespace hapto {
 
@@ -31,8 +34,17 @@ struct LocateResult {
     std::span<const std::uint32_t> candidates; ///< Slots of the leaf's objects, ascending.
     std::uint32_t leaf = kNoLeaf;              ///< Octree node, grid cell, or 0 (brute force).
     std::uint32_t steps = 0; ///< Links followed (parent, child, neighbour) to get there.
-    bool outside = true;     ///< The point is outside the bounds: no candidates, except from
-                             ///< BruteForce, whose candidates are every object everywhere.
+    bool outside = true;     ///< The point is outside the bounds: the candidates are then the
+                             ///< objects that reach outside them (SpatialIndex::outsideObjects;
+                             ///< BruteForce: every object, as everywhere).
+};
+
+/// An index that would need more memory than its spec allows (IndexSpec::maxBytes). Bad input:
+/// the `hapto` command exits with code 2; the message names the estimate, the limit and
+/// `--max-index-mb`.
+class IndexTooLargeError : public InputError {
+public:
+    using InputError::InputError;
 };
 
 /// A spatial index over a static scene: immutable after build, all queries const.
@@ -53,6 +65,10 @@ public:
     std::uint32_t objectCount() const noexcept { return mObjectCount; }
     /// True when the point lies in the closed bounds (false for NaN). [servo]
     bool inBounds(const Vec3& point) const noexcept;
+    /// The objects (slots, ascending) whose bounds reach outside the index's bounds, found at
+    /// build time: the candidates of every point outside the bounds, so a hand inside the part
+    /// of an object that sticks out still feels it. [servo]
+    std::span<const std::uint32_t> outsideObjects() const noexcept { return mOutside; }
 
     /// The leaf holding the point, found from the root. [servo]
     virtual LocateResult locate(const Vec3& point) const noexcept = 0;
@@ -69,17 +85,32 @@ protected:
     /// Sets the spec, the bounds and the object count. [control]
     SpatialIndex(const IndexSpec& spec, const Aabb& bounds, std::uint32_t objectCount);
 
+    /// Fills outsideObjects() from the scene (after the bounds are final). [control]
+    void recordOutsideObjects(const Scene& scene);
+    /// The answer for a point outside the bounds: outsideObjects(), no leaf. [servo]
+    LocateResult outsideResult() const noexcept { return {mOutside, kNoLeaf, 0, true}; }
+
     IndexStats mStats; ///< Filled by the builder.
 
 private:
+    std::vector<std::uint32_t> mOutside; // slots reaching outside the bounds, ascending
     IndexSpec mSpec;
     Aabb mBounds;
     std::uint32_t mObjectCount;
 };
 
 /// Builds the index a spec asks for (in parallel, with TBB). Throws InputError for a spec
-/// that cannot be built (e.g. an octree that would need too many nodes). [control]
+/// that cannot be built (e.g. an octree that would need too many nodes), and
+/// IndexTooLargeError, before allocating it, for one that would need more than spec.maxBytes.
+/// [control]
 std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec);
+
+/// The memory a build of this index needs at its peak (bytes), estimated without building it:
+/// brute force exactly; the grid from its cells and, per object, the cells its AABB reaches
+/// (an upper bound on the object-cell pairs: the OBB test only removes some); the octree only
+/// its floor (the per-object arrays), since its node count is known only while it is built:
+/// Octree::build checks spec.maxBytes again before allocating each level. O(objects). [control]
+std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec);
 
 /// The bounds an index partitions: the scene's, each upper face moved out by the few ulps
 /// needed so that min + (max - min) >= max in floating point. [any thread]
