@@ -1,8 +1,8 @@
 #include "hapto/devices/TraceReader.h"
 
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/InputFile.h"
 
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -41,14 +41,15 @@ void TraceReader::fail(std::uint64_t offset, const std::string& what) const {
 
 TraceReader::TraceReader(const std::filesystem::path& path) : mPath(path) {
     std::error_code ec;
-    const auto size = std::filesystem::file_size(path, ec);
-    if (ec) {
-        throw InputError(path.string() + ": cannot read the trace (" + ec.message() + ")");
+    if (!std::filesystem::exists(path, ec)) {
+        throw InputError(path.string() + ": cannot read the trace (" +
+                         (ec ? ec.message() : std::string("no such file")) + ")");
     }
-    mFile = std::fopen(path.c_str(), "rb");
-    if (!mFile) {
-        throw InputError(path.string() + ": cannot open the trace (" + std::strerror(errno) + ")");
-    }
+    // A regular file of at most kMaxInputFileBytes (a FIFO, a pipe or /dev/zero is refused at
+    // once); its size is taken from the open file, so it matches what is read.
+    InputFile file(path, "trace");
+    const std::uint64_t size = file.size();
+    mFile = file.releaseToStdio();
     try {
         unsigned char bytes[kTraceHeaderBytes];
         const std::size_t got = std::fread(bytes, 1, sizeof bytes, mFile);
