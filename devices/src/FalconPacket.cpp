@@ -7,9 +7,19 @@ constexpr std::uint8_t kStart = '<';
 constexpr std::uint8_t kEnd = '>';
 constexpr std::uint8_t kNibbleBase = 0x41;
 constexpr std::size_t kFlagByte = 13;
+constexpr std::size_t kUnusedByteIndex = 14;
 
 bool isNibbleByte(std::uint8_t b) {
     return b >= kNibbleBase && b < kNibbleBase + 16;
+}
+
+/// Whether byte `i` (1..14) of a frame may hold `b`: nibbles in 1-12, the 7-bit flag field plus
+/// 0x41 in 13, anything in 14 (see the design note in FalconPacket.h).
+bool isPayloadByte(std::size_t i, std::uint8_t b) {
+    if (i == kFlagByte) {
+        return b >= kNibbleBase && b <= kMaxReplyFlagByte;
+    }
+    return i == kUnusedByteIndex || isNibbleByte(b);
 }
 
 /// Writes a 16-bit word as four nibble bytes, least significant nibble first.
@@ -28,16 +38,16 @@ std::int16_t getWord(std::span<const std::uint8_t> bytes, std::size_t first) {
     return static_cast<std::int16_t>(u);
 }
 
-Packet frameWith(const std::array<std::int16_t, 3>& words, std::uint8_t flags) {
+/// A frame of three words, a flag field (at most 7 bits) in byte 13 and `byte14`.
+Packet frameWith(const std::array<std::int16_t, 3>& words, std::uint8_t flags,
+                 std::uint8_t byte14) {
     Packet p{};
     p[0] = kStart;
     putWord(p, 1, words[0]);
     putWord(p, 5, words[1]);
     putWord(p, 9, words[2]);
-    // Byte 13 carries one nibble; byte 14 carries the upper nibble of the device's flag byte
-    // (homed bits 4-6) and is zero ('A') in host commands.
-    p[kFlagByte] = static_cast<std::uint8_t>(kNibbleBase + (flags & 0xF));
-    p[14] = static_cast<std::uint8_t>(kNibbleBase + ((flags >> 4) & 0xF));
+    p[kFlagByte] = static_cast<std::uint8_t>(kNibbleBase + (flags & 0x7F));
+    p[kUnusedByteIndex] = byte14;
     p[15] = kEnd;
     return p;
 }
@@ -49,7 +59,7 @@ bool isValidFrame(std::span<const std::uint8_t> bytes) {
         return false;
     }
     for (std::size_t i = 1; i < kPacketSize - 1; ++i) {
-        if (!isNibbleByte(bytes[i])) {
+        if (!isPayloadByte(i, bytes[i])) {
             return false;
         }
     }
@@ -59,11 +69,14 @@ bool isValidFrame(std::span<const std::uint8_t> bytes) {
 Packet encodeCommand(const FalconCommand& c) {
     const std::uint8_t flags = static_cast<std::uint8_t>((c.homing ? 1 : 0) | (c.ledGreen ? 2 : 0) |
                                                          (c.ledBlue ? 4 : 0) | (c.ledRed ? 8 : 0));
-    return frameWith(c.motor, flags);
+    return frameWith(c.motor, flags, kUnusedByte);
 }
 
 std::optional<FalconCommand> decodeCommand(std::span<const std::uint8_t> bytes) {
-    if (!isValidFrame(bytes)) {
+    // A host command carries only a nibble of flags and 'A' in byte 14 (libnifalcon
+    // FalconFirmwareNovintSDK.cpp, formatInput).
+    if (!isValidFrame(bytes) || !isNibbleByte(bytes[kFlagByte]) ||
+        bytes[kUnusedByteIndex] != kUnusedByte) {
         return std::nullopt;
     }
     FalconCommand c;
@@ -77,9 +90,9 @@ std::optional<FalconCommand> decodeCommand(std::span<const std::uint8_t> bytes) 
 }
 
 Packet encodeReading(const FalconReading& r) {
-    const std::uint8_t flags = static_cast<std::uint8_t>(
-        (r.buttons & 0xF) | ((r.homedMask & 0x7) << 4) | (r.flagBit7 ? 0x80 : 0));
-    return frameWith(r.encoder, flags);
+    const std::uint8_t flags =
+        static_cast<std::uint8_t>((r.buttons & 0xF) | ((r.homedMask & 0x7) << 4));
+    return frameWith(r.encoder, flags, r.byte14);
 }
 
 std::optional<FalconReading> decode(std::span<const std::uint8_t> bytes) {
@@ -88,11 +101,12 @@ std::optional<FalconReading> decode(std::span<const std::uint8_t> bytes) {
     }
     FalconReading r;
     r.encoder = {getWord(bytes, 1), getWord(bytes, 5), getWord(bytes, 9)};
-    const unsigned flags =
-        ((bytes[kFlagByte] - kNibbleBase) & 0xFu) | (((bytes[14] - kNibbleBase) & 0xFu) << 4);
+    // One 7-bit field: buttons in bits 0-3, homed per motor in bits 4-6 (libnifalcon
+    // src/firmware/FalconFirmwareNovintSDK.cpp, formatOutput). Byte 14 is not read for meaning.
+    const unsigned flags = (bytes[kFlagByte] - kNibbleBase) & 0x7Fu;
     r.buttons = static_cast<std::uint8_t>(flags & 0xFu);
     r.homedMask = static_cast<std::uint8_t>((flags >> 4) & 0x7u);
-    r.flagBit7 = (flags & 0x80u) != 0;
+    r.byte14 = bytes[kUnusedByteIndex];
     return r;
 }
 
@@ -111,7 +125,7 @@ bool FalconStreamParser::extract(Packet& frame) {
         bool bad = false;
         for (std::size_t i = 1; i < check && !bad; ++i) {
             const std::uint8_t b = mBuffer[start + i];
-            bad = (i == kPacketSize - 1) ? b != kEnd : !isNibbleByte(b);
+            bad = (i == kPacketSize - 1) ? b != kEnd : !isPayloadByte(i, b);
         }
         if (bad) {
             ++mStats.badFrames;
