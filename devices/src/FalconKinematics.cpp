@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -228,14 +229,18 @@ std::int16_t FalconKinematics::torqueToMotorWord(double torqueNm) {
     return static_cast<std::int16_t>(w);
 }
 
-MotorWords FalconKinematics::torqueToMotorWords(const Vec3& torqueNm, double maxTorqueNm) {
+MotorWords FalconKinematics::torqueToMotorWords(const Vec3& torqueNm, int wordLimit) {
     if (!std::isfinite(torqueNm.x) || !std::isfinite(torqueNm.y) || !std::isfinite(torqueNm.z)) {
         return {0, 0, 0};
     }
+    // Scale the three words together (libnifalcon src/kinematic/FalconKinematicStamper.cpp,
+    // getForces, scales all torques by the largest for the same reason: clamping one motor alone
+    // turns the force). The limit is a word limit: the public headers cap motor values at 4096.
+    const double limit = static_cast<double>(std::clamp(wordLimit, 1, kMaxMotorWordLimit));
+    const Vec3 words = -torqueNm * kMotorWordPerNm;
     const double largest =
-        std::max(std::abs(torqueNm.x), std::max(std::abs(torqueNm.y), std::abs(torqueNm.z)));
-    const double limit = (maxTorqueNm > 0.0 && std::isfinite(maxTorqueNm)) ? maxTorqueNm : 0.0;
-    const double scale = largest > limit ? (largest > 0.0 ? limit / largest : 0.0) : 1.0;
+        std::max(std::abs(words.x), std::max(std::abs(words.y), std::abs(words.z)));
+    const double scale = largest > limit ? limit / largest : 1.0;
     return {torqueToMotorWord(torqueNm.x * scale), torqueToMotorWord(torqueNm.y * scale),
             torqueToMotorWord(torqueNm.z * scale)};
 }

@@ -3,8 +3,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 using namespace hapto;
 using namespace hapto::falcon;
@@ -128,14 +130,41 @@ TEST_CASE("motor words are -tau * 1e4, scaled down together over the limit, clam
     const MotorWords within = FalconKinematics::torqueToMotorWords(Vec3(0.1, -0.2, 0.3));
     CHECK(within == MotorWords{-1000, 2000, -3000});
 
-    // Over a 1 Nm limit: the largest becomes exactly the limit, ratios are kept.
-    const MotorWords scaled = FalconKinematics::torqueToMotorWords(Vec3(1.0, -2.0, 4.0), 1.0);
-    CHECK(scaled == MotorWords{-2500, 5000, -10000});
-    // The default limit is what an int16 can say: nothing is ever clipped unevenly.
+    // Over a 1000-count limit: words {-1e4, 2e4, -4e4} are scaled by 1000 / 4e4 together.
+    const MotorWords scaled = FalconKinematics::torqueToMotorWords(Vec3(1.0, -2.0, 4.0), 1000);
+    CHECK(scaled == MotorWords{-250, 500, -1000});
+    // The default limit is 4096 counts (the public headers' cap), not what an int16 can say.
+    CHECK(kDefaultMotorWordLimit == 4096);
     const MotorWords big = FalconKinematics::torqueToMotorWords(Vec3(100.0, 50.0, -25.0));
-    CHECK(big[0] == -32767);
-    CHECK(big[1] == Approx(-32767 / 2.0).margin(1));
-    CHECK(big[2] == Approx(32767 / 4.0).margin(1));
+    CHECK(big == MotorWords{-4096, -2048, 1024});
     const double nan = std::numeric_limits<double>::quiet_NaN();
     CHECK(FalconKinematics::torqueToMotorWords(Vec3(nan, 1, 1)) == MotorWords{0, 0, 0});
+    CHECK(FalconKinematics::torqueToMotorWords(Vec3(1, std::numeric_limits<double>::infinity(), 1),
+                                               4096) == MotorWords{0, 0, 0});
+}
+
+TEST_CASE("over the word limit, the three words keep their ratios and the largest is the limit",
+          "[kinematics]") {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> torque(-5.0, 5.0); // up to 50000 counts
+    for (const int limit : {1, 1000, 4095, 4096, 32767}) {
+        for (int trial = 0; trial < 2000; ++trial) {
+            const Vec3 tau(torque(rng), torque(rng), torque(rng));
+            const MotorWords w = FalconKinematics::torqueToMotorWords(tau, limit);
+            const Vec3 raw = -tau * kMotorWordPerNm;
+            const double largest = std::max({std::abs(raw.x), std::abs(raw.y), std::abs(raw.z)});
+            const double scale = largest > limit ? limit / largest : 1.0;
+            INFO("limit " << limit << " tau " << tau.x << ", " << tau.y << ", " << tau.z);
+            int biggest = 0;
+            for (int i = 0; i < 3; ++i) {
+                // Each word is the raw word times one common factor, rounded: same direction.
+                CHECK(std::abs(w[static_cast<std::size_t>(i)] - raw[i] * scale) <= 0.5 + 1e-9);
+                biggest = std::max(biggest, std::abs(int{w[static_cast<std::size_t>(i)]}));
+            }
+            CHECK(biggest <= limit);
+            if (largest > limit) {
+                CHECK(biggest == limit);
+            }
+        }
+    }
 }

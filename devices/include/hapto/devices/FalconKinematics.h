@@ -44,8 +44,12 @@ struct FalconGeometry {
 inline constexpr double kWorkspaceOriginZ = 0.150;
 /// Motor command word per newton-metre of joint torque (the firmware's scale): word = -tau * 1e4.
 inline constexpr double kMotorWordPerNm = 1.0e4;
-/// The largest torque a command word can express (Nm): 32767 / 1e4.
-inline constexpr double kMaxMotorTorqueNm = 32767.0 / kMotorWordPerNm;
+/// The default largest |motor word| (counts): the public headers cap motor values at 4096, and
+/// a capture of the vendor driver's packets peaks at 4095 (not confirmed on hardware).
+/// FalconConfig::motorWordLimit overrides it.
+inline constexpr int kDefaultMotorWordLimit = 4096;
+/// The largest |motor word| an int16 can carry symmetrically (counts).
+inline constexpr int kMaxMotorWordLimit = 32767;
 
 /// Three joint values, one per leg.
 using Angles = std::array<double, 3>;
@@ -90,11 +94,12 @@ public:
 
     /// Joint torques (Nm) for a tip force (N): tau = J^T F. [any thread]
     static Vec3 forceToTorque(const Mat3& jacobian, const Vec3& forceN);
-    /// Motor words for joint torques (Nm): if max|tau| exceeds maxTorqueNm all three are scaled
-    /// down together; then word = -tau * 1e4, rounded and clamped to int16; NaN gives 0.
-    /// [any thread]
+    /// Motor words for joint torques (Nm): word = -tau * 1e4; if the largest |word| exceeds
+    /// `wordLimit` (counts, clamped to 1..32767) all three are scaled down together so that it
+    /// equals the limit, keeping the force's direction (never clamped one by one); then rounded.
+    /// Any non-finite torque gives {0, 0, 0}. [any thread]
     static MotorWords torqueToMotorWords(const Vec3& torqueNm,
-                                         double maxTorqueNm = kMaxMotorTorqueNm);
+                                         int wordLimit = kDefaultMotorWordLimit);
     /// One torque (Nm) to a motor word: -tau * 1e4, rounded, clamped to int16, NaN -> 0.
     /// [any thread]
     static std::int16_t torqueToMotorWord(double torqueNm);
