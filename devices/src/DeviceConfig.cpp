@@ -119,9 +119,31 @@ ReplayConfig parseReplay(const Source& w, const Json& j, const Path& path) {
     return c;
 }
 
-FalconConfig parseFalcon(const Source& w, const Json& j, const Path& path) {
+/// `command_timeout_ms` of a device with its own I/O thread, or the default for `rateHz`.
+double parseCommandTimeout(const Source& w, const Json& j, const Path& path, double rateHz) {
+    const Json* v = optional(j, "command_timeout_ms");
+    if (!v) {
+        return defaultCommandTimeoutMs(rateHz);
+    }
+    const Path at = path / "command_timeout_ms";
+    const double ms = ranged(w, *v, at, 0.0, kMaxCommandTimeoutMs, true,
+                             "the command timeout (ms; how long a stalled servo's last force "
+                             "may still be applied)");
+    const double periodMs = 1000.0 / rateHz;
+    if (ms < periodMs) {
+        w.fail(at, "the command timeout (" + show(ms) + " ms) is shorter than one servo period (" +
+                       show(periodMs) + " ms at rate_hz " + show(rateHz) +
+                       "), so every force would be zeroed before the next one arrives; use at "
+                       "least one period (default: two)");
+    }
+    return ms;
+}
+
+FalconConfig parseFalcon(const Source& w, const Json& j, const Path& path, double rateHz) {
     object(w, j, path);
-    checkKeys(w, j, path, {"serial", "bus", "address", "firmware", "home"});
+    checkKeys(
+        w, j, path,
+        {"serial", "bus", "address", "firmware", "home", "motor_word_limit", "command_timeout_ms"});
     FalconConfig c;
     if (const Json* v = optional(j, "serial")) {
         c.serial = string(w, *v, path / "serial");
@@ -138,12 +160,29 @@ FalconConfig parseFalcon(const Source& w, const Json& j, const Path& path) {
     if (const Json* v = optional(j, "home")) {
         c.home = boolean(w, *v, path / "home");
     }
+    if (const Json* v = optional(j, "motor_word_limit")) {
+        const bool whole = v->is_number_integer();
+        const bool inRange =
+            whole &&
+            !(v->is_number_unsigned() &&
+              v->get<std::uint64_t>() > std::uint64_t{falcon::kMaxMotorWordLimit}) &&
+            v->get<std::int64_t>() >= 1 && v->get<std::int64_t>() <= falcon::kMaxMotorWordLimit;
+        if (!inRange) {
+            w.fail(path / "motor_word_limit",
+                   "the motor word limit must be a whole number of motor counts in 1.." +
+                       std::to_string(falcon::kMaxMotorWordLimit) + " (got " + describe(*v) +
+                       "); the public headers cap motor values at " +
+                       std::to_string(falcon::kDefaultMotorWordLimit) + ", the default");
+        }
+        c.motorWordLimit = static_cast<int>(v->get<std::int64_t>());
+    }
+    c.commandTimeoutMs = parseCommandTimeout(w, j, path, rateHz);
     return c;
 }
 
-PhantomConfig parsePhantom(const Source& w, const Json& j, const Path& path) {
+PhantomConfig parsePhantom(const Source& w, const Json& j, const Path& path, double rateHz) {
     object(w, j, path);
-    checkKeys(w, j, path, {"device", "library"});
+    checkKeys(w, j, path, {"device", "library", "command_timeout_ms"});
     PhantomConfig c;
     if (const Json* v = optional(j, "device")) {
         c.deviceName = string(w, *v, path / "device");
@@ -154,6 +193,7 @@ PhantomConfig parsePhantom(const Source& w, const Json& j, const Path& path) {
             w.fail(path / "library", "the library name must not be empty");
         }
     }
+    c.commandTimeoutMs = parseCommandTimeout(w, j, path, rateHz);
     return c;
 }
 
@@ -210,14 +250,18 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
         }
         d.params = parseReplay(w, *params, ppath);
     } else if (d.kind == "falcon") {
-        d.params = params ? parseFalcon(w, *params, ppath) : FalconConfig{};
+        d.params = parseFalcon(w, params ? *params : Json::object(), ppath, d.rateHz);
     } else {
-        d.params = params ? parsePhantom(w, *params, ppath) : PhantomConfig{};
+        d.params = parsePhantom(w, params ? *params : Json::object(), ppath, d.rateHz);
     }
     return d;
 }
 
 } // namespace
+
+double defaultCommandTimeoutMs(double rateHz) {
+    return std::min(2.0 * 1000.0 / rateHz, kMaxCommandTimeoutMs);
+}
 
 std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_view sourceName) {
     const Source w(sourceName);

@@ -172,6 +172,8 @@ struct FalconDevice::Impl {
     FalconConfig config;
     double maxForceN = kDefaultMaxForceN;
     FalconTimeouts timeouts;
+    std::int64_t commandTimeoutNs = 2'000'000; ///< A command older than this is not applied.
+    std::int64_t (*commandClock)() = &nowNs;   ///< Stamps commands and judges their age (ns).
     falcon::FalconKinematics kinematics;
 
     // USB (control thread, then owned by the I/O thread between open and close).
@@ -186,7 +188,7 @@ struct FalconDevice::Impl {
     // State shared between threads.
     std::atomic<bool> open{false};
     std::atomic<bool> stopRequested{false};
-    std::atomic<bool> homing{false};
+    std::atomic<bool> homing{false};   // waiting for the homed flags: motor words held at zero
     std::atomic<std::uint8_t> leds{0}; // bit1 green, bit2 blue, bit3 red (packet layout)
     std::atomic<IoState> ioState{IoState::Running};
     std::atomic<bool> badSinceValid{false};
@@ -271,16 +273,18 @@ struct FalconDevice::Impl {
 
     /// Sends one zero-force packet and waits briefly for any valid reply frame.
     bool firmwareAnswers() {
-        const falcon::Packet p = falcon::encodeCommand({});
+        falcon::FalconCommand probe;
+        probe.homing = true; // a homed Falcon stays homed only while every packet asks for it
+        const falcon::Packet p = falcon::encodeCommand(probe);
         if (!writeBytes(p.data(), p.size())) {
             return false;
         }
-        falcon::FalconStreamParser probe;
+        falcon::FalconStreamParser replies;
         bool answered = false;
         const auto deadline = Clock::now() + timeouts.probe;
         while (!answered && Clock::now() < deadline) {
             const auto bytes = readBytes(falcon::kPacketSize, timeouts.probe);
-            probe.pushPayload(bytes, [&](const falcon::Packet&) { answered = true; });
+            replies.pushPayload(bytes, [&](const falcon::Packet&) { answered = true; });
             if (lastUsbError == LIBUSB_ERROR_NO_DEVICE) {
                 break;
             }
@@ -539,16 +543,13 @@ struct FalconDevice::Impl {
     }
 
     /// The motor words for the newest force at the newest pose (zero while homing, without a
-    /// pose, or when the servo has stopped writing).
+    /// pose, or when the newest command is older than the command timeout: a stalled servo).
     falcon::MotorWords motorWords(bool zero) {
         if (zero || !havePose || homing.load(std::memory_order_relaxed)) {
             return {0, 0, 0};
         }
         Command c{};
-        if (!commands.read(c) ||
-            nowNs() - c.timeNs >
-                std::chrono::duration_cast<std::chrono::nanoseconds>(timeouts.commandStale)
-                    .count()) {
+        if (!commands.read(c) || commandClock() - c.timeNs > commandTimeoutNs) {
             return {0, 0, 0};
         }
         const auto j = kinematics.jacobian(lastMechPosition, lastAngles);
@@ -557,14 +558,17 @@ struct FalconDevice::Impl {
         }
         const Vec3 tau = falcon::FalconKinematics::forceToTorque(
             *j, Vec3(c.forceN[0], c.forceN[1], c.forceN[2]));
-        return falcon::FalconKinematics::torqueToMotorWords(tau);
+        return falcon::FalconKinematics::torqueToMotorWords(tau, config.motorWordLimit);
     }
 
     void submitOut(bool zero) {
         falcon::FalconCommand cmd;
         cmd.motor = motorWords(zero);
         const std::uint8_t l = zero ? 0 : leds.load(std::memory_order_relaxed);
-        cmd.homing = !zero && homing.load(std::memory_order_relaxed);
+        // The homing bit in EVERY packet, during homing, after it and in the last zero packet:
+        // "The homing mode bit must be set in each input packet sent in order for the falcon to
+        // stay homed" (libnifalcon include/falcon/core/FalconFirmware.h, "Homing Mode").
+        cmd.homing = true;
         cmd.ledGreen = (l & 2u) != 0;
         cmd.ledBlue = (l & 4u) != 0;
         cmd.ledRed = (l & 8u) != 0;
@@ -756,7 +760,7 @@ struct FalconDevice::Impl {
         }
         parser.reset();
         open = true;
-        // Set before the I/O thread starts, so its very first packet already asks for homing.
+        // Set before the I/O thread starts, so no force goes out before the homed flags arrive.
         homing = config.home;
         leds = config.home ? 8 : 2; // red while homing, green when ready
         startIo();
@@ -773,6 +777,11 @@ FalconDevice::FalconDevice(std::string name, const FalconConfig& config, double 
     mImpl->name = std::move(name);
     mImpl->config = config;
     mImpl->maxForceN = maxForceN > 0.0 ? maxForceN : kDefaultMaxForceN;
+    const double timeoutMs = std::isfinite(config.commandTimeoutMs) && config.commandTimeoutMs > 0.0
+                                 ? std::min(config.commandTimeoutMs, kMaxCommandTimeoutMs)
+                                 : defaultCommandTimeoutMs(1000.0);
+    mImpl->commandTimeoutNs = static_cast<std::int64_t>(std::llround(timeoutMs * 1.0e6));
+    mImpl->config.motorWordLimit = std::clamp(config.motorWordLimit, 1, falcon::kMaxMotorWordLimit);
 }
 
 FalconDevice::~FalconDevice() {
@@ -854,7 +863,7 @@ DeviceStatus FalconDevice::write(const Vec3& forceN) {
     if (len > m.maxForceN) {
         f *= m.maxForceN / len;
     }
-    m.commands.publish(Command{{f.x, f.y, f.z}, nowNs()});
+    m.commands.publish(Command{{f.x, f.y, f.z}, m.commandClock()});
     switch (m.ioState.load(std::memory_order_acquire)) {
     case IoState::Running:
         return DeviceStatus::Ok;
@@ -889,6 +898,10 @@ void FalconDevice::setLeds(bool green, bool blue, bool red) {
 
 void FalconDevice::setTimeouts(const FalconTimeouts& timeouts) {
     mImpl->timeouts = timeouts;
+}
+
+void FalconDevice::setCommandClock(std::int64_t (*nowNs)()) {
+    mImpl->commandClock = nowNs ? nowNs : &hapto::nowNs;
 }
 
 bool FalconDevice::firmwareWasLoaded() const {

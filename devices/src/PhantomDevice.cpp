@@ -5,7 +5,7 @@
 // the device I/O (hdBeginFrame/hdEndFrame must run there); the hapto servo thread owns the force
 // computation. Between them sit two single-writer seqlock mailboxes per device:
 //   sample  HD thread -> servo   {position m, velocity m/s, buttons, time since open (ns)}
-//   force   servo -> HD thread   {force N}
+//   force   servo -> HD thread   {force N, time of the write on the command clock (ns)}
 // plus atomics for faults (HD thread -> everyone), the zero-force request at close (control ->
 // HD thread) and its acknowledgement (HD thread -> control).
 // The invariants:
@@ -13,6 +13,10 @@
 //     close() never writes `force`: it raises `zeroForce`, which the callback obeys before
 //     looking at `force`, so there is never a second writer.
 //   - Once `zeroForce` is raised or a fault is recorded, every later HD tick applies exactly zero.
+//   - A force older than the command timeout is never applied: if the servo thread stalls, the
+//     HD callback (which keeps running) applies zero from the first tick past that age. The age
+//     is judged on our own monotonic clock: hdGetSchedulerTimeStamp counts only from the start
+//     of the current frame (OpenHaptics hdScheduler.h), not across ticks.
 //   - The callback's user data (PhantomLink) outlives its scheduling: it is freed only after
 //     hdUnschedule returned (and PhantomDevice cannot move).
 //   - HD calls from control threads (init, enable, probe, schedule, start/stop) are serialised
@@ -35,24 +39,32 @@ namespace hapto {
 
 namespace detail {
 
+/// One force command as the servo left it.
+struct PhantomForce {
+    double forceN[3];    ///< Device frame (N).
+    std::int64_t timeNs; ///< When write() published it, on the command clock (ns).
+};
+
 /// Everything the HD callback and the servo thread share for one device, aligned so the HD
 /// thread's and the servo thread's hot words sit on separate cache lines.
 struct alignas(64) PhantomLink {
     const hd::HdApi* api = nullptr;               ///< Set before scheduling.
     hd::HHD handle = hd::kInvalidHandle;          ///< Set before scheduling.
     std::chrono::steady_clock::time_point origin; ///< Sample times count from here.
+    std::int64_t (*commandClock)() = nullptr;     ///< Set before scheduling: stamps forces (ns).
+    std::int64_t commandTimeoutNs = 0;            ///< Set before scheduling: max force age (ns).
 
     /// {px, py, pz (m), vx, vy, vz (m/s), buttons, time since origin (ns)}.
     alignas(64) Mailbox<std::array<double, 8>> sample;
-    /// {fx, fy, fz (N)}.
-    alignas(64) Mailbox<std::array<double, 3>> force;
+    /// The newest force and when it was written.
+    alignas(64) Mailbox<PhantomForce> force;
 
     alignas(64) std::atomic<bool> zeroForce{false};     ///< Control -> HD: apply zero from now on.
     std::atomic<bool> zeroForceApplied{false};          ///< HD -> control: a zero was applied.
     std::atomic<std::uint32_t> faultCode{hd::kSuccess}; ///< First HD error, or kSuccess.
     std::atomic<int> faultInternal{0};                  ///< Its driver code.
     std::atomic<std::uint64_t> ticks{0};                ///< Callback runs since open.
-    std::array<double, 3> heldForce{0.0, 0.0, 0.0};     ///< HD thread only: last force read.
+    PhantomForce heldForce{{0.0, 0.0, 0.0}, 0};         ///< HD thread only: last force read.
 
     alignas(64) std::atomic<std::uint64_t> staleReads{0}; ///< Servo writes, anyone reads.
     std::uint64_t lastWrites = 0;                         ///< Servo only.
@@ -67,7 +79,7 @@ struct alignas(64) PhantomLink {
         faultCode.store(hd::kSuccess);
         faultInternal.store(0);
         ticks.store(0);
-        heldForce = {0.0, 0.0, 0.0};
+        heldForce = PhantomForce{{0.0, 0.0, 0.0}, 0};
         staleReads.store(0);
         lastWrites = 0;
         lastSample = {};
@@ -81,7 +93,15 @@ static_assert(alignof(PhantomLink) == 64, "HD-side and servo-side words on separ
 
 namespace {
 
+using detail::PhantomForce;
 using detail::PhantomLink;
+
+/// The default command clock: std::chrono::steady_clock (ns since its epoch).
+std::int64_t steadyNowNs() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
 constexpr double kMmToM = 1.0e-3;
 constexpr std::chrono::seconds kFirstSampleTimeout{2};
 constexpr std::chrono::milliseconds kZeroForceTimeout{200};
@@ -104,12 +124,15 @@ hd::HDCallbackCode phantomServoCallback(void* userData) {
                       link.faultCode.load(std::memory_order_relaxed) != hd::kSuccess;
     hd::HDdouble force[3] = {0.0, 0.0, 0.0};
     if (!zero) {
-        std::array<double, 3> f;
+        PhantomForce f;
         std::uint64_t writes = 0;
-        if (link.force.read(f, writes)) {
+        if (link.force.read(f, writes) && writes > 0) {
             link.heldForce = f; // else keep the last force: the writer is mid-update
         }
-        std::copy(link.heldForce.begin(), link.heldForce.end(), force);
+        // A stalled servo leaves its last force behind: apply it only while it is young.
+        if (link.commandClock() - link.heldForce.timeNs <= link.commandTimeoutNs) {
+            std::copy(std::begin(link.heldForce.forceN), std::end(link.heldForce.forceN), force);
+        }
     }
     api.setDoublev(hd::kCurrentForce, force);
     api.endFrame(link.handle);
@@ -177,6 +200,11 @@ PhantomInfo queryCurrentDevice(const hd::HdApi& api, const std::string& deviceNa
 PhantomDevice::PhantomDevice(std::string name, const PhantomConfig& config, double maxForceN)
     : mName(std::move(name)), mConfig(config), mMaxForceN(maxForceN),
       mLink(std::make_unique<PhantomLink>()) {
+    mCommandClock = &steadyNowNs;
+    const double timeoutMs = std::isfinite(config.commandTimeoutMs) && config.commandTimeoutMs > 0.0
+                                 ? std::min(config.commandTimeoutMs, kMaxCommandTimeoutMs)
+                                 : defaultCommandTimeoutMs(1000.0);
+    mCommandTimeoutNs = static_cast<std::int64_t>(std::llround(timeoutMs * 1.0e6));
     mCaps.model = "PHANToM / Touch (OpenHaptics, not open)";
     mCaps.maxForceN = std::max(0.0, maxForceN);
     mCaps.buttonCount = 2;
@@ -252,6 +280,8 @@ DeviceStatus PhantomDevice::open() {
     link.reset();
     link.api = &api;
     link.handle = handle;
+    link.commandClock = mCommandClock;
+    link.commandTimeoutNs = mCommandTimeoutNs;
 
     api.enable(hd::kForceOutput);
     const hd::HDSchedulerHandle scheduled =
@@ -407,7 +437,7 @@ DeviceStatus PhantomDevice::write(const Vec3& forceN) {
         return statusForHdError(code);
     }
     if (!finite(forceN)) {
-        link.force.publish({0.0, 0.0, 0.0});
+        link.force.publish(detail::PhantomForce{{0.0, 0.0, 0.0}, mCommandClock()});
         return DeviceStatus::BadData;
     }
     Vec3 f = forceN;
@@ -415,7 +445,7 @@ DeviceStatus PhantomDevice::write(const Vec3& forceN) {
     if (magnitude > mForceLimitN) {
         f *= mForceLimitN / magnitude; // magnitude > limit >= 0, so no division by zero
     }
-    link.force.publish({f.x, f.y, f.z});
+    link.force.publish(detail::PhantomForce{{f.x, f.y, f.z}, mCommandClock()});
     return DeviceStatus::Ok;
 }
 
@@ -431,6 +461,10 @@ std::string PhantomDevice::errorMessage() const {
                      : "Close and reopen the device; run Touch_Diagnostic if it repeats.");
     }
     return mError;
+}
+
+void PhantomDevice::setCommandClock(std::int64_t (*nowNs)()) {
+    mCommandClock = nowNs ? nowNs : &steadyNowNs;
 }
 
 std::uint64_t PhantomDevice::staleSampleCount() const {

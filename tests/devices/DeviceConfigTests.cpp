@@ -122,6 +122,40 @@ TEST_CASE("every sim field parses") {
     CHECK(s.noiseM == 0.0);
 }
 
+TEST_CASE("falcon and phantom command timeouts default to two servo periods, at most 10 ms") {
+    const auto one = [](const std::string& device) {
+        return parseDeviceConfig(R"({"format": "hapto-devices", "version": 1, "devices": [)" +
+                                     device + "]}",
+                                 "t.json")[0];
+    };
+    // 1 kHz: 2 ms; 4 kHz: 0.5 ms; 100 Hz: 20 ms would be two periods, capped at 10 ms.
+    CHECK(
+        std::get<FalconConfig>(one(R"({"name": "f", "kind": "falcon"})").params).commandTimeoutMs ==
+        Approx(2.0));
+    CHECK(std::get<FalconConfig>(one(R"({"name": "f", "kind": "falcon", "rate_hz": 4000})").params)
+              .commandTimeoutMs == Approx(0.5));
+    CHECK(std::get<PhantomConfig>(one(R"({"name": "p", "kind": "phantom", "rate_hz": 500,
+                                          "phantom": {"device": "x"}})")
+                                      .params)
+              .commandTimeoutMs == Approx(4.0));
+    CHECK(std::get<PhantomConfig>(one(R"({"name": "p", "kind": "phantom", "rate_hz": 100})").params)
+              .commandTimeoutMs == Approx(10.0));
+    CHECK(defaultCommandTimeoutMs(100.0) == kMaxCommandTimeoutMs);
+    // Given values are kept, from one servo period up to 10 ms.
+    const auto f = std::get<FalconConfig>(one(R"({"name": "f", "kind": "falcon",
+                "falcon": {"command_timeout_ms": 1, "motor_word_limit": 4095}})")
+                                              .params);
+    CHECK(f.commandTimeoutMs == 1.0);
+    CHECK(f.motorWordLimit == 4095);
+    CHECK(std::get<PhantomConfig>(one(R"({"name": "p", "kind": "phantom",
+                                          "phantom": {"command_timeout_ms": 10}})")
+                                      .params)
+              .commandTimeoutMs == 10.0);
+    // The motor word limit defaults to the public headers' 4096.
+    CHECK(std::get<FalconConfig>(one(R"({"name": "f", "kind": "falcon"})").params).motorWordLimit ==
+          4096);
+}
+
 TEST_CASE("every bad input names the file and its JSON path") {
     struct Case {
         std::string text;
@@ -195,6 +229,32 @@ TEST_CASE("every bad input names the file and its JSON path") {
          "bad.json: devices[1].phantom.library:"},
         {two + R"({"name": "b", "kind": "phantom", "phantom": {"serial": "x"}}]})",
          "bad.json: devices[1].phantom: unknown field 'serial'"},
+        {two + R"({"name": "b", "kind": "falcon", "falcon": {"motor_word_limit": 0}}]})",
+         "bad.json: devices[1].falcon.motor_word_limit: the motor word limit must be a whole "
+         "number of motor counts in 1..32767 (got 0)"},
+        {two + R"({"name": "b", "kind": "falcon", "falcon": {"motor_word_limit": 40000}}]})",
+         "bad.json: devices[1].falcon.motor_word_limit: the motor word limit must be a whole "
+         "number of motor counts in 1..32767 (got 40000)"},
+        {two + R"({"name": "b", "kind": "falcon", "falcon": {"motor_word_limit": 4095.5}}]})",
+         "bad.json: devices[1].falcon.motor_word_limit: the motor word limit must be a whole"},
+        {two + R"({"name": "b", "kind": "falcon", "falcon": {"motor_word_limit": "4096"}}]})",
+         "bad.json: devices[1].falcon.motor_word_limit:"},
+        {two + R"({"name": "b", "kind": "falcon", "falcon": {"command_timeout_ms": 0}}]})",
+         "bad.json: devices[1].falcon.command_timeout_ms: the command timeout (ms; how long a "
+         "stalled servo's last force may still be applied) must be > 0 (got 0)"},
+        {two + R"({"name": "b", "kind": "falcon", "falcon": {"command_timeout_ms": 100}}]})",
+         "bad.json: devices[1].falcon.command_timeout_ms: the command timeout (ms; how long a "
+         "stalled servo's last force may still be applied) must be <= 10 (got 100)"},
+        {two + R"({"name": "b", "kind": "phantom", "phantom": {"command_timeout_ms": -1}}]})",
+         "bad.json: devices[1].phantom.command_timeout_ms: the command timeout"},
+        {two + R"({"name": "b", "kind": "phantom", "phantom": {"command_timeout_ms": "2"}}]})",
+         "bad.json: devices[1].phantom.command_timeout_ms: expected a number, got a string"},
+        {two + R"({"name": "b", "kind": "phantom", "rate_hz": 200,
+                   "phantom": {"command_timeout_ms": 4}}]})",
+         "bad.json: devices[1].phantom.command_timeout_ms: the command timeout (4 ms) is shorter "
+         "than one servo period (5 ms at rate_hz 200)"},
+        {two + R"({"name": "b", "kind": "sim", "sim": {"command_timeout_ms": 2}}]})",
+         "bad.json: devices[1].sim: unknown field 'command_timeout_ms'"},
     };
     for (const Case& c : cases) {
         INFO(c.text);

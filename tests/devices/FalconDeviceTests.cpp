@@ -63,8 +63,13 @@ FalconTimeouts testTimeouts() {
     t.probe = 200ms;
     t.homing = 10s;
     t.stale = 50ms;
-    t.commandStale = 500ms;
     return t;
+}
+
+/// A command clock the test steps by hand (ns).
+std::atomic<std::int64_t> gTestNowNs{1'000'000'000};
+std::int64_t testClock() {
+    return gTestNowNs.load();
 }
 
 /// Polls `pred` until it holds or a hang guard (not a timing requirement) expires.
@@ -79,9 +84,12 @@ template <class P> bool eventually(P&& pred, std::chrono::milliseconds guard = 1
     return pred();
 }
 
+/// No homing wait, and the longest command timeout allowed (10 ms), so that the servo threads
+/// of these tests, which sleep 1 ms between writes on a loaded machine, keep their force.
 FalconConfig noHoming() {
     FalconConfig c;
     c.home = false;
+    c.commandTimeoutMs = 10.0;
     return c;
 }
 
@@ -248,34 +256,53 @@ TEST_CASE("without firmware and without a firmware file, open says what to do", 
     CHECK_FALSE(emu.firmwareRunning());
 }
 
-TEST_CASE("homing sets the homing bit until all three motors report homed", "[emulated]") {
+TEST_CASE("homing: every packet asks for homing mode, open waits for all three homed flags, and "
+          "the Falcon stays homed while it runs and after close",
+          "[emulated]") {
     requireEmulation();
     FalconEmulatorOptions opt;
     opt.homeAfterPackets = 20;
     FalconEmulator emu(opt);
+    const Pose a = poseNear(Vec3(0.0, 0.01, 0.13));
+    emu.setEncoders(a.encoders);
     FalconDevice dev("left", FalconConfig{}, 5.0);
     dev.setTimeouts(testTimeouts());
-    REQUIRE_OPEN(dev);
-    REQUIRE(eventually([&] {
-        const auto c = emu.commands();
-        return !c.empty() && !c.back().homing;
-    }));
+    REQUIRE_OPEN(dev); // only possible if the homed replies (byte 13 above 'P') were accepted
+    const std::size_t atOpen = emu.commandCount();
+    CHECK(emu.homedMask() == 0x7);
+    CHECK(emu.lastReply()[13] > 'P'); // what a homed Falcon sends: 0x41 + (7 << 4) + buttons
+
+    // Run with force for a while: every command still asks for homing, so it stays homed.
+    std::atomic<bool> stop{false};
+    std::thread servo([&] {
+        while (!stop.load()) {
+            DeviceState s;
+            (void)dev.read(s);
+            (void)dev.write(Vec3(0.5, 0.0, 0.0));
+            std::this_thread::sleep_for(1ms);
+        }
+    });
+    CHECK(eventually([&] { return emu.commandCount() > atOpen + 100; }));
+    CHECK(emu.homedMask() == 0x7);
+    stop = true;
+    servo.join();
     dev.close();
+
     const auto cmds = emu.commands();
+    REQUIRE(cmds.size() > atOpen);
     std::size_t homingCount = 0;
-    for (const auto& c : cmds) {
-        homingCount += c.homing ? 1 : 0;
-        CHECK(c.motor == MotorWords{0, 0, 0}); // no force while homing or without a servo
+    for (std::size_t i = 0; i < cmds.size(); ++i) {
+        INFO("command " << i);
+        CHECK(cmds[i].homing); // the probe, homing, running and the last zero packet alike
+        homingCount += cmds[i].homing ? 1 : 0;
+        if (i < atOpen) {
+            CHECK(cmds[i].motor == MotorWords{0, 0, 0}); // no force before homed
+        }
     }
     CHECK(homingCount >= 20);
-    // The first packet is open()'s firmware probe; homing packets follow, then none again.
-    REQUIRE(cmds.size() > 2);
-    CHECK_FALSE(cmds.front().homing);
-    CHECK(cmds[1].homing);
-    const auto firstPlain = std::find_if(cmds.begin() + 1, cmds.end(),
-                                         [](const FalconCommand& c) { return !c.homing; });
-    CHECK(std::none_of(firstPlain, cmds.end(), [](const FalconCommand& c) { return c.homing; }));
-    CHECK_FALSE(cmds.back().homing);
+    CHECK(cmds.back().motor == MotorWords{0, 0, 0});
+    CHECK(emu.homedMask() == 0x7); // close's zero packet asked for homing too
+    CHECK(emu.badCommandFrames() == 0);
 }
 
 TEST_CASE("homing times out with a message telling the user what to do", "[emulated]") {
@@ -293,7 +320,7 @@ TEST_CASE("homing times out with a message telling the user what to do", "[emula
     const auto cmds = emu.commands();
     REQUIRE_FALSE(cmds.empty());
     CHECK(cmds.back().motor == MotorWords{0, 0, 0});
-    CHECK_FALSE(cmds.back().homing);
+    CHECK(cmds.back().homing);
 }
 
 TEST_CASE("a second of I/O gives known positions and known motor words, zero at close",
@@ -362,6 +389,9 @@ TEST_CASE("a second of I/O gives known positions and known motor words, zero at 
     const auto cmds = emu.commands();
     REQUIRE(cmds.size() > 2);
     CHECK(cmds.back().motor == MotorWords{0, 0, 0}); // close() sent zero force last
+    // "home": false only skips the wait: every packet still keeps the Falcon homed.
+    CHECK(std::all_of(cmds.begin(), cmds.end(), [](const FalconCommand& c) { return c.homing; }));
+    CHECK(emu.badCommandFrames() == 0);
     const FalconIoStats st = dev.ioStats();
     CHECK(st.framesDecoded > 0);
     CHECK(st.badFrames == 0);
@@ -393,6 +423,150 @@ TEST_CASE("forces are clamped to the max force and non-finite forces become zero
         const auto c = emu.commands();
         return !c.empty() && c.back().motor == MotorWords{0, 0, 0};
     }));
+    dev.close();
+}
+
+TEST_CASE("motor words over the configured limit are scaled together: the force keeps its "
+          "direction and the largest word equals the limit",
+          "[emulated]") {
+    requireEmulation();
+    FalconEmulator emu;
+    const Pose a = poseNear(Vec3(0.01, -0.01, 0.13));
+    emu.setEncoders(a.encoders);
+    FalconConfig cfg = noHoming();
+    cfg.motorWordLimit = 700;
+    FalconDevice dev("left", cfg, 20.0);
+    dev.setTimeouts(testTimeouts());
+    REQUIRE_OPEN(dev);
+    DeviceState s;
+    REQUIRE(readOk(dev, s));
+
+    const Vec3 force(3.0, -2.0, 6.0); // N, under the 20 N clamp
+    const FalconKinematics k;
+    const auto j = k.jacobian(a.mechPosition, a.angles);
+    REQUIRE(j);
+    const Vec3 raw = -FalconKinematics::forceToTorque(*j, force) * kMotorWordPerNm; // unlimited
+    const double largest = std::max({std::abs(raw.x), std::abs(raw.y), std::abs(raw.z)});
+    REQUIRE(largest > 700.0); // the test is only meaningful if the limit bites
+    // Scaled together: raw * (700 / largest), rounded; a clamp per word would differ.
+    MotorWords got{};
+    CHECK(eventually([&] {
+        dev.write(force);
+        const auto c = emu.commands();
+        if (c.empty() || c.back().motor == MotorWords{0, 0, 0}) {
+            return false;
+        }
+        got = c.back().motor;
+        return true;
+    }));
+    INFO("words " << got[0] << ", " << got[1] << ", " << got[2]);
+    int biggest = 0;
+    for (int i = 0; i < 3; ++i) {
+        const auto w = got[static_cast<std::size_t>(i)];
+        CHECK(std::abs(w - raw[i] * 700.0 / largest) <= 1.0);
+        biggest = std::max(biggest, std::abs(int{w}));
+    }
+    CHECK(biggest == 700);
+    dev.close();
+}
+
+TEST_CASE("a Falcon whose servo stops writing is commanded zero once the newest command is "
+          "older than the command timeout (stepped clock)",
+          "[emulated]") {
+    requireEmulation();
+    FalconEmulator emu;
+    const Pose a = poseNear(Vec3(0.0, 0.0, 0.130));
+    emu.setEncoders(a.encoders);
+    FalconConfig cfg = noHoming();
+    cfg.commandTimeoutMs = 4.0;
+    FalconDevice dev("left", cfg, 5.0);
+    dev.setTimeouts(testTimeouts());
+    const std::int64_t t0 = 5'000'000'000;
+    gTestNowNs = t0;
+    dev.setCommandClock(&testClock);
+    REQUIRE_OPEN(dev);
+    DeviceState s;
+    REQUIRE(readOk(dev, s));
+
+    const Vec3 force(1.0, -0.5, 2.0);
+    const MotorWords words = expectedWords(a, force);
+    REQUIRE(words != MotorWords{0, 0, 0});
+    REQUIRE(dev.write(force) == DeviceStatus::Ok); // stamped t0; then the servo stalls
+    // Exactly as old as the timeout: still applied, packet after packet.
+    gTestNowNs = t0 + 4'000'000;
+    REQUIRE(eventually([&] {
+        const auto c = emu.commands();
+        return !c.empty() && wordsClose(c.back().motor, words);
+    }));
+    const std::size_t young = emu.commandCount();
+    REQUIRE(eventually([&] { return emu.commandCount() >= young + 50; }));
+    auto cmds = emu.commands();
+    for (std::size_t i = young; i < cmds.size(); ++i) {
+        INFO("command " << i);
+        CHECK(wordsClose(cmds[i].motor, words));
+    }
+    // One nanosecond older: zero from the next packet on (one may already be on its way).
+    gTestNowNs = t0 + 4'000'001;
+    const std::size_t old = emu.commandCount();
+    REQUIRE(eventually([&] { return emu.commandCount() >= old + 50; }));
+    cmds = emu.commands();
+    std::size_t firstZero = old;
+    while (firstZero < cmds.size() && cmds[firstZero].motor != MotorWords{0, 0, 0}) {
+        ++firstZero;
+    }
+    CHECK(firstZero <= old + 1);
+    for (std::size_t i = firstZero; i < cmds.size(); ++i) {
+        INFO("command " << i);
+        CHECK(cmds[i].motor == MotorWords{0, 0, 0});
+    }
+    // A fresh write brings the force back.
+    REQUIRE(dev.write(force) == DeviceStatus::Ok);
+    CHECK(eventually([&] {
+        const auto c = emu.commands();
+        return !c.empty() && wordsClose(c.back().motor, words);
+    }));
+    dev.close();
+    gTestNowNs = 1'000'000'000;
+}
+
+TEST_CASE("a Falcon whose servo thread stops is commanded zero (steady clock)",
+          "[emulated][realtime]") {
+    requireEmulation();
+    FalconEmulator emu;
+    const Pose a = poseNear(Vec3(0.0, 0.0, 0.130));
+    emu.setEncoders(a.encoders);
+    FalconConfig cfg = noHoming();
+    cfg.commandTimeoutMs = 2.0;
+    FalconDevice dev("left", cfg, 5.0);
+    dev.setTimeouts(testTimeouts());
+    REQUIRE_OPEN(dev);
+    std::atomic<bool> stop{false};
+    std::thread servo([&] {
+        while (!stop.load()) {
+            (void)dev.write(Vec3(1.0, -0.5, 2.0));
+            std::this_thread::sleep_for(200us);
+        }
+    });
+    const bool forced = eventually([&] {
+        const auto c = emu.commands();
+        return !c.empty() && c.back().motor != MotorWords{0, 0, 0};
+    });
+    stop = true;
+    servo.join(); // the servo thread is gone; the I/O thread keeps sending packets
+    REQUIRE(forced);
+    // Only the eventual zero is asserted (a loaded machine may take long to get there), and
+    // that it stays zero for the next 50 packets.
+    std::size_t zeroAt = 0;
+    REQUIRE(eventually([&] {
+        const auto c = emu.commands();
+        zeroAt = c.size();
+        return !c.empty() && c.back().motor == MotorWords{0, 0, 0};
+    }));
+    REQUIRE(eventually([&] { return emu.commandCount() >= zeroAt + 50; }));
+    const auto cmds = emu.commands();
+    for (std::size_t i = zeroAt; i < cmds.size(); ++i) {
+        CHECK(cmds[i].motor == MotorWords{0, 0, 0});
+    }
     dev.close();
 }
 

@@ -74,6 +74,47 @@ std::vector<std::uint8_t> stringDescriptor(std::uint16_t value, const std::strin
     return d;
 }
 
+/// A reply frame as the firmware sends it: '<', three words as nibbles + 0x41 least significant
+/// first, byte 13 = 0x41 + buttons + (homed << 4), byte 14 'A', '>'.
+falcon::Packet replyFrame(const std::array<std::int16_t, 3>& encoders, std::uint8_t buttons,
+                          std::uint8_t homedMask) {
+    falcon::Packet p{};
+    p[0] = '<';
+    for (std::size_t w = 0; w < 3; ++w) {
+        const auto u = static_cast<std::uint16_t>(encoders[w]);
+        for (std::size_t n = 0; n < 4; ++n) {
+            p[1 + 4 * w + n] = static_cast<std::uint8_t>(0x41 + ((u >> (4 * n)) & 0xF));
+        }
+    }
+    p[13] = static_cast<std::uint8_t>(0x41 + (buttons & 0xF) + ((homedMask & 0x7) << 4));
+    p[14] = 0x41;
+    p[15] = '>';
+    return p;
+}
+
+/// A host command frame's fields, or nothing when a payload byte is outside 'A'..'P'.
+std::optional<falcon::FalconCommand> parseCommandFrame(const std::uint8_t* f) {
+    for (std::size_t i = 1; i < 15; ++i) {
+        if (f[i] < 0x41 || f[i] > 0x50) {
+            return std::nullopt;
+        }
+    }
+    falcon::FalconCommand c;
+    for (std::size_t w = 0; w < 3; ++w) {
+        std::uint16_t u = 0;
+        for (std::size_t n = 0; n < 4; ++n) {
+            u = static_cast<std::uint16_t>(u | (f[1 + 4 * w + n] - 0x41) << (4 * n));
+        }
+        c.motor[w] = static_cast<std::int16_t>(u);
+    }
+    const unsigned flags = f[13] - 0x41u;
+    c.homing = (flags & 1u) != 0;
+    c.ledGreen = (flags & 2u) != 0;
+    c.ledBlue = (flags & 4u) != 0;
+    c.ledRed = (flags & 8u) != 0;
+    return c;
+}
+
 } // namespace
 
 bool FalconEmulator::inMockEnvironment() {
@@ -150,6 +191,9 @@ void FalconEmulator::replug() {
         mBoot = Boot::Idle;
         mDtr = false;
         mFirmware = mOptions.firmwareLoaded;
+        mCommandBytes.clear();
+        mHomedMask = 0; // a power cycle loses homing
+        mHomingPackets = 0;
     }
     umockdev_testbed_uevent(mTestbed, mSysPath.c_str(), "add");
 }
@@ -162,6 +206,21 @@ std::vector<FtdiRequest> FalconEmulator::ftdiRequests() const {
 std::vector<falcon::FalconCommand> FalconEmulator::commands() const {
     std::lock_guard lock(mMutex);
     return mCommands;
+}
+
+std::size_t FalconEmulator::badCommandFrames() const {
+    std::lock_guard lock(mMutex);
+    return mBadCommandFrames;
+}
+
+std::uint8_t FalconEmulator::homedMask() const {
+    std::lock_guard lock(mMutex);
+    return mHomedMask;
+}
+
+falcon::Packet FalconEmulator::lastReply() const {
+    std::lock_guard lock(mMutex);
+    return mLastReply;
 }
 
 std::size_t FalconEmulator::commandCount() const {
@@ -194,23 +253,19 @@ void FalconEmulator::queueReply(std::vector<std::uint8_t> bytes) {
     mInData.push_back({std::move(bytes), false});
 }
 
-void FalconEmulator::receiveCommand(const falcon::Packet& frame) {
-    const auto cmd = falcon::decodeCommand(frame);
-    if (!cmd) {
-        return;
-    }
-    mCommands.push_back(*cmd);
-    if (cmd->homing) {
+void FalconEmulator::receiveCommand(const falcon::FalconCommand& cmd) {
+    mCommands.push_back(cmd);
+    if (cmd.homing) {
         ++mHomingPackets;
         if (mOptions.homeAfterPackets >= 0 && mHomingPackets >= mOptions.homeAfterPackets) {
             mHomedMask = 0x7;
         }
+    } else {
+        mHomingPackets = 0; // homing mode off: the motors do not stay homed
+        mHomedMask = 0;
     }
-    falcon::FalconReading r;
-    r.encoder = mEncoders;
-    r.buttons = mButtons;
-    r.homedMask = mHomedMask;
-    const falcon::Packet reply = falcon::encodeReading(r);
+    const falcon::Packet reply = replyFrame(mEncoders, mButtons, cmd.homing ? mHomedMask : 0);
+    mLastReply = reply;
     ++mReplies;
     switch (mMode) {
     case ReplyMode::Normal:
@@ -242,8 +297,31 @@ void FalconEmulator::receiveCommand(const falcon::Packet& frame) {
 
 void FalconEmulator::receiveBytes(const std::uint8_t* bytes, std::size_t n) {
     if (mFirmware) {
-        mCommandParser.pushPayload(std::span<const std::uint8_t>(bytes, n),
-                                   [this](const falcon::Packet& f) { receiveCommand(f); });
+        // Frame the input like the public reference does: from a '<', 16 bytes ending in '>'.
+        mCommandBytes.insert(mCommandBytes.end(), bytes, bytes + n);
+        std::size_t at = 0;
+        while (at < mCommandBytes.size()) {
+            if (mCommandBytes[at] != '<') {
+                ++at;
+                continue;
+            }
+            if (mCommandBytes.size() - at < falcon::kPacketSize) {
+                break;
+            }
+            const std::uint8_t* f = mCommandBytes.data() + at;
+            if (f[15] != '>') {
+                ++mBadCommandFrames;
+                ++at;
+                continue;
+            }
+            if (const auto cmd = parseCommandFrame(f)) {
+                receiveCommand(*cmd);
+            } else {
+                ++mBadCommandFrames;
+            }
+            at += falcon::kPacketSize;
+        }
+        mCommandBytes.erase(mCommandBytes.begin(), mCommandBytes.begin() + static_cast<long>(at));
         return;
     }
     switch (mBoot) {
@@ -299,7 +377,7 @@ void FalconEmulator::handleControl(PendingUrb& urb, std::uint8_t* buffer, int le
             mBaud = value;
             if (value == kBaudNormal && mBoot == Boot::Uploading && !mImage.empty()) {
                 mFirmware = true; // the bootloader jumps into the uploaded image
-                mCommandParser.reset();
+                mCommandBytes.clear();
             }
         } else if (request == 1 && (value & 0x0100)) {
             mDtr = (value & 0x0001) != 0;

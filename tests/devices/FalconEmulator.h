@@ -7,10 +7,19 @@
 // on the emulated node is handed to our handler on umockdev's worker thread. The handler keeps
 // a small model: the FTDI line settings (baud divisor, DTR), a bootloader that does the
 // firmware handshake and echoes the upload, and, once firmware runs, a Falcon that answers
-// each 16-byte command frame with one reading frame. URBs complete when reaped: control and
-// OUT URBs at once, IN URBs when the model has bytes to send (EAGAIN until then). All model
-// state is behind one mutex; the handler never blocks. Fault injection: fragmented replies
-// with garbage and short transfers, garbage-only replies, silence, and unplugging.
+// each 16-byte command frame with one reading frame. The firmware model follows the public
+// reference, not hapto's driver, and builds and parses its frames itself (it does not use
+// FalconPacket's codec): a reply's byte 13 is 0x41 + buttons (bits 0-3) + homed flags << 4
+// (bits 4-6), so a homed Falcon answers with byte 13 above 'P' (libnifalcon
+// src/firmware/FalconFirmwareNovintSDK.cpp, formatOutput; include/falcon/firmware/
+// FalconFirmwareNovintSDK.h, "Buttons and Homing Control Report"); byte 14 is 'A' (that header's
+// sample reply "<HNGPOKOPFPOPAA>"). Homed flags are reported only while the command asks for
+// homing mode ("(If homing mode on) ... Encoder Homed", same header), and a command without the
+// homing bit loses the homed state ("The homing mode bit must be set in each input packet sent
+// in order for the falcon to stay homed", include/falcon/core/FalconFirmware.h). URBs complete when
+// reaped: control and OUT URBs at once, IN URBs when the model has bytes to send (EAGAIN until
+// then). All model state is behind one mutex; the handler never blocks. Fault injection: fragmented
+// replies with garbage and short transfers, garbage-only replies, silence, and unplugging.
 
 #include "hapto/devices/FalconPacket.h"
 
@@ -85,6 +94,12 @@ public:
     std::vector<FtdiRequest> ftdiRequests() const;
     /// Valid command frames received while firmware ran, in order.
     std::vector<falcon::FalconCommand> commands() const;
+    /// Frames between '<' and '>' that were not valid commands (a payload byte outside 'A'..'P').
+    std::size_t badCommandFrames() const;
+    /// The homed flags (bit i: motor i) the firmware holds now.
+    std::uint8_t homedMask() const;
+    /// The last reply frame the firmware built (all zero before the first).
+    falcon::Packet lastReply() const;
     /// Number of command frames received.
     std::size_t commandCount() const;
     /// The bytes uploaded to the bootloader.
@@ -109,7 +124,7 @@ private:
     bool handleIoctl(UMockdevIoctlClient* client);
     void handleControl(PendingUrb& urb, std::uint8_t* buffer, int length);
     void receiveBytes(const std::uint8_t* bytes, std::size_t n);
-    void receiveCommand(const falcon::Packet& frame);
+    void receiveCommand(const falcon::FalconCommand& cmd);
     void queueReply(std::vector<std::uint8_t> bytes);
 
     FalconEmulatorOptions mOptions;
@@ -126,7 +141,9 @@ private:
     std::vector<unsigned long> mUnknown;
     std::vector<std::uint8_t> mImage;
     std::vector<std::uint8_t> mBootInput;
-    falcon::FalconStreamParser mCommandParser;
+    std::vector<std::uint8_t> mCommandBytes; ///< Firmware input not yet framed.
+    std::size_t mBadCommandFrames = 0;
+    falcon::Packet mLastReply{};
     std::array<std::int16_t, 3> mEncoders{};
     std::uint8_t mButtons = 0;
     std::uint8_t mHomedMask = 0;

@@ -7,6 +7,7 @@
 
 #include <dlfcn.h>
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <stdexcept>
@@ -40,6 +41,7 @@ struct FakeHd {
     int (*callbacksScheduled)();
     int (*maxDevicesPerTick)();
     int (*initWhileRunning)();
+    unsigned long long (*step)(int);
 
     FakeHd() {
         mLib = dlopen(kFakeLibrary.c_str(), RTLD_NOW | RTLD_LOCAL);
@@ -62,6 +64,7 @@ struct FakeHd {
         get("fakehd_callbacks_scheduled", callbacksScheduled);
         get("fakehd_max_devices_per_tick", maxDevicesPerTick);
         get("fakehd_init_while_running", initWhileRunning);
+        get("fakehd_step", step);
         reset();
     }
     ~FakeHd() {
@@ -108,6 +111,20 @@ PhantomConfig fakeConfig(const std::string& deviceName) {
 
 bool near(const Vec3& a, const Vec3& b, double tolerance = 1e-12) {
     return glm::length(a - b) <= tolerance;
+}
+
+/// A command clock the test steps by hand (ns).
+std::atomic<std::int64_t> gTestNowNs{1'000'000'000};
+std::int64_t testClock() {
+    return gTestNowNs.load();
+}
+
+/// Gives `dev` the hand-stepped command clock: while a test leaves it alone, a written force
+/// never ages, so a test that writes once and then waits for the HD thread to apply it does
+/// not race the command timeout (which has its own tests below).
+PhantomDevice& withFrozenClock(PhantomDevice& dev) {
+    dev.setCommandClock(&testClock);
+    return dev;
 }
 
 } // namespace
@@ -187,6 +204,7 @@ TEST_CASE("positions arrive in metres from the HD's millimetres, with velocity a
 TEST_CASE("forces arrive in newtons, clamped to the limit, and are zero after close") {
     FakeHd fake;
     PhantomDevice dev("left", fakeConfig("Left Touch"), 2.0);
+    withFrozenClock(dev);
     REQUIRE(dev.open() == DeviceStatus::Ok);
     CHECK(near(fake.force(kLeft), Vec3(0.0))); // open applies zero force
 
@@ -222,6 +240,8 @@ TEST_CASE("two phantoms share one HD scheduler and each gets its own force") {
     fake.setMotion(kRight, 100.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     PhantomDevice left("left", fakeConfig("Left Touch"), 0.0);
     PhantomDevice right("right", fakeConfig("Right Touch"), 0.0);
+    withFrozenClock(left);
+    withFrozenClock(right);
     REQUIRE(left.open() == DeviceStatus::Ok);
     REQUIRE(right.open() == DeviceStatus::Ok);
     CHECK(fake.initWhileRunning() == 0); // the scheduler was paused around hdInitDevice
@@ -257,6 +277,7 @@ TEST_CASE("two phantoms share one HD scheduler and each gets its own force") {
 TEST_CASE("an HD error in the scheduler becomes a fault with the HD code and text") {
     FakeHd fake;
     PhantomDevice dev("left", fakeConfig(""), 0.0);
+    withFrozenClock(dev);
     REQUIRE(dev.open() == DeviceStatus::Ok);
     REQUIRE(dev.write(Vec3(0.5, 0.0, 0.0)) == DeviceStatus::Ok);
     REQUIRE(waitFor([&] { return near(fake.force(kDefault), Vec3(0.5, 0.0, 0.0)); }));
@@ -354,4 +375,75 @@ TEST_CASE("probePhantoms lists the stand-in's default device") {
     REQUIRE(dev.open() == DeviceStatus::Ok);
     CHECK(probePhantoms(kFakeLibrary, why).empty());
     CHECK_THAT(why, Catch::Contains("in use"));
+}
+
+TEST_CASE("a phantom whose servo stops writing applies zero force once the newest command is "
+          "older than the command timeout (stepped HD ticks and clock)") {
+    FakeHd fake;
+    PhantomConfig config = fakeConfig("Left Touch");
+    config.commandTimeoutMs = 3.0;
+    PhantomDevice dev("left", config, 0.0);
+    const std::int64_t t0 = 7'000'000'000;
+    gTestNowNs = t0;
+    dev.setCommandClock(&testClock);
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    fake.stall(1); // from here on only fake.step runs HD ticks, on this thread
+
+    const Vec3 force(1.0, -0.5, 0.25);
+    REQUIRE(dev.write(force) == DeviceStatus::Ok); // stamped t0; then the servo stalls
+    fake.step(1);
+    CHECK(near(fake.force(kLeft), force));
+    // Exactly as old as the timeout: the HD callback keeps applying it.
+    gTestNowNs = t0 + 3'000'000;
+    for (int tick = 0; tick < 20; ++tick) {
+        fake.step(1);
+        INFO("tick " << tick);
+        CHECK(near(fake.force(kLeft), force));
+    }
+    // One nanosecond older: the very next tick applies zero, and every tick after it.
+    gTestNowNs = t0 + 3'000'001;
+    for (int tick = 0; tick < 20; ++tick) {
+        fake.step(1);
+        INFO("tick " << tick);
+        CHECK(near(fake.force(kLeft), Vec3(0.0)));
+    }
+    // Reading goes on as before, and a fresh write brings the force back at once.
+    DeviceState s;
+    CHECK(dev.read(s) == DeviceStatus::Ok);
+    REQUIRE(dev.write(Vec3(0.0, 0.0, 0.5)) == DeviceStatus::Ok);
+    fake.step(1);
+    CHECK(near(fake.force(kLeft), Vec3(0.0, 0.0, 0.5)));
+    fake.stall(0);
+    dev.close();
+    CHECK(near(fake.force(kLeft), Vec3(0.0)));
+    gTestNowNs = 1'000'000'000;
+}
+
+TEST_CASE("a phantom whose servo thread stops feels no force (steady clock)", "[realtime]") {
+    FakeHd fake;
+    PhantomConfig config = fakeConfig("");
+    config.commandTimeoutMs = 2.0;
+    PhantomDevice dev("left", config, 0.0);
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    // A servo that writes until the force is seen applied, then stops for good.
+    std::atomic<bool> applied{false};
+    std::thread servo([&] {
+        const auto guard = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (!applied.load() && std::chrono::steady_clock::now() < guard) {
+            (void)dev.write(Vec3(0.5, 0.0, 0.0));
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+        }
+    });
+    CHECK(waitFor([&] {
+        const bool on = near(fake.force(kDefault), Vec3(0.5, 0.0, 0.0));
+        if (on) {
+            applied = true;
+        }
+        return on;
+    }));
+    applied = true;
+    servo.join();
+    // Only the eventual zero is asserted, within the generous bound of waitFor (10 s).
+    CHECK(waitFor([&] { return near(fake.force(kDefault), Vec3(0.0)); }));
+    dev.close();
 }

@@ -9,7 +9,9 @@
 //   - positions following p0 + v * t (mm, t = scheduler ticks / rate), velocity v (mm/s);
 //   - a force recorder: the force applied by each hdEndFrame with force output enabled.
 // Errors go on a per-thread stack (hdGetError pops the newest), the current device is
-// per-thread, as in the HD API. Test hooks (fakehd_*) script errors, stalls and removal.
+// per-thread, as in the HD API. Test hooks (fakehd_*) script errors, stalls and removal, and
+// step the scheduler by hand: with the thread stalled, fakehd_step runs whole ticks on the
+// caller's thread, so a test decides exactly when each callback runs.
 
 #include <algorithm>
 #include <atomic>
@@ -134,6 +136,31 @@ void positionNow(const FakeDevice& d, double out[3]) {
     }
 }
 
+/// One scheduler tick: every scheduled callback once, highest priority first. The scheduler
+/// thread's ticks are skipped while stalled (checked under gSched, so none runs after
+/// fakehd_stall(1) returns); fakehd_step's are not.
+void runTick(bool fromSchedulerThread) {
+    std::lock_guard sched(gSched);
+    if (fromSchedulerThread && gStalled.load()) {
+        return;
+    }
+    gTick.fetch_add(1);
+    {
+        std::lock_guard state(gState);
+        gFramedMask = 0;
+    }
+    for (std::size_t i = 0; i < gCallbacks.size();) {
+        const Scheduled s = gCallbacks[i];
+        if (s.callback(s.data) == kCallbackDone) {
+            gCallbacks.erase(gCallbacks.begin() + static_cast<long>(i));
+        } else {
+            ++i;
+        }
+    }
+    std::lock_guard state(gState);
+    gMaxFramedPerTick = std::max(gMaxFramedPerTick, __builtin_popcount(gFramedMask));
+}
+
 void schedulerLoop() {
     auto next = std::chrono::steady_clock::now();
     while (gRunning.load()) {
@@ -143,25 +170,7 @@ void schedulerLoop() {
             next = now; // fell far behind (loaded machine): do not burst
         }
         std::this_thread::sleep_until(next);
-        if (gStalled.load()) {
-            continue;
-        }
-        std::lock_guard sched(gSched);
-        gTick.fetch_add(1);
-        {
-            std::lock_guard state(gState);
-            gFramedMask = 0;
-        }
-        for (std::size_t i = 0; i < gCallbacks.size();) {
-            const Scheduled s = gCallbacks[i];
-            if (s.callback(s.data) == kCallbackDone) {
-                gCallbacks.erase(gCallbacks.begin() + static_cast<long>(i));
-            } else {
-                ++i;
-            }
-        }
-        std::lock_guard state(gState);
-        gMaxFramedPerTick = std::max(gMaxFramedPerTick, __builtin_popcount(gFramedMask));
+        runTick(true);
     }
 }
 
@@ -517,7 +526,17 @@ FAKEHD_EXPORT void fakehd_inject_error(int dev, unsigned code, int internal) {
 
 /// While on, the scheduler thread keeps running but calls no callback.
 FAKEHD_EXPORT void fakehd_stall(int on) {
+    std::lock_guard sched(gSched); // a tick in progress finishes first
     gStalled.store(on != 0);
+}
+
+/// Runs `ticks` scheduler ticks now, on the calling thread (use with fakehd_stall(1), so the
+/// scheduler thread runs none in between). Returns the tick count afterwards.
+FAKEHD_EXPORT unsigned long long fakehd_step(int ticks) {
+    for (int i = 0; i < ticks; ++i) {
+        runTick(false);
+    }
+    return gTick.load();
 }
 
 /// Unplugs the device: hdBeginFrame fails with HD_COMM_ERROR, no force reaches it.

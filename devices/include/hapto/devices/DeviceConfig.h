@@ -1,6 +1,7 @@
 #pragma once
 /// The device configuration file (`--devices D.json`): which devices, where, how fast, how hard.
 
+#include "hapto/devices/FalconKinematics.h"
 #include "hapto/scenes/Geometry.h"
 
 #include <cstdint>
@@ -67,19 +68,37 @@ struct ReplayConfig {
     bool loop = false;           ///< Start over at the end instead of stalling.
 };
 
+/// The longest a device's own I/O thread may keep applying the servo's last force (ms): a
+/// command older than its `command_timeout_ms` is replaced by zero force, and longer timeouts
+/// are refused. A hand on the handle feels at most this much of a stalled servo's force.
+inline constexpr double kMaxCommandTimeoutMs = 10.0;
+/// The command timeout when a file gives none: two servo periods (ms) at `rateHz` (Hz), capped
+/// at kMaxCommandTimeoutMs. [any thread]
+double defaultCommandTimeoutMs(double rateHz);
+
 /// A Novint Falcon over libusb (`"kind": "falcon"`).
 struct FalconConfig {
     std::string serial;             ///< Pick by USB serial number; empty = any.
     int bus = -1;                   ///< Pick by USB bus number; -1 = any.
     int address = -1;               ///< Pick by USB device address; -1 = any.
     std::filesystem::path firmware; ///< Firmware image to upload when none is loaded.
-    bool home = true;               ///< Run the homing procedure at open.
+    bool home = true;               ///< Wait at open until all three motors report homed.
+    int motorWordLimit = falcon::kDefaultMotorWordLimit; ///< Largest |motor word| sent (counts,
+                                                         ///< 1..32767); the three words are
+                                                         ///< scaled together to fit.
+                                                         ///< `motor_word_limit`.
+    double commandTimeoutMs = 2.0; ///< The I/O thread sends zero force once the newest write()
+                                   ///< is older than this (ms), (0, 10]. A file's default is two
+                                   ///< servo periods (2 ms at 1 kHz). `command_timeout_ms`.
 };
 
 /// A PHANToM or Touch through OpenHaptics (`"kind": "phantom"`).
 struct PhantomConfig {
     std::string deviceName;           ///< OpenHaptics device name; empty = the default device.
     std::string library = "libHD.so"; ///< The HD library to dlopen.
+    double commandTimeoutMs = 2.0;    ///< The HD callback applies zero force once the newest
+                                   ///< write() is older than this (ms), (0, 10]. A file's default
+                                   ///< is two servo periods (2 ms at 1 kHz). `command_timeout_ms`.
 };
 
 /// The device configuration file format version this build reads.

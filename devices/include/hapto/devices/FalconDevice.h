@@ -15,7 +15,11 @@
 // Invariants: one writer per mailbox at a time (the I/O thread for samples; the control
 // thread, then the servo thread, for commands); the servo path does no allocation, lock,
 // syscall (clock reads go through the vDSO) or throw. If the servo stops writing, the I/O thread
-// sends zero force after the command timeout.
+// sends zero force once the newest command is older than FalconConfig::commandTimeoutMs (two
+// servo periods by default, at most 10 ms). Every packet, the firmware probe and the last zero
+// packet included, carries the homing bit: the public firmware notes say it must stay set for
+// the motors to stay homed (libnifalcon include/falcon/core/FalconFirmware.h, "Homing Mode").
+// Motor words are scaled together so the largest fits FalconConfig::motorWordLimit.
 
 #include "hapto/devices/Device.h"
 #include "hapto/devices/DeviceConfig.h"
@@ -42,12 +46,11 @@ std::vector<FalconInfo> listFalcons(std::string& whyNone);
 
 /// Timeouts of a FalconDevice; the defaults suit real hardware, tests shorten them.
 struct FalconTimeouts {
-    std::chrono::milliseconds usb{500};          ///< One synchronous set-up transfer.
-    std::chrono::milliseconds probe{100};        ///< Wait for a reply when probing for firmware.
-    std::chrono::milliseconds homing{30000};     ///< Wait for all three homed flags.
-    std::chrono::milliseconds stale{50};         ///< A sample older than this is Stalled.
-    std::chrono::milliseconds commandStale{100}; ///< No write() for this long -> zero force.
-    std::chrono::microseconds period{1000};      ///< I/O cycle: one command packet per period.
+    std::chrono::milliseconds usb{500};      ///< One synchronous set-up transfer.
+    std::chrono::milliseconds probe{100};    ///< Wait for a reply when probing for firmware.
+    std::chrono::milliseconds homing{30000}; ///< Wait for all three homed flags.
+    std::chrono::milliseconds stale{50};     ///< A sample older than this is Stalled.
+    std::chrono::microseconds period{1000};  ///< I/O cycle: one command packet per period.
 };
 
 /// Counters of the I/O thread, for diagnostics (monotonic).
@@ -67,7 +70,8 @@ struct FalconIoStats {
 class FalconDevice final : public Device {
 public:
     /// A Falcon picked by `config` (serial or bus/address), forces clamped to maxForceN (N;
-    /// <= 0 means the Falcon's own ~9 N). Does not touch USB until open(). [control]
+    /// <= 0 means the Falcon's own ~9 N). A command timeout outside (0, 10] ms is clamped into
+    /// it (the file parser refuses such values). Does not touch USB until open(). [control]
     FalconDevice(std::string name, const FalconConfig& config, double maxForceN);
     /// Closes the device if open. [control]
     ~FalconDevice() override;
@@ -100,6 +104,10 @@ public:
     void setLeds(bool green, bool blue, bool red);
     /// Replaces the timeouts; call before open(). [control]
     void setTimeouts(const FalconTimeouts& timeouts);
+    /// The monotonic clock (ns) that stamps each write() and judges its age on the I/O thread;
+    /// default std::chrono::steady_clock. Tests pass a clock they step. Must be callable from
+    /// the servo and I/O threads without blocking. Call before open(). [control]
+    void setCommandClock(std::int64_t (*nowNs)());
     /// True when open() found firmware running, false when it uploaded the file. [control]
     bool firmwareWasLoaded() const;
     /// I/O counters so far. [any thread]

@@ -25,6 +25,10 @@
 /// start. close() commands zero force, waits until one HD tick has applied it (bounded), then
 /// unschedules its callback, disables force output and calls hdDisableDevice.
 ///
+/// Stale commands: the callback applies the servo's newest force only while it is younger than
+/// PhantomConfig::commandTimeoutMs (two servo periods by default, at most 10 ms) on the command
+/// clock; a servo thread that stops writing leaves zero force on the handle, not its last force.
+///
 /// HD errors seen by the callback (drained with hdGetError after hdEndFrame) make the device
 /// faulted: from then on it applies zero force, read()/write() return Disconnected
 /// (HD_COMM_ERROR, HD_COMM_CONFIG_ERROR) or Error (any other code), and errorMessage() gives the
@@ -73,7 +77,9 @@ class PhantomDevice final : public Device {
 public:
     /// A closed device named `name` ("left") for OpenHaptics device `config.deviceName` (empty =
     /// HD_DEFAULT_DEVICE) from `config.library`; forces are clamped to `maxForceN` (N), or to
-    /// the device's HD_NOMINAL_MAX_FORCE when that is smaller or `maxForceN` is 0. [control]
+    /// the device's HD_NOMINAL_MAX_FORCE when that is smaller or `maxForceN` is 0. A command
+    /// timeout outside (0, 10] ms is clamped into it (the file parser refuses such values).
+    /// [control]
     PhantomDevice(std::string name, const PhantomConfig& config, double maxForceN);
     /// Closes the device (zero force first). [control]
     ~PhantomDevice() override;
@@ -101,8 +107,9 @@ public:
     /// The newest HD sample (m, m/s, buttons). Stalled when it is older than the stale timeout;
     /// Disconnected / Error after an HD error; BadData when not finite. [servo]
     DeviceStatus read(DeviceState& state) override;
-    /// Leaves a force (N, clamped to the limit) for the next HD tick; a non-finite force leaves
-    /// zero and returns BadData. [servo]
+    /// Leaves a force (N, clamped to the limit), stamped with the command clock, for the next HD
+    /// ticks; they apply it until it is older than the command timeout, then zero. A non-finite
+    /// force leaves zero and returns BadData. [servo]
     DeviceStatus write(const Vec3& forceN) override;
 
     /// What went wrong last, with the HD error code, name and text for HD errors. [control]
@@ -115,6 +122,10 @@ public:
     /// starts it; 0 (default) keeps OpenHaptics' default (1000 Hz). Match hapto's servo rate to
     /// avoid stale samples. Call before open(). [control]
     void setSchedulerRateHz(unsigned long rateHz) { mSchedulerRateHz = rateHz; }
+    /// The monotonic clock (ns) that stamps each write() and judges its age in the HD callback;
+    /// default std::chrono::steady_clock. Tests pass a clock they step. Must be callable from
+    /// the servo and HD threads without blocking. Call before open(). [control]
+    void setCommandClock(std::int64_t (*nowNs)());
 
     /// Stale reads: read() calls since open() that found no HD sample newer than the previous
     /// read() had. [any thread]
@@ -131,6 +142,8 @@ private:
     double mMaxForceN;
     std::chrono::nanoseconds mStaleTimeout{std::chrono::milliseconds(50)};
     unsigned long mSchedulerRateHz = 0;
+    std::int64_t mCommandTimeoutNs = 2'000'000; ///< Max age of an applied force (ns).
+    std::int64_t (*mCommandClock)() = nullptr;  ///< Set by the constructor: steady_clock (ns).
 
     // Control-thread state.
     hd::HdRuntime* mRuntime = nullptr; ///< Non-null while open.
