@@ -98,6 +98,23 @@ DeviceStatus ReplayDevice::read(DeviceState& state) {
     return s.status;
 }
 
+void useTraceRates(std::span<DeviceConfig> configs) {
+    for (DeviceConfig& c : configs) {
+        if (c.kind != "replay") {
+            continue;
+        }
+        const std::filesystem::path& trace = replayOf(c).trace;
+        const double rateHz = TraceReader(trace).header().rateHz;
+        if (!(rateHz >= 100.0 && rateHz <= 100000.0)) {
+            throw InputError(trace.string() + ": device '" + c.name + "' would replay at " +
+                             std::to_string(rateHz) +
+                             " Hz, the trace's rate, outside 100..100000 Hz; give the session "
+                             "a rate (hapto run --rate)");
+        }
+        c.rateHz = rateHz;
+    }
+}
+
 DeviceStatus ReplayDevice::write(const Vec3& forceN) {
     if (!mOpen) {
         return DeviceStatus::NotOpen;

@@ -129,3 +129,43 @@ TEST_CASE("replay: a missing or corrupt trace is refused when the device is made
     CHECK_THROWS_WITH(makeDevice(replayConfig(dir / "empty.trace", false), scene),
                       Catch::Contains("no samples"));
 }
+
+TEST_CASE("replay: a replay configuration takes its trace's rate; other kinds keep theirs") {
+    test::TempDir dir;
+    {
+        TraceHeader h;
+        h.name = "x";
+        h.kind = "sim";
+        h.rateHz = 2500.0;
+        TraceRecorder rec(dir / "fast.trace", h);
+        TraceSample s;
+        REQUIRE(rec.push(s));
+        rec.close();
+    }
+    std::vector<DeviceConfig> configs{replayConfig(dir / "fast.trace", false),
+                                      defaultDeviceConfigs()[0]};
+    configs[1].rateHz = 700.0;
+    useTraceRates(configs);
+    CHECK(configs[0].rateHz == 2500.0);
+    CHECK(configs[1].rateHz == 700.0);
+
+    configs[0] = replayConfig(dir / "none.trace", false);
+    CHECK_THROWS_WITH(useTraceRates(configs), Catch::Contains("none.trace"));
+}
+
+TEST_CASE("replay: a trace rate the runtime cannot run is refused, naming the device") {
+    test::TempDir dir;
+    {
+        TraceHeader h;
+        h.name = "x";
+        h.kind = "sim";
+        h.rateHz = 500000.0; // a valid trace, but above the servo's 100 kHz
+        TraceRecorder rec(dir / "odd.trace", h);
+        TraceSample s;
+        REQUIRE(rec.push(s));
+        rec.close();
+    }
+    std::vector<DeviceConfig> configs{replayConfig(dir / "odd.trace", false)};
+    CHECK_THROWS_WITH(useTraceRates(configs),
+                      Catch::Contains("'again'") && Catch::Contains("100..100000 Hz"));
+}

@@ -8,6 +8,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <thread>
@@ -226,6 +227,60 @@ TEST_CASE("trace recorder: a servo thread and a draining thread lose nothing unc
     for (const TraceSample& s : back) {
         REQUIRE(s.positionM.x == static_cast<double>(s.tick));
     }
+}
+
+namespace {
+
+/// The names in a folder, sorted.
+std::vector<std::string> namesIn(const std::filesystem::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+        names.push_back(e.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+} // namespace
+
+TEST_CASE("trace recorder: the trace appears whole at close; until then the old file stays") {
+    test::TempDir dir;
+    const auto p = dir / "t.trace";
+    const auto first = randomSamples(5, 6);
+    writeTrace(p, first);
+    const std::string before = test::readFile(p);
+    {
+        TraceRecorder rec(p, header(), 64);
+        for (const TraceSample& s : randomSamples(7, 7)) {
+            REQUIRE(rec.push(s));
+        }
+        rec.drain();
+        CHECK(test::readFile(p) == before); // the new samples go elsewhere until close()
+        CHECK(namesIn(dir.path()).size() == 2);
+        rec.close();
+    }
+    CHECK(TraceReader::load(p) == randomSamples(7, 7));
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace"}); // no temporary left
+}
+
+TEST_CASE("trace recorder: a symlink at the trace's name is replaced, never followed") {
+    test::TempDir dir;
+    test::writeFile(dir / "victim.txt", "keep me");
+    std::filesystem::create_symlink(dir / "victim.txt", dir / "t.trace");
+    writeTrace(dir / "t.trace", randomSamples(3, 8));
+    CHECK(test::readFile(dir / "victim.txt") == "keep me");
+    CHECK(std::filesystem::is_regular_file(std::filesystem::symlink_status(dir / "t.trace")));
+    CHECK(TraceReader::load(dir / "t.trace") == randomSamples(3, 8));
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace", "victim.txt"});
+}
+
+TEST_CASE("trace recorder: a folder or a missing folder is refused and nothing is left") {
+    test::TempDir dir;
+    std::filesystem::create_directory(dir / "t.trace");
+    CHECK_THROWS_WITH(TraceRecorder(dir / "t.trace", header()), Catch::Contains("t.trace"));
+    CHECK_THROWS_AS(TraceRecorder(dir / "missing" / "t.trace", header()), InputError);
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace"});
+    CHECK(std::filesystem::is_empty(dir / "t.trace"));
 }
 
 TEST_CASE("spsc ring: order, capacity rounding, wrap-around") {

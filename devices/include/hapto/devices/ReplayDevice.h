@@ -66,4 +66,10 @@ private:
     std::string mError;
 };
 
+/// Gives every replay configuration its trace's rate (`rateHz` := the recorded rate), which
+/// is what a replay runs at unless the user sets a rate for the whole session (`hapto run
+/// --rate`); other kinds are left alone. Reads only the trace headers. Throws InputError for a
+/// trace that cannot be read. [control]
+void useTraceRates(std::span<DeviceConfig> configs);
+
 } // namespace hapto
