@@ -42,4 +42,6 @@ TEST_CASE("a parsed spec carries the default memory limit, 1024 MB") {
     IndexSpec limited = IndexSpec::grid(5);
     limited.maxBytes = 1;
     CHECK(limited.toString() == "grid:5"); // not part of the text form
+    CHECK(IndexSpec::grid(5).withMaxMegabytes(3).maxBytes == 3u << 20);
+    CHECK(IndexSpec::grid(5).withMaxMegabytes(~std::uint64_t(0)).maxBytes == ~std::uint64_t(0));
 }

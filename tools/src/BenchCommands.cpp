@@ -109,6 +109,7 @@ struct QueryArgs {
     std::uint64_t seed = 1;
     std::size_t batch = 16;
     bool json = false;
+    std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
 };
 
 void runQuery(const QueryArgs& args) {
@@ -130,7 +131,7 @@ void runQuery(const QueryArgs& args) {
     for (const Target& t : targets) {
         auto run = std::make_unique<Run>();
         run->target = t;
-        run->index = buildIndex(scene, t.spec);
+        run->index = buildIndex(scene, t.spec.withMaxMegabytes(args.maxIndexMb));
         run->cursor = Cursor(*run->index, t.strategy);
         run->nsPerQuery.reserve(steps / args.batch + steps / kBlockSteps + 2);
         runs.push_back(std::move(run));
@@ -246,6 +247,10 @@ void addBenchCommands(CLI::App& app) {
                     "optionally with :aabb, then optionally @root, @climb or @links to pick the "
                     "octree cursor's strategy (default links), e.g. octree:2:0.005@climb. "
                     "Default: brute, grid:5 and octree:2:0.005");
+    cmd->add_option("--max-index-mb", args->maxIndexMb,
+                    "Most memory an index build may take (MB); a larger index is refused")
+        ->capture_default_str()
+        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
     cmd->add_option("--steps", args->steps, "Walk steps (queries) per index, e.g. 1e5")
         ->capture_default_str();
     cmd->add_option("--seed", args->seed, "Walk seed; same seed, same walk")->capture_default_str();

@@ -28,6 +28,7 @@ struct DemoArgs {
     std::string devices;
     std::string report;
     std::string index = "octree:2:0.005";
+    std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
     ObjectId object = 0;
     bool realtime = false;
 };
@@ -73,7 +74,7 @@ int runDemo(const DemoArgs& a) {
                          ": the grasp demo takes exactly two devices (left, right), got " +
                          std::to_string(configs.size()));
     }
-    World world(scene, IndexSpec::parse(a.index));
+    World world(scene, IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb));
     std::vector<RuntimeDevice> devices;
     std::vector<SimDevice*> sims;
     for (const DeviceConfig& c : configs) {
@@ -234,6 +235,10 @@ void addDemoCommands(CLI::App& app) {
                     "grasp-right scripts)");
     cmd->add_option("--object", a->object, "Id of the object to grasp")->capture_default_str();
     cmd->add_option("--index", a->index, "Spatial index SPEC")->capture_default_str();
+    cmd->add_option("--max-index-mb", a->maxIndexMb,
+                    "Most memory an index build may take (MB); a larger index is refused")
+        ->capture_default_str()
+        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
     cmd->add_option("--report", a->report, "Write a JSON report here");
     cmd->add_flag("--realtime", a->realtime, "Ask for SCHED_FIFO for the servo threads");
     cmd->callback([a] { runDemo(*a); });

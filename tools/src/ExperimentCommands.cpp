@@ -214,6 +214,10 @@ void addExperimentCommands(CLI::App& app) {
                         "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb; "
                         "the cursor part uses it when it is an octree, else octree:2:0.005")
             ->capture_default_str();
+        cmd->add_option("--max-index-mb", a->maxIndexMb,
+                        "Most memory an index build may take (MB); a larger index is refused")
+            ->capture_default_str()
+            ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
         cmd->add_option("--script", a->script,
                         "Hand script: walk (random hops through the scene) or slide (slide on "
                         "the nearest surface)")

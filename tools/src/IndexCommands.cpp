@@ -6,6 +6,7 @@
 #include "hapto/index/IndexSpec.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/InputFile.h"
 
 #include <nlohmann/json.hpp>
 
@@ -35,16 +36,20 @@ std::string_view trim(std::string_view s) {
     return s;
 }
 
-/// Reads `x,y,z` lines (m), with an optional `x,y,z` header; blank lines are skipped.
+/// Reads `x,y,z` lines (m), with an optional `x,y,z` header; blank lines are skipped. Only a
+/// regular file of at most kMaxInputFileBytes is read (InputFile).
 std::vector<Vec3> readPoints(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        throw InputError("cannot read points file '" + path + "': no such file or no access");
-    }
+    const std::string all = InputFile(path, "points file").readAll();
     std::vector<Vec3> points;
-    std::string line;
-    for (int number = 1; std::getline(in, line); ++number) {
-        const std::string_view text = trim(line);
+    std::size_t lineStart = 0;
+    for (std::size_t number = 1; lineStart < all.size(); ++number) {
+        std::size_t lineEnd = all.find('\n', lineStart);
+        if (lineEnd == std::string::npos) {
+            lineEnd = all.size();
+        }
+        const std::string_view text =
+            trim(std::string_view(all).substr(lineStart, lineEnd - lineStart));
+        lineStart = lineEnd + 1;
         if (text.empty() || (points.empty() && text == "x,y,z")) {
             continue;
         }
@@ -76,8 +81,8 @@ std::vector<Vec3> readPoints(const std::string& path) {
 }
 
 void runQuery(const std::string& scenePath, const std::string& specText,
-              const std::string& pointsPath, const std::string& outPath) {
-    const IndexSpec spec = IndexSpec::parse(specText);
+              const std::string& pointsPath, const std::string& outPath, std::uint64_t maxIndexMb) {
+    const IndexSpec spec = IndexSpec::parse(specText).withMaxMegabytes(maxIndexMb);
     const std::vector<Vec3> points = readPoints(pointsPath);
     const Scene scene = loadSceneOrDefault(scenePath);
     const std::unique_ptr<SpatialIndex> index = buildIndex(scene, spec);
@@ -199,7 +204,12 @@ void addIndexCommands(CLI::App& app) {
                         "CSV file, one point x,y,z (m) per line, optional header x,y,z")
             ->required();
         cmd->add_option("-o,--output", *out, "Output CSV file (default: standard output)");
-        cmd->callback([=] { runQuery(*scene, *spec, *points, *out); });
+        auto maxIndexMb = std::make_shared<std::uint64_t>(IndexSpec::kDefaultMaxMegabytes);
+        cmd->add_option("--max-index-mb", *maxIndexMb,
+                        "Most memory an index build may take (MB); a larger index is refused")
+            ->capture_default_str()
+            ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+        cmd->callback([=] { runQuery(*scene, *spec, *points, *out, *maxIndexMb); });
     }
     // index-stats
     {
@@ -213,8 +223,13 @@ void addIndexCommands(CLI::App& app) {
         cmd->add_option("--scene", *scene, "Scene file (default: the embedded default scene)");
         cmd->add_option("--index", *spec, specHelp)->required();
         cmd->add_flag("--json", *json, "Print the statistics as one JSON object");
+        auto maxIndexMb = std::make_shared<std::uint64_t>(IndexSpec::kDefaultMaxMegabytes);
+        cmd->add_option("--max-index-mb", *maxIndexMb,
+                        "Most memory an index build may take (MB); a larger index is refused")
+            ->capture_default_str()
+            ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
         cmd->callback([=] {
-            const IndexSpec parsed = IndexSpec::parse(*spec);
+            const IndexSpec parsed = IndexSpec::parse(*spec).withMaxMegabytes(*maxIndexMb);
             const Scene s = loadSceneOrDefault(*scene);
             const std::unique_ptr<SpatialIndex> index = buildIndex(s, parsed);
             if (*json) {

@@ -32,6 +32,7 @@ struct RunArgs {
     std::string scene;
     std::string devices;
     std::string index = "octree:2:0.005";
+    std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
     double rateHz = 0;
     double durationS = 5;
     std::string report;
@@ -69,7 +70,7 @@ void printSummary(const RunReport& r) {
 
 int runSession(const RunArgs& a) {
     const Scene scene = loadSceneOrDefault(a.scene);
-    const IndexSpec spec = IndexSpec::parse(a.index);
+    const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
     std::vector<DeviceConfig> configs =
         a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
     if (a.rateHz > 0) {
@@ -178,6 +179,10 @@ void addRunCommands(CLI::App& app) {
     cmd->add_option("--index", a->index,
                     "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb")
         ->capture_default_str();
+    cmd->add_option("--max-index-mb", a->maxIndexMb,
+                    "Most memory an index build may take (MB); a larger index is refused")
+        ->capture_default_str()
+        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
     cmd->add_option("--rate", a->rateHz,
                     "Servo rate for every device (Hz; default: each device's own)")
         ->check(CLI::Range(100.0, 100000.0));

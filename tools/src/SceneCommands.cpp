@@ -1,6 +1,8 @@
 // `hapto scene grid|random|cluster|default|info`.
 
 #include "Commands.h"
+#include "Options.h"
+#include "OutputFile.h"
 
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
@@ -35,11 +37,18 @@ Scene loadSceneOrDefault(const std::string& path) {
 
 namespace {
 
+/// Refuses an output that cannot be written before the scene is generated. [control]
+void checkSceneOutput(const std::string& out) {
+    if (out != "-") {
+        checkOutputFile(out, "-o");
+    }
+}
+
 void writeScene(const Scene& scene, const std::string& out) {
     if (out == "-") {
         std::cout << sceneToJson(scene);
     } else {
-        saveSceneFile(scene, out);
+        writeFileAtomically(out, sceneToJson(scene));
         std::cerr << "wrote " << scene.size() << " objects to " << out << "\n";
     }
 }
@@ -80,16 +89,19 @@ void addSceneCommands(CLI::App& app) {
         auto out = std::make_shared<std::string>();
         cmd->add_option("--per-side", opt->perSide, "K, cubes per lattice side")
             ->required()
-            ->check(CLI::Range(1, 100000));
+            ->check(finiteRange(1, 100000));
         cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
             ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+            ->check(finiteRange(1e-6, 1e3));
         cmd->add_option("--gap", opt->gap, "Free space between neighbouring cubes (m)")
             ->capture_default_str()
-            ->check(CLI::NonNegativeNumber);
+            ->check(finiteRange(0, 1e3));
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();
-        cmd->callback([opt, out] { writeScene(makeLatticeScene(*opt), *out); });
+        cmd->callback([opt, out] {
+            checkSceneOutput(*out);
+            writeScene(makeLatticeScene(*opt), *out);
+        });
     }
     // random
     {
@@ -101,22 +113,24 @@ void addSceneCommands(CLI::App& app) {
         auto out = std::make_shared<std::string>();
         cmd->add_option("--count", *count, "Number of cubes (e.g. 200 or 1e6)")->required();
         cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(finiteRange(0, kMaxSeed));
         cmd->add_option("--workspace", opt->workspace, "Edge of the work cube (m)")
             ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+            ->check(finiteRange(1e-6, 1e4));
         cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
             ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+            ->check(finiteRange(1e-6, 1e3));
         cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
         cmd->add_option("--keep-clear", opt->keepClear,
                         "No object within this distance of the centre, where cursors start (m)")
             ->capture_default_str()
-            ->check(CLI::NonNegativeNumber);
+            ->check(finiteRange(0, 1e4));
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();
         cmd->callback([opt, count, out] {
             opt->count = parseCount(*count, "--count");
+            checkSceneOutput(*out);
             writeScene(makeRandomScene(*opt), *out);
         });
     }
@@ -131,23 +145,25 @@ void addSceneCommands(CLI::App& app) {
         cmd->add_option("--count", *count, "Number of cubes (e.g. 1e5)")->required();
         cmd->add_option("--clusters", opt->clusters, "Number of clusters")
             ->capture_default_str()
-            ->check(CLI::Range(1, 1000000));
+            ->check(finiteRange(1, 1000000));
         cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(finiteRange(0, kMaxSeed));
         cmd->add_option("--workspace", opt->workspace, "Edge of the work cube (m)")
             ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+            ->check(finiteRange(1e-6, 1e4));
         cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
             ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+            ->check(finiteRange(1e-6, 1e3));
         cmd->add_option("--spread", opt->spread, "Standard deviation of each cluster (m)")
             ->capture_default_str()
-            ->check(CLI::NonNegativeNumber);
+            ->check(finiteRange(0, 1e4));
         cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();
         cmd->callback([opt, count, out] {
             opt->count = parseCount(*count, "--count");
+            checkSceneOutput(*out);
             writeScene(makeClusterScene(*opt), *out);
         });
     }
@@ -159,7 +175,10 @@ void addSceneCommands(CLI::App& app) {
         auto out = std::make_shared<std::string>();
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();
-        cmd->callback([out] { writeScene(makeDefaultScene(), *out); });
+        cmd->callback([out] {
+            checkSceneOutput(*out);
+            writeScene(makeDefaultScene(), *out);
+        });
     }
     // info
     {

@@ -40,6 +40,7 @@ struct SoakArgs {
     double rateHz = 1000.0;
     std::string scene;
     std::string index = "octree:2:0.005";
+    std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
     double faultEveryS = 15.0;
     double windowS = 60.0;
     double watchdogMs = 50.0;
@@ -172,7 +173,7 @@ private:
 
 int runSoak(const SoakArgs& a) {
     const Scene scene = loadSceneOrDefault(a.scene);
-    const IndexSpec spec = IndexSpec::parse(a.index);
+    const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
     World world(scene, spec);
 
     std::vector<FaultInjectingDevice*> injectors;
@@ -462,6 +463,10 @@ void addSoakCommands(CLI::App& app) {
     cmd->add_option("--index", a->index,
                     "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb")
         ->capture_default_str();
+    cmd->add_option("--max-index-mb", a->maxIndexMb,
+                    "Most memory an index build may take (MB); a larger index is refused")
+        ->capture_default_str()
+        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
     cmd->add_option("--fault-every", a->faultEveryS,
                     "Inject a fault every this many seconds, into the hands in turn: disconnect "
                     "(0.5 s), stall of 0.4 watchdog timeouts (a miss, not a fault), non-finite "

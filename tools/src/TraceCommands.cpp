@@ -1,6 +1,7 @@
 // `hapto trace export|info`: look inside trace files written by `hapto run --record`.
 
 #include "Commands.h"
+#include "OutputFile.h"
 
 #include "hapto/devices/TraceReader.h"
 #include "hapto/scenes/InputError.h"
@@ -8,7 +9,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -24,15 +24,17 @@ void appendNumber(std::string& out, double v) {
 
 // Writes the CSV: one header row, one row per sample; numbers round-trip exactly.
 void exportCsv(const std::string& tracePath, const std::string& outPath) {
+    const bool toFile = !outPath.empty() && outPath != "-";
+    if (toFile) {
+        refuseSameFile(outPath, "-o", tracePath, "the trace");
+        checkOutputFile(outPath, "-o");
+    }
     TraceReader reader(tracePath);
-    std::ofstream file;
+    std::unique_ptr<AtomicOutputFile> file;
     std::ostream* os = &std::cout;
-    if (!outPath.empty() && outPath != "-") {
-        file.open(outPath, std::ios::binary | std::ios::trunc);
-        if (!file) {
-            throw InputError(outPath + ": cannot open for writing");
-        }
-        os = &file;
+    if (toFile) {
+        file = std::make_unique<AtomicOutputFile>(outPath);
+        os = &file->stream();
     }
     std::string out = "tick,time_ns,x_m,y_m,z_m,fx_n,fy_n,fz_n,compute_ns,io_ns,status,buttons\n";
     TraceSample s;
@@ -70,7 +72,8 @@ void exportCsv(const std::string& tracePath, const std::string& outPath) {
         throw std::runtime_error((outPath.empty() ? std::string("stdout") : outPath) +
                                  ": write failed (disk full?)");
     }
-    if (os == &file) {
+    if (file) {
+        file->commit();
         std::cerr << "wrote " << rows << " samples to " << outPath << "\n";
     }
 }

@@ -238,9 +238,10 @@ int runDevices(const DevicesArgs& args) {
     if (args.script != "walk" && args.script != "slide") {
         throw InputError("--script '" + args.script + "': expected walk or slide");
     }
-    const IndexSpec spec = IndexSpec::parse(args.index);
-    IndexSpec cursorSpec =
-        spec.kind == IndexSpec::Kind::Octree ? spec : IndexSpec::octree(2, 0.005);
+    const IndexSpec spec = IndexSpec::parse(args.index).withMaxMegabytes(args.maxIndexMb);
+    IndexSpec cursorSpec = spec.kind == IndexSpec::Kind::Octree
+                               ? spec
+                               : IndexSpec::octree(2, 0.005).withMaxMegabytes(args.maxIndexMb);
     const Scene scene = cli::loadSceneOrDefault(args.scene);
     const std::vector<int> counts = deviceCounts(args.maxDevices);
 

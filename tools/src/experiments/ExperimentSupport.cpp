@@ -2,6 +2,8 @@
 
 #include "ExperimentSupport.h"
 
+#include "../OutputFile.h"
+
 #include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/runtime/CandidateSet.h"
@@ -337,11 +339,7 @@ std::filesystem::path prepareOutDir(const std::string& dir) {
 }
 
 void writeText(const std::filesystem::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    if (!out) {
-        throw std::runtime_error("cannot write " + path.string());
-    }
+    cli::writeFileAtomically(path, text);
 }
 
 namespace {

@@ -174,7 +174,8 @@ double probeTickSeconds(const World& world, const Vec3& point, int runs);
 
 /// Output folder: created; throws InputError when it cannot be. [control]
 std::filesystem::path prepareOutDir(const std::string& dir);
-/// Writes text to a file; throws std::runtime_error on failure. [control]
+/// Writes text to a file, whole or not at all (a temporary renamed into place); throws
+/// InputError or std::runtime_error on failure. [control]
 void writeText(const std::filesystem::path& path, const std::string& text);
 /// A CSV file from a header and rows (fields with commas or quotes are quoted). [control]
 void writeCsv(const std::filesystem::path& path, const std::vector<std::string>& header,

@@ -50,6 +50,7 @@ struct DevicesArgs {
     std::vector<double> ratesHz{1000.0, 4000.0}; ///< Servo rates (Hz).
     std::string scene;                           ///< Scene file; empty = the default scene.
     std::string index = "octree:2:0.005";        ///< Index spec.
+    std::uint64_t maxIndexMb = 1024;             ///< Index memory limit (MB).
     std::string script = "walk";                 ///< Hand script: walk or slide.
     std::vector<std::size_t> cursorObjects{100, 1000, 10000, 100000, 1000000}; ///< N values.
     std::size_t walkSteps = 200000; ///< Cursor walk length (1 ms steps).

@@ -2,6 +2,8 @@
 
 #include "Plot.h"
 
+#include "../OutputFile.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -153,13 +155,11 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
            << " noenhanced font 'sans,10'\nset output " << gq(spec.name + ".svg") << "\n"
            << plot << "set output\n";
     const std::filesystem::path gp = dir / (spec.name + ".gp");
-    {
-        std::ofstream out(gp, std::ios::binary);
-        out << script.str();
-        if (!out) {
-            r.problem = "cannot write " + gp.string();
-            return r;
-        }
+    try {
+        cli::writeFileAtomically(gp, script.str());
+    } catch (const std::exception& e) {
+        r.problem = e.what();
+        return r;
     }
     if (!gnuplotAvailable()) {
         r.problem = "gnuplot not found on PATH (Debian: apt-get install gnuplot-nox); wrote " +

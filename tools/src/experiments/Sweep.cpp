@@ -130,7 +130,10 @@ std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
                               " objects");
                 std::unique_ptr<World> world;
                 try {
-                    world = std::make_unique<World>(scene, r.spec);
+                    // The build itself refuses past the limit too (its own estimate).
+                    world = std::make_unique<World>(
+                        scene, r.spec.withMaxMegabytes(
+                                   static_cast<std::uint64_t>(std::ceil(options.maxIndexMb))));
                 } catch (const std::exception& e) {
                     skipAll(std::string("index build failed: ") + e.what());
                     continue;

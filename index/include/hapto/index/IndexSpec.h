@@ -17,8 +17,10 @@ struct IndexSpec {
 
     static constexpr int kMaxGridCells = 256;       ///< Largest n of an n^3 grid.
     static constexpr int kMaxLeafObjects = 1 << 20; ///< Largest M of an octree.
-    /// Default memory limit of a build (bytes): 1024 MB (2^20 bytes each), `--max-index-mb`.
-    static constexpr std::uint64_t kDefaultMaxBytes = std::uint64_t(1024) << 20;
+    /// Default memory limit of a build, in MB (2^20 bytes each): `--max-index-mb`'s default.
+    static constexpr std::uint64_t kDefaultMaxMegabytes = 1024;
+    /// The same in bytes.
+    static constexpr std::uint64_t kDefaultMaxBytes = kDefaultMaxMegabytes << 20;
 
     Kind kind = Kind::BruteForce; ///< Which index.
     int gridCells = 0;            ///< Grid only: n, cells per side (1..kMaxGridCells).
@@ -41,6 +43,13 @@ struct IndexSpec {
     /// Parses "brute", "grid:5", "octree:2:0.005", each optionally with ":aabb" (or ":obb").
     /// Throws InputError saying what is wrong and what is expected. [any thread]
     static IndexSpec parse(std::string_view text);
+    /// This spec with a memory limit of `megabytes` MB (2^20 bytes each; saturates). For the
+    /// commands' `--max-index-mb`. [any thread]
+    IndexSpec withMaxMegabytes(std::uint64_t megabytes) const {
+        IndexSpec s = *this;
+        s.maxBytes = megabytes >= (std::uint64_t(1) << 44) ? ~std::uint64_t(0) : megabytes << 20;
+        return s;
+    }
     /// The text form; parse(toString()) gives this spec back. [any thread]
     std::string toString() const;
 

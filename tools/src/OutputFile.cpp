@@ -1,0 +1,272 @@
+// Output files written whole or not at all (temporary beside the target, then rename).
+
+#include "OutputFile.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <random>
+#include <stdexcept>
+#include <streambuf>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <vector>
+
+namespace hapto::cli {
+namespace fs = std::filesystem;
+namespace {
+
+std::string quoted(const fs::path& p) {
+    return "'" + p.string() + "'";
+}
+
+/// The file a write to `path` lands in: a symlink's target, else `path` itself.
+fs::path resolveTarget(const fs::path& path) {
+    std::error_code ec;
+    if (fs::is_symlink(fs::symlink_status(path, ec))) {
+        const fs::path resolved = fs::weakly_canonical(path, ec);
+        if (!ec) {
+            return resolved;
+        }
+    }
+    return path;
+}
+
+/// `p` made absolute, symlinks resolved as far as they exist, lexically normal otherwise.
+fs::path resolved(const fs::path& p) {
+    std::error_code ec;
+    const fs::path absolute = fs::absolute(p, ec).lexically_normal();
+    const fs::path canonical = fs::weakly_canonical(absolute, ec);
+    return ec ? absolute : canonical;
+}
+
+fs::path folderOf(const fs::path& path) {
+    return path.has_parent_path() ? path.parent_path() : fs::path(".");
+}
+
+/// A streambuf writing to a file descriptor through a buffer; errors make the stream bad.
+class FdBuf final : public std::streambuf {
+public:
+    explicit FdBuf(int fd) : mFd(fd), mBuffer(1 << 16) {
+        setp(mBuffer.data(), mBuffer.data() + mBuffer.size());
+    }
+    bool failed() const { return mFailed; }
+    int error() const { return mErrno; }
+
+protected:
+    int_type overflow(int_type c) override {
+        if (sync() != 0) {
+            return traits_type::eof();
+        }
+        if (!traits_type::eq_int_type(c, traits_type::eof())) {
+            *pptr() = traits_type::to_char_type(c);
+            pbump(1);
+        }
+        return traits_type::not_eof(c);
+    }
+    int sync() override {
+        const char* p = pbase();
+        while (p < pptr() && !mFailed) {
+            const ssize_t n = ::write(mFd, p, static_cast<std::size_t>(pptr() - p));
+            if (n < 0 && errno == EINTR) {
+                continue;
+            }
+            if (n <= 0) {
+                mFailed = true;
+                mErrno = n < 0 ? errno : EIO;
+                break;
+            }
+            p += n;
+        }
+        setp(mBuffer.data(), mBuffer.data() + mBuffer.size());
+        return mFailed ? -1 : 0;
+    }
+
+private:
+    int mFd;
+    std::vector<char> mBuffer;
+    bool mFailed = false;
+    int mErrno = 0;
+};
+
+} // namespace
+
+struct AtomicOutputFile::Impl {
+    fs::path target;    // where the contents end up (a symlink resolved)
+    fs::path temporary; // empty when writing the target directly (a device or a FIFO)
+    int fd = -1;
+    std::unique_ptr<FdBuf> buf;
+    std::unique_ptr<std::ostream> stream;
+    bool committed = false;
+};
+
+AtomicOutputFile::AtomicOutputFile(const fs::path& path)
+    : mPath(path), mImpl(std::make_unique<Impl>()) {
+    Impl& m = *mImpl;
+    m.target = resolveTarget(path);
+    struct stat st {};
+    const bool exists = ::stat(m.target.c_str(), &st) == 0;
+    if (exists && S_ISDIR(st.st_mode)) {
+        throw InputError(quoted(path) + " is a folder; give a file name to write");
+    }
+    if (exists && !S_ISREG(st.st_mode)) {
+        // A device, FIFO or socket cannot be replaced: write it as it is.
+        m.fd = ::open(m.target.c_str(), O_WRONLY | O_CLOEXEC);
+        if (m.fd < 0) {
+            throw InputError("cannot write " + quoted(path) + " (" + std::strerror(errno) + ")");
+        }
+    } else {
+        std::random_device random;
+        const char* digits = "0123456789abcdefghijklmnopqrstuvwxyz";
+        for (int attempt = 0; attempt < 100 && m.fd < 0; ++attempt) {
+            std::string suffix = ".tmp-";
+            for (int i = 0; i < 6; ++i) {
+                suffix += digits[random() % 36];
+            }
+            m.temporary = m.target;
+            m.temporary += suffix;
+            m.fd = ::open(m.temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC,
+                          0666);
+            if (m.fd < 0 && errno != EEXIST) {
+                break;
+            }
+        }
+        if (m.fd < 0) {
+            throw InputError("cannot write " + quoted(path) + " (" + std::strerror(errno) +
+                             "); check that the folder " + quoted(folderOf(m.target)) +
+                             " exists and is writable");
+        }
+        if (exists) {
+            (void)::fchmod(m.fd, st.st_mode & 07777); // a replaced file keeps its permissions
+        }
+    }
+    m.buf = std::make_unique<FdBuf>(m.fd);
+    m.stream = std::make_unique<std::ostream>(m.buf.get());
+}
+
+AtomicOutputFile::~AtomicOutputFile() {
+    if (mImpl->fd >= 0) {
+        ::close(mImpl->fd);
+    }
+    if (!mImpl->committed && !mImpl->temporary.empty()) {
+        ::unlink(mImpl->temporary.c_str());
+    }
+}
+
+std::ostream& AtomicOutputFile::stream() {
+    return *mImpl->stream;
+}
+
+void AtomicOutputFile::commit() {
+    Impl& m = *mImpl;
+    if (m.committed || m.fd < 0) {
+        throw std::logic_error("AtomicOutputFile::commit called twice");
+    }
+    m.stream->flush();
+    const bool written = !m.buf->failed() && static_cast<bool>(*m.stream);
+    int error = m.buf->failed() ? m.buf->error() : 0;
+    bool ok = written;
+    if (ok && !m.temporary.empty() && ::fsync(m.fd) != 0) {
+        ok = false;
+        error = errno;
+    }
+    if (::close(m.fd) != 0 && ok) {
+        ok = false;
+        error = errno;
+    }
+    m.fd = -1;
+    if (ok && !m.temporary.empty() && ::rename(m.temporary.c_str(), m.target.c_str()) != 0) {
+        ok = false;
+        error = errno;
+    }
+    if (!ok) {
+        throw std::runtime_error("writing " + quoted(mPath) + " failed (" +
+                                 std::strerror(error ? error : EIO) +
+                                 "); the file was left as it was");
+    }
+    m.committed = true;
+}
+
+void writeFileAtomically(const fs::path& path, std::string_view content) {
+    AtomicOutputFile file(path);
+    file.stream().write(content.data(), static_cast<std::streamsize>(content.size()));
+    file.commit();
+}
+
+void checkOutputFile(const fs::path& path, std::string_view option) {
+    if (path.empty()) {
+        return;
+    }
+    const std::string what = std::string(option) + " " + quoted(path);
+    const fs::path target = resolveTarget(path);
+    std::error_code ec;
+    const fs::file_status status = fs::status(target, ec);
+    if (fs::is_directory(status)) {
+        throw InputError(what + ": this is a folder; give a file name to write");
+    }
+    if (fs::exists(status) && !fs::is_regular_file(status)) {
+        return; // a device or FIFO: written as it is
+    }
+    const fs::path folder = folderOf(target);
+    if (!fs::exists(folder, ec)) {
+        throw InputError(what + ": the folder " + quoted(folder) +
+                         " does not exist; create it first");
+    }
+    if (!fs::is_directory(folder, ec)) {
+        throw InputError(what + ": " + quoted(folder) + " is not a folder");
+    }
+    if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+        throw InputError(what + ": the folder " + quoted(folder) + " is not writable (" +
+                         std::strerror(errno) + ")");
+    }
+}
+
+void checkOutputFolder(const fs::path& dir, std::string_view option) {
+    if (dir.empty()) {
+        return;
+    }
+    const std::string what = std::string(option) + " " + quoted(dir);
+    std::error_code ec;
+    fs::path existing = dir;
+    while (!fs::exists(existing, ec) && existing.has_parent_path() &&
+           existing.parent_path() != existing) {
+        existing = existing.parent_path();
+    }
+    if (!fs::exists(existing, ec)) {
+        existing = ".";
+    }
+    if (!fs::is_directory(existing, ec)) {
+        throw InputError(what + ": " + quoted(existing) +
+                         (existing == dir ? " exists and is not a folder"
+                                          : " is not a folder, so the folder cannot be made"));
+    }
+    if (::access(existing.c_str(), W_OK | X_OK) != 0) {
+        throw InputError(what + ": the folder " + quoted(existing) + " is not writable (" +
+                         std::strerror(errno) + ")");
+    }
+}
+
+bool sameFile(const fs::path& a, const fs::path& b) {
+    if (a.empty() || b.empty()) {
+        return false;
+    }
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec)) {
+        const bool same = fs::equivalent(a, b, ec);
+        return !ec && same;
+    }
+    return resolved(a) == resolved(b);
+}
+
+void refuseSameFile(const fs::path& output, std::string_view outOption, const fs::path& input,
+                    std::string_view inWhat) {
+    if (sameFile(output, input)) {
+        throw InputError(std::string(outOption) + " " + quoted(output) + " is the same file as " +
+                         std::string(inWhat) + " " + quoted(input) +
+                         "; an input is never overwritten: write the output somewhere else");
+    }
+}
+
+} // namespace hapto::cli

@@ -1,0 +1,67 @@
+#pragma once
+/// Output files written whole or not at all, and the checks made on output paths before work.
+///
+/// Design note. Every file a command writes (`-o`, `--report`, experiment and soak outputs)
+/// goes to a temporary file in the target's own folder (`<name>.tmp-XXXXXX`, created
+/// exclusively, never through a symlink) and is renamed onto the target only once it is
+/// complete and synced, so a failure or a kill leaves the old file as it was, never a half
+/// file. The temporary is removed when anything fails before the rename. A target that is a
+/// symlink is resolved first (the link stays, its file is replaced); a target that exists and
+/// is neither a regular file nor a folder (/dev/null, a FIFO, a terminal) is written directly,
+/// since it cannot be replaced. The checks run before any work starts, so bad output paths are
+/// refused (InputError, exit code 2) instead of being found after a long run.
+
+#include <filesystem>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <string_view>
+
+namespace hapto::cli {
+
+/// One output file being written: a stream onto a temporary beside the target, renamed into
+/// place by commit(). Destroyed without commit(), it removes the temporary. [control]
+class AtomicOutputFile {
+public:
+    /// Creates the temporary. Throws InputError naming `path` when its folder cannot take it.
+    explicit AtomicOutputFile(const std::filesystem::path& path);
+    /// Removes the temporary unless commit() succeeded.
+    ~AtomicOutputFile();
+    AtomicOutputFile(const AtomicOutputFile&) = delete;
+    AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
+
+    /// Where to write the contents.
+    std::ostream& stream();
+    /// Flushes and syncs the contents and renames them onto the target. Throws
+    /// std::runtime_error (the temporary removed, the target untouched) when that fails.
+    void commit();
+    /// The target as given.
+    const std::filesystem::path& path() const { return mPath; }
+
+private:
+    struct Impl;
+    std::filesystem::path mPath;
+    std::unique_ptr<Impl> mImpl;
+};
+
+/// Writes `content` to `path` through an AtomicOutputFile. Throws InputError when the folder
+/// cannot take it, std::runtime_error when the write fails. [control]
+void writeFileAtomically(const std::filesystem::path& path, std::string_view content);
+
+/// Refuses (InputError naming `option`) an output file that cannot be written: a folder, or a
+/// path whose folder does not exist or is not writable. Nothing is created. [control]
+void checkOutputFile(const std::filesystem::path& path, std::string_view option);
+/// Refuses (InputError naming `option`) an output folder that cannot be used: an existing
+/// non-folder, a folder not writable, or (when missing) a nearest existing parent that is not a
+/// writable folder. Nothing is created. [control]
+void checkOutputFolder(const std::filesystem::path& dir, std::string_view option);
+
+/// True when `a` and `b` name the same file: the same inode when both exist (hard links and
+/// symlinks included), else the same absolute path once resolved. [control]
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
+/// Refuses (InputError) writing `output` (given with `outOption`) over the input `input`
+/// (given as `inWhat`, e.g. "--scene"): an input is never overwritten. Empty paths pass.
+void refuseSameFile(const std::filesystem::path& output, std::string_view outOption,
+                    const std::filesystem::path& input, std::string_view inWhat);
+
+} // namespace hapto::cli

@@ -1,0 +1,85 @@
+// Checks made on a session's arguments before any device starts.
+
+#include "SessionChecks.h"
+
+#include "OutputFile.h"
+
+#include "hapto/runtime/World.h"
+#include "hapto/scenes/InputError.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace hapto::cli {
+namespace fs = std::filesystem;
+
+void checkDeviceCount(std::size_t devices, const std::string& source) {
+    if (devices > World::kMaxReaders) {
+        throw InputError((source.empty() ? std::string("the session") : "--devices " + source) +
+                         ": " + std::to_string(devices) + " devices, but one session drives at " +
+                         "most " + std::to_string(World::kMaxReaders) +
+                         " (World::kMaxReaders, one snapshot reader per servo thread); split " +
+                         "them over several sessions");
+    }
+}
+
+void checkSpinAgainstRates(double spinUs, std::span<const DeviceConfig> configs) {
+    for (const DeviceConfig& c : configs) {
+        const double periodUs = 1e6 / c.rateHz;
+        if (spinUs > 0 && spinUs >= periodUs) {
+            char text[256];
+            std::snprintf(text, sizeof text,
+                          "--spin-us %g: not shorter than the servo period of device '%s' "
+                          "(%g us at %g Hz); spin less than the period, or run slower",
+                          spinUs, c.name.c_str(), periodUs, c.rateHz);
+            throw InputError(text);
+        }
+    }
+}
+
+void checkSessionFiles(const SessionPaths& paths, std::span<const DeviceConfig> configs) {
+    // Every file the session reads.
+    std::vector<std::pair<fs::path, std::string>> inputs;
+    if (!paths.scene.empty()) {
+        inputs.emplace_back(paths.scene, "--scene");
+    }
+    if (!paths.devices.empty()) {
+        inputs.emplace_back(paths.devices, "--devices");
+    }
+    for (const DeviceConfig& c : configs) {
+        if (const auto* replay = std::get_if<ReplayConfig>(&c.params)) {
+            inputs.emplace_back(replay->trace, "the trace replay device '" + c.name + "' reads");
+        }
+    }
+    const auto refuseInputs = [&](const fs::path& output, const std::string& option) {
+        for (const auto& [input, what] : inputs) {
+            refuseSameFile(output, option, input, what);
+        }
+    };
+    if (!paths.report.empty()) {
+        refuseInputs(paths.report, "--report");
+        checkOutputFile(paths.report, "--report");
+    }
+    if (!paths.record.empty()) {
+        checkOutputFolder(paths.record, "--record");
+        for (const DeviceConfig& c : configs) {
+            const fs::path trace = fs::path(paths.record) / (c.name + ".trace");
+            const std::string option = "--record (device '" + c.name + "')";
+            refuseInputs(trace, option);
+            if (sameFile(trace, paths.report)) {
+                throw InputError("--report " + paths.report + " is where --record writes device '" +
+                                 c.name + "''s trace; give the report another name");
+            }
+            std::error_code ec;
+            if (fs::is_directory(trace, ec)) {
+                throw InputError(option + ": " + trace.string() +
+                                 " is a folder, so the trace cannot be written there");
+            }
+        }
+    }
+}
+
+} // namespace hapto::cli

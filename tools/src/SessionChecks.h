@@ -1,0 +1,36 @@
+#pragma once
+/// The checks a session's arguments pass before any device starts (`hapto run`, `demo`,
+/// `soak`): bad ones are refused with InputError (exit code 2) while nothing runs yet.
+
+#include "hapto/devices/DeviceConfig.h"
+
+#include <cstddef>
+#include <span>
+#include <string>
+
+namespace hapto::cli {
+
+/// What a session reads and writes, as given on the command line ("" = none or built in).
+struct SessionPaths {
+    std::string scene;   ///< --scene: the scene file.
+    std::string devices; ///< --devices: the device configuration file.
+    std::string report;  ///< --report: the JSON report to write.
+    std::string record;  ///< --record: the folder the traces go to (<folder>/<name>.trace).
+};
+
+/// Refuses more devices than one World serves (World::kMaxReaders), naming the limit and
+/// `source` (the device file). [control]
+void checkDeviceCount(std::size_t devices, const std::string& source);
+
+/// Refuses a spin (us, before each deadline) that is not shorter than the servo period of
+/// every device at its rate. [control]
+void checkSpinAgainstRates(double spinUs, std::span<const DeviceConfig> configs);
+
+/// Refuses outputs that cannot be written or would destroy an input: a --report that is a
+/// folder, in a missing or read-only folder, or the same file as the scene, the device file or
+/// a replay device's trace; a --record folder that cannot be made or written, or whose
+/// `<name>.trace` would be a folder, an input (a trace a replay device of this session reads,
+/// the scene, the device file) or the report. Nothing is created. [control]
+void checkSessionFiles(const SessionPaths& paths, std::span<const DeviceConfig> configs);
+
+} // namespace hapto::cli
