@@ -1,6 +1,7 @@
 // `hapto bench query`: per-query cost of indices over one scene, along one hand-speed walk.
 
 #include "Commands.h"
+#include "Options.h"
 
 #include "../bench/HandWalk.h"
 
@@ -253,10 +254,12 @@ void addBenchCommands(CLI::App& app) {
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
     cmd->add_option("--steps", args->steps, "Walk steps (queries) per index, e.g. 1e5")
         ->capture_default_str();
-    cmd->add_option("--seed", args->seed, "Walk seed; same seed, same walk")->capture_default_str();
+    cmd->add_option("--seed", args->seed, "Walk seed; same seed, same walk")
+        ->capture_default_str()
+        ->check(finiteRange(0, kMaxSeed));
     cmd->add_option("--batch", args->batch, "Queries per clock reading (1 = time each query alone)")
         ->capture_default_str()
-        ->check(CLI::Range(std::size_t{1}, kBlockSteps));
+        ->check(finiteRange(1, kBlockSteps));
     cmd->add_flag("--json", args->json,
                   "Print only a JSON array of {index, objects, steps, ns_p50, ns_p999, ns_mean, "
                   "locate_steps_mean, candidates_mean}");

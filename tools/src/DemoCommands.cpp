@@ -1,9 +1,13 @@
 // `hapto demo grasp`: two simulated hands pick up, carry and put down an object.
 
 #include "Commands.h"
+#include "Options.h"
+#include "OutputFile.h"
+#include "SessionChecks.h"
 
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/DeviceFactory.h"
+#include "hapto/devices/ReplayDevice.h"
 #include "hapto/devices/SimDevice.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/index/IndexSpec.h"
@@ -17,7 +21,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <thread>
 
 namespace hapto::cli {
@@ -74,6 +77,8 @@ int runDemo(const DemoArgs& a) {
                          ": the grasp demo takes exactly two devices (left, right), got " +
                          std::to_string(configs.size()));
     }
+    useTraceRates(configs);
+    checkSessionFiles({a.scene, a.devices, a.report, ""}, configs);
     World world(scene, IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb));
     std::vector<RuntimeDevice> devices;
     std::vector<SimDevice*> sims;
@@ -210,11 +215,7 @@ int runDemo(const DemoArgs& a) {
             {"index_finds_it_at_start", foundOld},
             {"path", path},
             {"devices", devicesJson}};
-        std::ofstream out(a.report);
-        out << report.dump(2) << "\n";
-        if (!out) {
-            throw InputError(a.report + ": cannot write the report");
-        }
+        writeFileAtomically(a.report, report.dump(2) + "\n");
         std::printf("report written to %s\n", a.report.c_str());
     }
     return 0;
@@ -233,7 +234,9 @@ void addDemoCommands(CLI::App& app) {
     cmd->add_option("--devices", a->devices,
                     "Two-device configuration (default: simulated hands with the grasp-left / "
                     "grasp-right scripts)");
-    cmd->add_option("--object", a->object, "Id of the object to grasp")->capture_default_str();
+    cmd->add_option("--object", a->object, "Id of the object to grasp")
+        ->capture_default_str()
+        ->check(finiteRange(0, kMaxObjectId));
     cmd->add_option("--index", a->index, "Spatial index SPEC")->capture_default_str();
     cmd->add_option("--max-index-mb", a->maxIndexMb,
                     "Most memory an index build may take (MB); a larger index is refused")

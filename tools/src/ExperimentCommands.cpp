@@ -2,6 +2,7 @@
 // by the real Runtime, written as CSV, JSON, markdown and gnuplot figures.
 
 #include "Commands.h"
+#include "Options.h"
 
 #include "experiments/ExperimentSupport.h"
 #include "experiments/Experiments.h"
@@ -36,12 +37,12 @@ void addCommon(CLI::App* cmd, CommonArgs& a, CommonOptions& o, const std::string
     o.duration = cmd->add_option("--duration", a.durationS,
                                  "Timed servo run per measurement (s); --quick: 0.15")
                      ->capture_default_str()
-                     ->check(CLI::Range(0.02, 60.0));
+                     ->check(finiteRange(0.02, 60));
     o.repeats = cmd->add_option("--repeats", a.repeats,
                                 "Runs per measurement; every figure is the median over them; "
                                 "--quick: 1")
                     ->capture_default_str()
-                    ->check(CLI::Range(1, 99));
+                    ->check(finiteRange(1, 99));
     cmd->add_flag("--no-realtime", o.noRealtime,
                   "Do not ask for SCHED_FIFO and CPU pinning (default: ask; the runtime falls "
                   "back to normal scheduling when refused and says so)");
@@ -103,12 +104,12 @@ void addExperimentCommands(CLI::App& app) {
                                      "2,3,4,5,6,8,10,13,16,20,25,32,40,50,64,80,100,... up to "
                                      "it; --quick: 4")
                          ->capture_default_str()
-                         ->check(CLI::Range(2, 400));
+                         ->check(finiteRange(2, 400));
         cmd->add_option("--max-index-mb", a->maxIndexMb,
                         "Skip an index whose memory, extrapolated from the previous size, "
                         "would pass this (MB)")
             ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+            ->check(finiteRange(1e-3, 1e9));
         cmd->callback([a, o, rates, maxK, verdict] {
             applyQuick(a->common, *o);
             a->verdict = parseVerdict(*verdict, "--verdict");
@@ -147,19 +148,19 @@ void addExperimentCommands(CLI::App& app) {
         auto* seeds =
             cmd->add_option("--seeds", a->seeds, "Scenes per count (seeds 1..N); --quick: 2")
                 ->capture_default_str()
-                ->check(CLI::Range(1, 100));
+                ->check(finiteRange(1, 100));
         cmd->add_option("--rate", *rates,
                         "Servo rate(s) (Hz, 100..100000), comma-separated for several")
             ->capture_default_str();
         cmd->add_option("--keep-clear", a->keepClearM,
                         "No object within this distance of the centre, where the hand starts (m)")
             ->capture_default_str()
-            ->check(CLI::Range(0.005, 0.1));
+            ->check(finiteRange(0.005, 0.1));
         cmd->add_option("--max-index-mb", a->maxIndexMb,
                         "Skip an index whose memory, extrapolated from the previous count, "
                         "would pass this (MB)")
             ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+            ->check(finiteRange(1e-3, 1e9));
         cmd->callback([a, o, rates, counts, decades, countsOpt, seeds, verdict] {
             applyQuick(a->common, *o);
             a->verdict = parseVerdict(*verdict, "--verdict");
@@ -204,7 +205,7 @@ void addExperimentCommands(CLI::App& app) {
                                            "Largest device count; counts 1, 2, 4, ... up to it; "
                                            "--quick: 2")
                                ->capture_default_str()
-                               ->check(CLI::Range(1, 60));
+                               ->check(finiteRange(1, 60));
         auto* ratesOpt = cmd->add_option("--rates", *rates,
                                          "Servo rates (Hz, 100..100000), comma-separated; "
                                          "--quick: 1000")

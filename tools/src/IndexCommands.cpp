@@ -1,6 +1,7 @@
 // `hapto query` and `hapto index-stats`: build a spatial index over a scene and ask it things.
 
 #include "Commands.h"
+#include "OutputFile.h"
 
 #include "hapto/index/Cursor.h"
 #include "hapto/index/IndexSpec.h"
@@ -83,19 +84,20 @@ std::vector<Vec3> readPoints(const std::string& path) {
 void runQuery(const std::string& scenePath, const std::string& specText,
               const std::string& pointsPath, const std::string& outPath, std::uint64_t maxIndexMb) {
     const IndexSpec spec = IndexSpec::parse(specText).withMaxMegabytes(maxIndexMb);
+    if (!outPath.empty()) {
+        refuseSameFile(outPath, "-o", scenePath, "--scene");
+        refuseSameFile(outPath, "-o", pointsPath, "--points");
+        checkOutputFile(outPath, "-o");
+    }
     const std::vector<Vec3> points = readPoints(pointsPath);
     const Scene scene = loadSceneOrDefault(scenePath);
     const std::unique_ptr<SpatialIndex> index = buildIndex(scene, spec);
 
-    std::ofstream file;
+    std::unique_ptr<AtomicOutputFile> file;
     if (!outPath.empty()) {
-        file.open(outPath, std::ios::binary | std::ios::trunc);
-        if (!file) {
-            throw InputError("cannot write output file '" + outPath +
-                             "': check the folder exists and is writable");
-        }
+        file = std::make_unique<AtomicOutputFile>(outPath);
     }
-    std::ostream& out = outPath.empty() ? std::cout : file;
+    std::ostream& out = file ? file->stream() : std::cout;
     std::string text = "point,candidates\n";
     Cursor cursor(*index);
     std::vector<ObjectId> ids;
@@ -124,6 +126,9 @@ void runQuery(const std::string& scenePath, const std::string& specText,
     out.flush();
     if (!out) {
         throw std::runtime_error("writing the query results failed");
+    }
+    if (file) {
+        file->commit();
     }
 }
 

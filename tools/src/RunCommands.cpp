@@ -1,9 +1,13 @@
 // `hapto run`: a session of D devices over one shared world, reporting each device's load.
 
 #include "Commands.h"
+#include "Options.h"
+#include "OutputFile.h"
+#include "SessionChecks.h"
 
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/DeviceFactory.h"
+#include "hapto/devices/ReplayDevice.h"
 #include "hapto/devices/TraceRecorder.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/runtime/Runtime.h"
@@ -68,6 +72,18 @@ void printSummary(const RunReport& r) {
     }
 }
 
+// Gives replay devices their trace's rate unless --rate set one for all, then refuses, before
+// anything starts, what cannot work: too many devices, a spin as long as a period, outputs
+// that cannot be written or would overwrite an input. Throws InputError.
+void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
+    if (!(a.rateHz > 0)) {
+        useTraceRates(configs);
+    }
+    checkDeviceCount(configs.size(), a.devices);
+    checkSpinAgainstRates(a.spinUs, configs);
+    checkSessionFiles({a.scene, a.devices, a.report, a.record}, configs);
+}
+
 int runSession(const RunArgs& a) {
     const Scene scene = loadSceneOrDefault(a.scene);
     const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
@@ -78,6 +94,7 @@ int runSession(const RunArgs& a) {
             c.rateHz = a.rateHz;
         }
     }
+    prepareSession(a, configs);
     World world(scene, spec);
 
     std::vector<std::unique_ptr<TraceRecorder>> recorders;
@@ -156,11 +173,7 @@ int runSession(const RunArgs& a) {
     const RunReport r = runtime.report();
     printSummary(r);
     if (!a.report.empty()) {
-        std::ofstream out(a.report);
-        out << reportToJson(r);
-        if (!out) {
-            throw InputError(a.report + ": cannot write the report");
-        }
+        writeFileAtomically(a.report, reportToJson(r));
         std::fprintf(stderr, "report written to %s\n", a.report.c_str());
     }
     return 0;
@@ -185,26 +198,26 @@ void addRunCommands(CLI::App& app) {
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
     cmd->add_option("--rate", a->rateHz,
                     "Servo rate for every device (Hz; default: each device's own)")
-        ->check(CLI::Range(100.0, 100000.0));
+        ->check(finiteRange(100, 100000));
     cmd->add_option("--duration", a->durationS, "Run time (s); 0 runs until Ctrl-C")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(finiteRange(0, 1e8));
     cmd->add_option("--report", a->report, "Write the JSON report here");
     cmd->add_option("--record", a->record,
                     "Record every device's ticks into DIR/<name>.trace (see `hapto trace export`)");
     cmd->add_flag("--no-realtime", a->noRealtime, "Do not ask for SCHED_FIFO and CPU pinning");
     cmd->add_option("--spin-us", a->spinUs, "Spin this long before each deadline (us)")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 1000.0));
+        ->check(finiteRange(0, 1000));
     cmd->add_option("--miss-limit", a->missLimit,
                     "K: after K missed deadlines in a row, command zero force until caught up")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000000));
+        ->check(finiteRange(1, 1000000));
     cmd->add_option("--reopen-ms", a->reopenMs,
                     "After a device fault (zero force at once), close the device and try to open "
                     "it again this often, then drive it again from zero force (ms); 0 = never")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 3600000.0));
+        ->check(finiteRange(0, 3600000));
     cmd->add_flag("--quiet", a->quiet, "No live view");
     cmd->callback([a] {
         const int rc = runSession(*a);

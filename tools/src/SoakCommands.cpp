@@ -4,6 +4,9 @@
 // injected fault zeroed its device and the device came back, and whether memory stayed flat.
 
 #include "Commands.h"
+#include "Options.h"
+#include "OutputFile.h"
+#include "SessionChecks.h"
 #include "experiments/ExperimentSupport.h"
 
 #include "hapto/devices/DeviceFactory.h"
@@ -172,6 +175,19 @@ private:
 };
 
 int runSoak(const SoakArgs& a) {
+    const double durationS = a.minutes * 60.0;
+    const double quietTailS =
+        std::min(durationS / 2, 3.0 * a.watchdogMs / 1000 + 1.0 + a.reopenMs / 1000);
+    if (a.faultEveryS >= durationS - quietTailS) {
+        char text[320];
+        std::snprintf(text, sizeof text,
+                      "--minutes %g: the soak would end before its first fault (--fault-every "
+                      "%g s; faults stop %.1f s before the end so the last can recover), so it "
+                      "could test nothing; run longer or inject faults more often",
+                      a.minutes, a.faultEveryS, quietTailS);
+        throw InputError(text);
+    }
+    checkSessionFiles({a.scene, "", a.report, ""}, {});
     const Scene scene = loadSceneOrDefault(a.scene);
     const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
     World world(scene, spec);
@@ -194,9 +210,6 @@ int runSoak(const SoakArgs& a) {
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
     Runtime runtime(world, std::move(rds), opt);
 
-    const double durationS = a.minutes * 60.0;
-    const double quietTailS =
-        std::min(durationS / 2, 3.0 * a.watchdogMs / 1000 + 1.0 + a.reopenMs / 1000);
     std::fprintf(stderr,
                  "hapto soak: %d devices at %.0f Hz, %u objects, index %s, %.1f min; a fault "
                  "every %.1f s, windows of %.0f s\n",
@@ -293,6 +306,9 @@ int runSoak(const SoakArgs& a) {
     world.settle();
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
+    // Stopped by a signal, or no fault injected (a machine too slow to reach the first one):
+    // then nothing was tested to the end, and the soak cannot pass.
+    const bool interrupted = gSoakStop.load();
     const RunReport r = runtime.report();
 
     // Verdicts.
@@ -380,9 +396,11 @@ int runSoak(const SoakArgs& a) {
                 static_cast<unsigned long long>(churn.updates()),
                 static_cast<unsigned long long>(world.buildsPublished()), world.retiredCount());
     std::printf("faults: %zu injected; %s\n", nextFault,
-                faultsOk ? "every one zeroed its device at once and the device came back, no "
-                           "other faults"
-                         : "NOT handled as expected (see above)");
+                !faultsOk        ? "NOT handled as expected (see above)"
+                : nextFault == 0 ? "none, so fault handling was not tested"
+                                 : "every one zeroed its device at once and the device came "
+                                   "back, no other faults");
+    const bool pass = faultsOk && memoryOk && nextFault > 0 && !interrupted;
     std::printf("timing: %.4f %% of deadlines missed (DESIGN's verdict: <= 0.1 %%: %s)%s\n",
                 missedPct, missedPct <= 0.1 ? "met" : "not met",
                 r.realtimeNote.empty() ? "" : ("; note: " + r.realtimeNote).c_str());
@@ -430,16 +448,17 @@ int runSoak(const SoakArgs& a) {
                                  {"faults_injected", nextFault},
                                  {"faults_ok", faultsOk},
                                  {"missed_pct", missedPct},
-                                 {"pass", faultsOk && memoryOk}};
-        std::ofstream file(a.report);
-        file << out.dump(2) << "\n";
-        if (!file) {
-            throw InputError(a.report + ": cannot write the soak report");
-        }
+                                 {"interrupted", interrupted},
+                                 {"pass", pass}};
+        writeFileAtomically(a.report, out.dump(2) + "\n");
         std::fprintf(stderr, "report written to %s\n", a.report.c_str());
     }
-    std::printf("soak: %s\n", faultsOk && memoryOk ? "PASS" : "FAIL");
-    return faultsOk && memoryOk ? 0 : 1;
+    if (interrupted) {
+        std::printf("soak: INTERRUPTED after %.1f of %.1f s: no verdict\n", r.durationS, durationS);
+    } else {
+        std::printf("soak: %s\n", pass ? "PASS" : "FAIL");
+    }
+    return pass ? 0 : 1;
 }
 
 } // namespace
@@ -448,17 +467,19 @@ void addSoakCommands(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "soak", "Run simulated hands for a long time over a changing world with faults injected "
                 "on a schedule; report tick-rate drift, memory growth and misses. Exit 0 when "
-                "every fault was handled and memory stayed flat, 1 otherwise");
+                "every fault was handled and memory stayed flat, 1 otherwise (and when "
+                "interrupted: no verdict); 2 for bad arguments, such as a soak too short to "
+                "reach its first fault");
     auto a = std::make_shared<SoakArgs>();
     cmd->add_option("--minutes", a->minutes, "How long to run (min; fractions allowed)")
         ->capture_default_str()
-        ->check(CLI::Range(0.02, 100000.0));
+        ->check(finiteRange(0.02, 100000));
     cmd->add_option("--devices", a->devices, "Simulated hands (D)")
         ->capture_default_str()
-        ->check(CLI::Range(1, 32));
+        ->check(finiteRange(1, 32));
     cmd->add_option("--rate", a->rateHz, "Servo rate of every hand (Hz)")
         ->capture_default_str()
-        ->check(CLI::Range(100.0, 100000.0));
+        ->check(finiteRange(100, 100000));
     cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
     cmd->add_option("--index", a->index,
                     "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb")
@@ -472,22 +493,22 @@ void addSoakCommands(CLI::App& app) {
                     "(0.5 s), stall of 0.4 watchdog timeouts (a miss, not a fault), non-finite "
                     "sample, stall of 3 watchdog timeouts, read error (s)")
         ->capture_default_str()
-        ->check(CLI::Range(0.1, 1e6));
+        ->check(finiteRange(0.1, 1e6));
     cmd->add_option("--window", a->windowS, "Report rate, drift, misses and memory per window (s)")
         ->capture_default_str()
-        ->check(CLI::Range(0.5, 1e6));
+        ->check(finiteRange(0.5, 1e6));
     cmd->add_option("--watchdog-ms", a->watchdogMs,
                     "No tick for this long faults a device (ms); stalls are sized from it")
         ->capture_default_str()
-        ->check(CLI::Range(5.0, 10000.0));
+        ->check(finiteRange(5, 10000));
     cmd->add_option("--reopen-ms", a->reopenMs, "Retry opening a faulted device this often (ms)")
         ->capture_default_str()
-        ->check(CLI::Range(1.0, 60000.0));
+        ->check(finiteRange(1, 60000));
     cmd->add_option("--memory-tolerance", a->memoryToleranceMiB,
                     "Resident memory may grow this much: median of the last third of the "
                     "windows against the first third, the first window left out (MiB)")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(finiteRange(0, 1e6));
     cmd->add_option("--report", a->report, "Write the JSON soak report here");
     cmd->add_flag("--no-realtime", a->noRealtime, "Do not ask for SCHED_FIFO and CPU pinning");
     cmd->callback([a] {
