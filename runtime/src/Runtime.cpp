@@ -4,6 +4,12 @@
 // is sized before the loop starts; inside the loop a tick is: sleep to an absolute deadline,
 // read, claim the snapshot, locate both cursors, render, filter, write, record. Faults become
 // zero force and a recorded FaultKind, never an exception.
+//
+// Supervision runs on the runtime's own supervisor thread (SCHED_FIFO one above the servo
+// threads when real-time): every few milliseconds it checks each servo thread's heartbeat
+// (the watchdog) and hands a device whose thread ended on a fault to a worker thread, which
+// closes it, reopens it every reopenAfterNs and starts its next servo thread. No step of
+// that waits on the control thread, a terminal, a disk or another device's open().
 
 #include "hapto/runtime/Runtime.h"
 
@@ -16,6 +22,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <pthread.h>
+#include <sched.h>
 #include <stdexcept>
 #include <unistd.h>
 
@@ -74,14 +82,17 @@ struct alignas(64) Runtime::Channel {
     int cpu = -1;
     std::atomic<bool> stop{false};
     std::thread thread;
-    bool opened = false;
+    bool opened = false; // open() succeeded at start(); control thread only
     std::string openError;
     rt::RealtimeGrant grant;
 
-    // Fault recovery, control thread only.
-    bool down = false;               // the thread ended on a fault; the device is closed
-    std::uint64_t downSinceNs = 0;   // when maintain() noticed the fault
-    std::uint64_t lastAttemptNs = 0; // last reopen attempt
+    // Fault recovery. The supervisor hands a faulted device to a worker thread (recovering),
+    // which closes it (down), reopens it and starts its next servo thread; with reopening
+    // off it stays closed (gaveUp). `closed` makes sure one thread, and one only, closes it.
+    std::atomic<bool> recovering{false}, down{false}, gaveUp{false}, closed{false};
+    std::thread worker;
+    mutable std::mutex cold;       // guards the record below: workers write it, report() reads
+    std::uint64_t downSinceNs = 0; // when the fault happened
     std::uint64_t faults = 0, reopens = 0, downNs = 0;
     std::string lastFault;       // what the last fault was, for the report
     std::string lastReopenError; // so a device that stays away is logged once, not per try
@@ -116,12 +127,18 @@ void storeVec(std::atomic<double> (&dst)[3], const Vec3& v) {
 
 Runtime::Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOptions options)
     : mWorld(world), mOptions(options) {
+    if (devices.size() > World::kMaxReaders) {
+        // Refused before anything opens or starts, not at the 65th servo thread.
+        throw std::invalid_argument("runtime: " + std::to_string(devices.size()) +
+                                    " devices; at most " + std::to_string(World::kMaxReaders) +
+                                    " can share one world");
+    }
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     for (std::size_t i = 0; i < devices.size(); ++i) {
         if (!devices[i].device) {
             throw std::invalid_argument("runtime: device " + std::to_string(i) + " is null");
         }
-        if (!(devices[i].config.rateHz > 0)) {
+        if (!(devices[i].config.rateHz > 0) || !std::isfinite(devices[i].config.rateHz)) {
             throw std::invalid_argument("runtime: device '" + devices[i].config.name +
                                         "' has no servo rate");
         }
@@ -139,7 +156,8 @@ Runtime::~Runtime() {
 
 std::size_t Runtime::start() {
     mStartNs = rt::nowNs();
-    std::size_t started = 0;
+    // Every device is opened before any servo thread starts (the PHANToM's HD scheduler must
+    // not run while another device is being initialised; a Falcon homes with zero force).
     for (auto& chp : mChannels) {
         Channel& ch = *chp;
         const DeviceStatus st = ch.rd.device->open();
@@ -147,25 +165,30 @@ std::size_t Runtime::start() {
             ch.openError = std::string(statusName(st)) + ": " + ch.rd.device->errorMessage();
             ch.metrics.fault.store(FaultKind::OpenFailed);
             ch.metrics.faultStatus.store(static_cast<std::uint8_t>(st));
+            ch.closed.store(true);
             continue;
         }
         ch.opened = true;
-        ch.reader = mWorld.registerReader();
-        if (!ch.reader) {
-            throw std::runtime_error("runtime: more devices than the world has reader slots (" +
-                                     std::to_string(World::kMaxReaders) + ")");
-        }
-        startThread(ch);
-        ++started;
+        ch.closed.store(false);
+        ch.reader = mWorld.registerReader(); // the constructor bounded the count
     }
+    std::size_t started = 0;
+    for (auto& chp : mChannels) {
+        if (chp->opened) {
+            startThread(*chp);
+            ++started;
+        }
+    }
+    mStopping.store(false);
+    mSupervisor = std::thread([this] { superviseMain(); });
     return started;
 }
 
 void Runtime::startThread(Channel& ch) {
     ch.stop.store(false, std::memory_order_release);
     ch.safety.reset(); // force grows from zero at the safety filter's rate
-    ch.metrics.running.store(true);
     ch.metrics.heartbeatNs.store(rt::nowNs());
+    ch.metrics.running.store(true);
     ch.thread = std::thread([this, &ch] { servoMain(ch); });
 }
 
@@ -191,6 +214,7 @@ void Runtime::servoMain(Channel& ch) {
     const std::uint64_t starvedNs =
         static_cast<std::uint64_t>(std::max(1, mOptions.missLimit)) * period;
     const std::uint64_t startNs = mStartNs;
+    const int missLimit = std::max(1, mOptions.missLimit);
 
     const WorldSnapshot* snap = &mWorld.acquire(*ch.reader);
     std::uint64_t version = snap->version;
@@ -259,8 +283,11 @@ void Runtime::servoMain(Channel& ch) {
         Triple external{0.0, 0.0, 0.0};
         (void)ch.externalForce.read(external);
 
+        if (ch.stop.load(std::memory_order_acquire)) {
+            break; // stopped while rendering: the exit below writes zero, not this force
+        }
         Vec3 force = ch.safety.filter(out.force + vec(external));
-        if (consecutiveMisses >= mOptions.missLimit || lateness >= starvedNs) {
+        if (consecutiveMisses >= missLimit || lateness >= starvedNs) {
             force = Vec3(0.0);
             ch.safety.reset();
             DeviceMetrics::bump(m.zeroedForMisses);
@@ -327,7 +354,7 @@ void Runtime::servoMain(Channel& ch) {
         deadline += period;
         if (done > deadline) {
             DeviceMetrics::bump(m.missedDeadlines);
-            ++consecutiveMisses;
+            consecutiveMisses = std::min(consecutiveMisses + 1, missLimit); // saturates
             deadline += ((done - deadline) / period + 1) * period;
         } else {
             consecutiveMisses = 0;
@@ -348,23 +375,138 @@ void Runtime::servoMain(Channel& ch) {
 }
 
 void Runtime::maintain() {
-    const std::uint64_t now = rt::nowNs();
-    for (auto& chp : mChannels) {
-        Channel& ch = *chp;
-        if (!ch.metrics.running.load(std::memory_order_acquire)) {
-            recover(ch, now);
-            continue;
-        }
-        const std::uint64_t beat = ch.metrics.heartbeatNs.load(std::memory_order_relaxed);
-        if (now > beat && now - beat > mOptions.stallTimeoutNs &&
-            ch.metrics.fault.load() == FaultKind::None) {
-            // The thread is stuck inside the device; when it returns it writes zero and ends.
-            ch.metrics.faultNs.store(beat);
-            ch.metrics.fault.store(FaultKind::Watchdog);
-            ch.stop.store(true, std::memory_order_release);
+    mWorld.maintain();
+}
+
+bool Runtime::waitUnlessStopping(std::uint64_t ns) {
+    std::unique_lock lock(mWakeMutex);
+    return !mWake.wait_for(lock, std::chrono::nanoseconds(ns),
+                           [this] { return mStopping.load(std::memory_order_acquire); });
+}
+
+void Runtime::superviseMain() {
+    // Above the servo threads, so a stalled or starved core never keeps the watchdog from
+    // running (it sleeps between passes and its pass is a few atomic loads).
+    if (mOptions.realtime) {
+        (void)rt::makeCurrentThreadRealtime(std::min(99, mOptions.fifoPriority + 1), -1);
+    }
+    const std::uint64_t passNs =
+        std::clamp<std::uint64_t>(mOptions.stallTimeoutNs / 5, 1'000'000, 10'000'000);
+    while (waitUnlessStopping(passNs)) {
+        const std::uint64_t now = rt::nowNs();
+        for (auto& chp : mChannels) {
+            Channel& ch = *chp;
+            if (!ch.opened || ch.recovering.load(std::memory_order_acquire) ||
+                ch.gaveUp.load(std::memory_order_acquire)) {
+                continue;
+            }
+            DeviceMetrics& m = ch.metrics;
+            if (m.running.load(std::memory_order_acquire)) {
+                const std::uint64_t beat = m.heartbeatNs.load(std::memory_order_relaxed);
+                FaultKind none = FaultKind::None;
+                if (now > beat && now - beat > mOptions.stallTimeoutNs &&
+                    m.fault.compare_exchange_strong(none, FaultKind::Watchdog)) {
+                    // The thread is stuck (in the device, or the host stopped it): when it
+                    // returns it writes zero and ends, and the fault is recovered like any.
+                    m.faultNs.store(beat);
+                    ch.stop.store(true, std::memory_order_release);
+                }
+                continue;
+            }
+            if (m.fault.load(std::memory_order_acquire) == FaultKind::None) {
+                continue; // between a reopen and its thread's start
+            }
+            if (ch.worker.joinable()) {
+                ch.worker.join(); // the previous recovery, finished
+            }
+            ch.recovering.store(true, std::memory_order_release);
+            ch.worker = std::thread([this, &ch] { recoverMain(ch); });
         }
     }
-    mWorld.maintain();
+}
+
+namespace {
+
+// Servo and supervisor threads are SCHED_FIFO; a recovery worker (close, open, homing) is not.
+void becomeNormalThread() {
+    sched_param param{};
+    (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &param);
+}
+
+} // namespace
+
+void Runtime::recoverMain(Channel& ch) {
+    becomeNormalThread();
+    if (ch.thread.joinable()) {
+        ch.thread.join(); // it left its loop after commanding zero force
+    }
+    const FaultKind f = ch.metrics.fault.load(std::memory_order_acquire);
+    if (!ch.closed.exchange(true)) {
+        ch.rd.device->close();
+    }
+    const std::uint64_t now = rt::nowNs();
+    {
+        std::lock_guard lock(ch.cold);
+        const std::uint64_t at = ch.metrics.faultNs.load();
+        ch.downSinceNs = at != 0 && at <= now ? at : now; // down since the fault itself
+        ++ch.faults;
+        const std::string status =
+            f == FaultKind::Watchdog
+                ? "no tick for " + std::to_string(mOptions.stallTimeoutNs / 1'000'000) + " ms"
+                : std::string(statusName(static_cast<DeviceStatus>(ch.metrics.faultStatus.load())));
+        ch.lastFault = std::string(faultName(f)) + ": " + status;
+        const std::string detail = ch.rd.device->errorMessage();
+        addEvent(ch, now,
+                 ch.lastFault + (detail.empty() ? "" : " (" + detail + ")") + "; force zeroed");
+        ch.down.store(true, std::memory_order_release);
+    }
+    if (mOptions.reopenAfterNs == 0) {
+        ch.gaveUp.store(true, std::memory_order_release);
+        ch.recovering.store(false, std::memory_order_release);
+        return;
+    }
+    while (waitUnlessStopping(mOptions.reopenAfterNs)) {
+        const DeviceStatus st = ch.rd.device->open();
+        const std::uint64_t back = rt::nowNs(); // open() may take long (set-up, homing)
+        if (st != DeviceStatus::Ok) {
+            const std::string why =
+                std::string(statusName(st)) + ": " + ch.rd.device->errorMessage();
+            std::lock_guard lock(ch.cold);
+            if (why != ch.lastReopenError) {
+                addEvent(ch, back,
+                         "reopen failed, " + why + "; trying every " +
+                             std::to_string(mOptions.reopenAfterNs / 1'000'000) + " ms");
+                ch.lastReopenError = why;
+            }
+            continue;
+        }
+        ch.closed.store(false);
+        std::lock_guard wake(mWakeMutex); // stop() cannot begin between this check and start
+        if (mStopping.load(std::memory_order_acquire)) {
+            break; // opened while stopping: close below
+        }
+        {
+            std::lock_guard lock(ch.cold);
+            ch.lastReopenError.clear();
+            ++ch.reopens;
+            ch.downNs += back - ch.downSinceNs;
+            addEvent(ch, back, "reopened; driving again from zero force");
+        }
+        {
+            std::lock_guard lock(ch.cold);
+            ch.metrics.fault.store(FaultKind::None);
+            ch.metrics.faultStatus.store(0);
+            ch.metrics.faultNs.store(0);
+            ch.down.store(false, std::memory_order_release);
+        }
+        startThread(ch);
+        ch.recovering.store(false, std::memory_order_release);
+        return;
+    }
+    if (!ch.closed.exchange(true)) {
+        ch.rd.device->close(); // stopping: a device opened meanwhile is closed again
+    }
+    ch.recovering.store(false, std::memory_order_release);
 }
 
 void Runtime::addEvent(Channel& ch, std::uint64_t nowNs, const std::string& what) {
@@ -377,70 +519,33 @@ void Runtime::addEvent(Channel& ch, std::uint64_t nowNs, const std::string& what
     ch.events.push_back(at + what);
 }
 
-void Runtime::recover(Channel& ch, std::uint64_t now) {
-    const FaultKind f = ch.metrics.fault.load(std::memory_order_acquire);
-    if (!ch.opened || f == FaultKind::None) {
-        return; // never opened, or stopped cleanly
-    }
-    if (!ch.down) {
-        // The thread ended on a fault and already commanded zero force. Close the device.
-        if (ch.thread.joinable()) {
-            ch.thread.join();
-        }
-        ch.rd.device->close();
-        ch.down = true;
-        const std::uint64_t at = ch.metrics.faultNs.load();
-        ch.downSinceNs = at != 0 && at <= now ? at : now; // down since the fault itself
-        ch.lastAttemptNs = now;
-        ++ch.faults;
-        const std::string status =
-            f == FaultKind::Watchdog
-                ? "no tick for " + std::to_string(mOptions.stallTimeoutNs / 1'000'000) + " ms"
-                : std::string(statusName(static_cast<DeviceStatus>(ch.metrics.faultStatus.load())));
-        ch.lastFault = std::string(faultName(f)) + ": " + status;
-        const std::string detail = ch.rd.device->errorMessage();
-        addEvent(ch, now,
-                 ch.lastFault + (detail.empty() ? "" : " (" + detail + ")") + "; force zeroed");
-        return;
-    }
-    if (mOptions.reopenAfterNs == 0 || now - ch.lastAttemptNs < mOptions.reopenAfterNs) {
-        return;
-    }
-    ch.lastAttemptNs = now;
-    const DeviceStatus st = ch.rd.device->open();
-    if (st != DeviceStatus::Ok) {
-        const std::string why = std::string(statusName(st)) + ": " + ch.rd.device->errorMessage();
-        if (why != ch.lastReopenError) {
-            addEvent(ch, now,
-                     "reopen failed, " + why + "; trying every " +
-                         std::to_string(mOptions.reopenAfterNs / 1'000'000) + " ms");
-            ch.lastReopenError = why;
-        }
-        return;
-    }
-    ch.down = false;
-    ch.lastReopenError.clear();
-    ++ch.reopens;
-    const std::uint64_t back = rt::nowNs(); // open() may take long (set-up, homing)
-    ch.downNs += back - ch.downSinceNs;
-    ch.metrics.fault.store(FaultKind::None);
-    ch.metrics.faultStatus.store(0);
-    ch.metrics.faultNs.store(0);
-    addEvent(ch, back, "reopened; driving again from zero force");
-    startThread(ch);
-}
-
 void Runtime::stop() {
+    {
+        std::lock_guard wake(mWakeMutex);
+        mStopping.store(true, std::memory_order_release);
+    }
+    mWake.notify_all();
     for (auto& ch : mChannels) {
         ch->stop.store(true, std::memory_order_release);
     }
+    if (mSupervisor.joinable()) {
+        mSupervisor.join();
+    }
+    for (auto& chp : mChannels) {
+        if (chp->worker.joinable()) {
+            chp->worker.join(); // returns at once, or when a reopen in progress returns
+        }
+    }
     for (auto& chp : mChannels) {
         Channel& ch = *chp;
+        ch.stop.store(true, std::memory_order_release); // a thread a worker just started
         if (ch.thread.joinable()) {
             ch.thread.join();
         }
         if (ch.opened) {
-            ch.rd.device->close();
+            if (!ch.closed.exchange(true)) {
+                ch.rd.device->close();
+            }
             mWorld.unregisterReader(ch.reader);
             ch.reader = nullptr;
             ch.opened = false;
@@ -449,16 +554,42 @@ void Runtime::stop() {
             }
         }
     }
-    if (mStartNs != 0 && mStopNs == 0) {
-        mStopNs = rt::nowNs();
+    std::uint64_t none = 0;
+    if (mStartNs != 0) {
+        mStopNs.compare_exchange_strong(none, rt::nowNs());
+    }
+}
+
+void Runtime::emergencyStop(std::uint64_t waitNs) noexcept {
+    mStopping.store(true, std::memory_order_release);
+    for (auto& ch : mChannels) {
+        ch->stop.store(true, std::memory_order_release);
+    }
+    // Each servo thread commands zero as it leaves its loop (at its next check).
+    const std::uint64_t until = rt::nowNs() + waitNs;
+    const auto anyInLoop = [this] {
+        return std::any_of(mChannels.begin(), mChannels.end(), [](auto& ch) {
+            return ch->metrics.running.load(std::memory_order_acquire);
+        });
+    };
+    while (anyInLoop() && rt::nowNs() < until) {
+        rt::sleepUntilNs(rt::nowNs() + 1'000'000, 0);
+    }
+    for (auto& chp : mChannels) {
+        Channel& ch = *chp;
+        if (!ch.metrics.running.load(std::memory_order_acquire) &&
+            !ch.recovering.load(std::memory_order_acquire) && !ch.closed.exchange(true)) {
+            ch.rd.device->close(); // zero force, and the device's own I/O ends
+        }
     }
 }
 
 bool Runtime::anyRunning() const {
-    const bool reopening = mOptions.reopenAfterNs > 0;
-    return std::any_of(mChannels.begin(), mChannels.end(), [reopening](auto& ch) {
-        return ch->metrics.running.load(std::memory_order_acquire) ||
-               (reopening && ch->down && !ch->stop.load(std::memory_order_acquire));
+    if (mStopping.load(std::memory_order_acquire)) {
+        return false;
+    }
+    return std::any_of(mChannels.begin(), mChannels.end(), [](auto& ch) {
+        return ch->opened && !ch->gaveUp.load(std::memory_order_acquire);
     });
 }
 
@@ -501,18 +632,20 @@ RunReport Runtime::report() const {
         d.snapshotsSeen = m.snapshotsSeen.load();
         d.safety = ch.safety.counters();
         d.realtime = m.realtime.load(std::memory_order_relaxed);
+        std::lock_guard lock(ch.cold);
         const FaultKind f = m.fault.load();
+        const bool down = ch.down.load(std::memory_order_acquire);
         if (f == FaultKind::OpenFailed) {
             d.fault = std::string("open-failed: ") + ch.openError;
-        } else if (ch.down) {
+        } else if (down) {
             d.fault = ch.lastFault;
-        } else if (f != FaultKind::None) { // faulted, not yet seen by maintain()
+        } else if (f != FaultKind::None) { // faulted, not yet taken by the supervisor
             d.fault = std::string(faultName(f)) + ": " +
                       std::string(statusName(static_cast<DeviceStatus>(m.faultStatus.load())));
         }
-        d.faults = ch.faults + (f != FaultKind::None && f != FaultKind::OpenFailed && !ch.down);
+        d.faults = ch.faults + (f != FaultKind::None && f != FaultKind::OpenFailed && !down);
         d.reopens = ch.reopens;
-        const std::uint64_t downNow = ch.down ? rt::nowNs() - ch.downSinceNs : 0;
+        const std::uint64_t downNow = down ? rt::nowNs() - ch.downSinceNs : 0;
         d.downS = static_cast<double>(ch.downNs + downNow) * 1e-9;
         d.events = ch.events;
         if (ch.eventsDropped > 0) {
@@ -525,7 +658,8 @@ RunReport Runtime::report() const {
         r.devices.push_back(std::move(d));
     }
     r.loadPerCore = r.loadSum / r.cores;
-    const std::uint64_t end = mStopNs ? mStopNs : rt::nowNs();
+    const std::uint64_t stoppedAt = mStopNs.load();
+    const std::uint64_t end = stoppedAt ? stoppedAt : rt::nowNs();
     r.durationS = mStartNs ? static_cast<double>(end - mStartNs) * 1e-9 : 0.0;
     r.realtimeNote = mRealtimeNote;
     return r;
@@ -602,7 +736,8 @@ std::string reportToJson(const RunReport& r) {
             {"safety",
              {{"clamped", d.safety.clamped},
               {"rate_limited", d.safety.rateLimited},
-              {"non_finite", d.safety.nonFinite}}},
+              {"non_finite", d.safety.nonFinite},
+              {"overflowed", d.safety.overflowed}}},
             {"faults", d.faults},
             {"fault", d.fault},
             {"reopens", d.reopens},

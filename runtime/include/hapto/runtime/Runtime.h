@@ -12,9 +12,11 @@
 
 #include <array>
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -94,7 +96,13 @@ struct RunReport {
     std::string realtimeNote; ///< Why SCHED_FIFO or pinning was not granted, if not.
 };
 
-/// Runs D servo threads. Construct, start(), let it run (poll or call maintain()), stop().
+/// Runs D servo threads and a supervisor. Construct, start(), call maintain() every few
+/// milliseconds for world upkeep, stop().
+///
+/// Supervision (the watchdog, closing a faulted device, reopening it, starting its new servo
+/// thread) runs on the runtime's own supervisor thread, and every close and open on a worker
+/// thread of that device: nothing a servo thread depends on waits for the control thread, a
+/// terminal, a disk or another device's open (Falcon homing can take 30 s).
 /// Threading: every public member is [control] except where marked.
 class Runtime {
 public:
@@ -106,17 +114,25 @@ public:
     Runtime(const Runtime&) = delete;
     Runtime& operator=(const Runtime&) = delete;
 
-    /// Opens every device and starts its thread. A device that fails to open is reported as
-    /// faulted and the others run. Returns the number of threads started. [control]
+    /// Opens every device, then (all opened) starts one servo thread per opened device and
+    /// the supervisor thread. A device that fails to open is reported as faulted and the
+    /// others run. Returns the number of servo threads started. [control]
     std::size_t start();
-    /// Watchdog, fault recovery and world maintenance; call every few milliseconds while
-    /// running. A device whose thread ended on a fault is closed here and, when
-    /// RuntimeOptions::reopenAfterNs allows, opened again and given a new servo thread. [control]
+    /// World upkeep (re-indexing rested objects, freeing old snapshots): call every few
+    /// milliseconds from the thread that updates the world. Supervision does not depend on
+    /// it. [control]
     void maintain();
-    /// Stops every thread: each commands zero force, then the devices are closed. [control]
+    /// Stops every thread: each commands zero force, then the devices are closed. Waits for a
+    /// reopen in progress to return (the device is at zero force meanwhile). [control]
     void stop();
-    /// True while some servo thread is live or a faulted device waits to be reopened.
-    /// [control]
+    /// The last resort when stop() cannot be waited for (a second Ctrl-C): tells every servo
+    /// thread to stop, waits at most `waitNs` for them to command zero force and leave, and
+    /// closes each device whose thread has left. Safe from a thread other than the control
+    /// thread while the control thread is blocked; the process should exit right after. [any
+    /// thread]
+    void emergencyStop(std::uint64_t waitNs = 200'000'000) noexcept;
+    /// True while some device is driven or will be again (a faulted device waiting to be
+    /// reopened counts when reopening is on). [control]
     bool anyRunning() const;
 
     /// Live metrics of device i. [any thread]
@@ -141,14 +157,21 @@ private:
     struct Channel;
     void servoMain(Channel& channel);
     void startThread(Channel& channel);
-    void recover(Channel& channel, std::uint64_t nowNs);
+    void superviseMain();
+    void recoverMain(Channel& channel);
+    bool waitUnlessStopping(std::uint64_t ns);
     void addEvent(Channel& channel, std::uint64_t nowNs, const std::string& what);
 
     World& mWorld;
     RuntimeOptions mOptions;
     std::vector<std::unique_ptr<Channel>> mChannels;
-    std::uint64_t mStartNs = 0, mStopNs = 0;
+    std::uint64_t mStartNs = 0;
+    std::atomic<std::uint64_t> mStopNs{0};
     std::string mRealtimeNote;
+    std::thread mSupervisor;
+    std::atomic<bool> mStopping{false};
+    std::mutex mWakeMutex; // with mWake: stop() interrupts supervision's waits
+    std::condition_variable mWake;
 };
 
 /// Renders a report as JSON text (the `hapto run --report` format). [control]
