@@ -1,9 +1,11 @@
 // `hapto run`: a session of D devices over one shared world, reporting each device's load.
 
 #include "Commands.h"
+#include "LiveLines.h"
 #include "Options.h"
 #include "OutputFile.h"
 #include "SessionChecks.h"
+#include "StopSignals.h"
 
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/DeviceFactory.h"
@@ -25,12 +27,6 @@
 
 namespace hapto::cli {
 namespace {
-
-std::atomic<bool> gStopRequested{false};
-
-extern "C" void onStopSignal(int) {
-    gStopRequested.store(true);
-}
 
 struct RunArgs {
     std::string scene;
@@ -85,6 +81,9 @@ void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
 }
 
 int runSession(const RunArgs& a) {
+    // First, before any thread starts (the index build's TBB workers included), so that every
+    // thread inherits the blocked stop signals and only the signal thread takes them.
+    StopSignals signals;
     const Scene scene = loadSceneOrDefault(a.scene);
     const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
     std::vector<DeviceConfig> configs =
@@ -125,58 +124,67 @@ int runSession(const RunArgs& a) {
     opt.missLimit = a.missLimit;
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
     Runtime runtime(world, std::move(devices), opt);
+    // A second signal while the orderly stop below is under way (or blocked): zero force
+    // now, from the signal thread, and exit.
+    signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
 
-    std::signal(SIGINT, onStopSignal);
-    std::signal(SIGTERM, onStopSignal);
     const bool live = !a.quiet && isatty(STDERR_FILENO);
-    std::fprintf(stderr, "hapto run: %zu devices, %u objects, index %s, %.1f s%s\n", configs.size(),
-                 scene.size(), spec.toString().c_str(), a.durationS,
-                 a.durationS <= 0 ? " (until Ctrl-C)" : "");
-    if (runtime.start() == 0) {
-        const RunReport r = runtime.report();
-        for (const DeviceReport& d : r.devices) {
-            std::fprintf(stderr, "hapto run: %s: %s\n", d.name.c_str(), d.fault.c_str());
-        }
-        std::fprintf(stderr, "hapto run: no device could be opened\n");
-        return 1;
-    }
-    const auto start = std::chrono::steady_clock::now();
-    auto lastLive = start;
-    bool drewLive = false;
-    while (!gStopRequested.load() && runtime.anyRunning()) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        runtime.maintain();
-        for (auto& rec : recorders) {
-            rec->drain();
-        }
-        const auto now = std::chrono::steady_clock::now();
-        if (live && now - lastLive > std::chrono::milliseconds(250)) {
-            lastLive = now;
-            if (drewLive) {
-                std::fprintf(stderr, "\x1b[%zuA", runtime.deviceCount());
+    char header[256];
+    std::snprintf(header, sizeof header, "hapto run: %zu devices, %u objects, index %s, %.1f s%s\n",
+                  configs.size(), scene.size(), spec.toString().c_str(), a.durationS,
+                  a.durationS <= 0 ? " (until Ctrl-C)" : "");
+    {
+        // Everything for the terminal goes through its own thread while devices are driven: a
+        // paused terminal blocks only that thread, never the session, its stop or its signals.
+        LiveLines terminal(live ? &runtime : nullptr);
+        terminal.say(header);
+        if (runtime.start() == 0) {
+            std::string why;
+            for (const DeviceReport& d : runtime.report().devices) {
+                why += "hapto run: " + d.name + ": " + d.fault + "\n";
             }
-            for (std::size_t i = 0; i < runtime.deviceCount(); ++i) {
-                std::fprintf(stderr, "\r\x1b[2K%s\n", runtime.liveLine(i).c_str());
+            terminal.say(why + "hapto run: no device could be opened\n");
+            return 1;
+        }
+        const auto start = std::chrono::steady_clock::now();
+        while (!signals.requested() && runtime.anyRunning()) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            runtime.maintain();
+            for (auto& rec : recorders) {
+                rec->drain();
             }
-            drewLive = true;
+            const auto now = std::chrono::steady_clock::now();
+            if (a.durationS > 0 && now - start >= std::chrono::duration<double>(a.durationS)) {
+                break;
+            }
         }
-        if (a.durationS > 0 && now - start >= std::chrono::duration<double>(a.durationS)) {
-            break;
-        }
+        runtime.stop(); // zero force on every device before anything else
     }
-    runtime.stop();
     for (auto& rec : recorders) {
         rec->close();
     }
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
     const RunReport r = runtime.report();
-    printSummary(r);
     if (!a.report.empty()) {
         writeFileAtomically(a.report, reportToJson(r));
+    }
+    printSummary(r);
+    if (!a.report.empty()) {
         std::fprintf(stderr, "report written to %s\n", a.report.c_str());
     }
-    return 0;
+    // A device that faulted and was not driven again by the end makes the run a failure.
+    int down = 0;
+    for (const DeviceReport& d : r.devices) {
+        if (!d.fault.empty()) {
+            std::fprintf(stderr, "hapto run: %s faulted and was not recovered: %s\n",
+                         d.name.c_str(), d.fault.c_str());
+            ++down;
+        }
+    }
+    if (signals.requested()) {
+        std::fprintf(stderr, "hapto run: stopped by signal %d; zero force on every device\n",
+                     signals.signalNumber());
+    }
+    return down > 0 ? 1 : 0;
 }
 
 } // namespace
