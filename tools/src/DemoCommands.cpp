@@ -4,6 +4,7 @@
 #include "Options.h"
 #include "OutputFile.h"
 #include "SessionChecks.h"
+#include "StopSignals.h"
 
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/DeviceFactory.h"
@@ -66,6 +67,7 @@ struct Felt {
 };
 
 int runDemo(const DemoArgs& a) {
+    StopSignals signals; // before any thread starts; see `hapto run`
     const Scene scene = a.scene.empty() ? makeGraspScene() : loadSceneOrDefault(a.scene);
     if (!scene.slotOf(a.object)) {
         throw InputError("--object: the scene has no object with id " + std::to_string(a.object));
@@ -91,6 +93,7 @@ int runDemo(const DemoArgs& a) {
     options.realtime = a.realtime;
     Runtime runtime(world, std::move(devices), options);
     GraspController grasp(world, runtime, 0, 1);
+    signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
 
     const Vec3 startPosition = scene.object(*scene.slotOf(a.object)).center;
     std::printf(
@@ -141,7 +144,7 @@ int runDemo(const DemoArgs& a) {
         const bool scriptsDone = sims[0] && sims[1] && sims[0]->phase() == ScriptPhase::Done &&
                                  sims[1]->phase() == ScriptPhase::Done;
         if ((scriptsDone && grasp.state() == GraspState::Idle && t > 1.0) || t > 12.0 ||
-            !runtime.anyRunning()) {
+            !runtime.anyRunning() || signals.requested()) {
             break;
         }
     }
