@@ -1,0 +1,153 @@
+// How a `hapto run` session ends: on each of the four stop signals, and with its terminal
+// paused (Ctrl-S). [realtime]: real processes and a real pseudo-terminal; each test waits, with
+// a generous bound, for what must happen and asserts no counts of ticks or sleeps.
+
+#include "TestSupport.h"
+
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <fcntl.h>
+#include <poll.h>
+#include <pty.h>
+#include <spawn.h>
+#include <termios.h>
+#include <thread>
+#include <unistd.h>
+
+using namespace hapto::test;
+
+extern char** environ;
+
+namespace {
+
+/// `hapto run ARGS...` with stderr on a pseudo-terminal (so the live view is on) and stdout
+/// to /dev/null.
+struct Session {
+    int master = -1, slave = -1;
+    pid_t pid = -1;
+
+    explicit Session(std::vector<std::string> args) {
+        REQUIRE(openpty(&master, &slave, nullptr, nullptr, nullptr) == 0);
+        posix_spawn_file_actions_t fa;
+        posix_spawn_file_actions_init(&fa);
+        posix_spawn_file_actions_adddup2(&fa, slave, STDERR_FILENO);
+        posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+        posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+        const std::string exe = std::string(HAPTO_BINARY_DIR) + "/tools/hapto";
+        args.insert(args.begin(), {exe, "run"});
+        std::vector<char*> argv;
+        for (std::string& a : args) {
+            argv.push_back(a.data());
+        }
+        argv.push_back(nullptr);
+        REQUIRE(posix_spawn(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ) == 0);
+        posix_spawn_file_actions_destroy(&fa);
+    }
+    ~Session() {
+        if (pid > 0) {
+            kill(pid, SIGKILL);
+            waitpid(pid, nullptr, 0);
+        }
+        close(master);
+        close(slave);
+    }
+    /// Reads the terminal until `text` shows, at most 20 s.
+    bool waitForOutput(const std::string& text) {
+        std::string seen;
+        const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+        while (seen.find(text) == std::string::npos && std::chrono::steady_clock::now() < until) {
+            pollfd p{master, POLLIN, 0};
+            if (poll(&p, 1, 100) > 0) {
+                char buf[1024];
+                const ssize_t n = read(master, buf, sizeof buf);
+                if (n > 0) {
+                    seen.append(buf, static_cast<std::size_t>(n));
+                }
+            }
+        }
+        return seen.find(text) != std::string::npos;
+    }
+    void pauseTerminal() { REQUIRE(tcflow(slave, TCOOFF) == 0); }
+    void resumeTerminal() { REQUIRE(tcflow(slave, TCOON) == 0); }
+    /// Reads the terminal (so it never fills) until the process exits, at most 20 s; its exit
+    /// code, or -1.
+    int finish() {
+        const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+        while (std::chrono::steady_clock::now() < until) {
+            int status = 0;
+            if (waitpid(pid, &status, WNOHANG) == pid) {
+                pid = -1;
+                return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+            }
+            pollfd p{master, POLLIN, 0};
+            if (poll(&p, 1, 20) > 0) {
+                char buf[1024];
+                (void)read(master, buf, sizeof buf);
+            }
+        }
+        return -1;
+    }
+};
+
+bool waitForFile(const std::filesystem::path& p) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (!std::filesystem::exists(p) && std::chrono::steady_clock::now() < until) {
+        std::this_thread::yield();
+    }
+    return std::filesystem::exists(p);
+}
+
+} // namespace
+
+TEST_CASE("a paused terminal never holds a session up: it ends, stops its devices and writes "
+          "its report while the terminal stays paused",
+          "[realtime]") {
+    TempDir dir;
+    Session s({"--duration", "1", "--no-realtime", "--report", (dir / "r.json").string()});
+    s.pauseTerminal(); // Ctrl-S before the first line: every write to it blocks
+    REQUIRE(waitForFile(dir / "r.json"));
+    const auto j = nlohmann::json::parse(readFile(dir / "r.json"));
+    for (const auto& d : j["devices"]) {
+        CHECK(d["ticks"].get<std::uint64_t>() > 0);
+        CHECK(d["fault"] == "");
+    }
+    s.resumeTerminal();
+    CHECK(s.finish() == 0);
+}
+
+TEST_CASE("each stop signal ends an untimed session with zero force and its report, also with "
+          "the terminal paused",
+          "[realtime]") {
+    for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+        for (const bool paused : {false, true}) {
+            INFO("signal " << sig << (paused ? ", terminal paused" : ""));
+            TempDir dir;
+            Session s({"--duration", "0", "--no-realtime", "--report", (dir / "r.json").string()});
+            REQUIRE(s.waitForOutput("hapto run:")); // the session's signal thread is up
+            if (paused) {
+                s.pauseTerminal();
+            }
+            REQUIRE(kill(s.pid, sig) == 0);
+            REQUIRE(waitForFile(dir / "r.json"));
+            s.resumeTerminal();
+            CHECK(s.finish() == 0);
+        }
+    }
+}
+
+TEST_CASE("a second signal forces the exit at once, with the devices stopped", "[realtime]") {
+    TempDir dir;
+    Session s({"--duration", "0", "--no-realtime", "--report", (dir / "r.json").string()});
+    REQUIRE(s.waitForOutput("hapto run:"));
+    // The terminal is paused, so the orderly exit stays blocked on its last lines; the second
+    // signal does not wait for it.
+    s.pauseTerminal();
+    REQUIRE(kill(s.pid, SIGINT) == 0);
+    REQUIRE(waitForFile(dir / "r.json"));
+    REQUIRE(kill(s.pid, SIGINT) == 0);
+    CHECK(s.finish() == 128 + SIGINT);
+}
