@@ -60,6 +60,53 @@ TEST_CASE("a session recorded with --record replays as a device and exports as C
     CHECK(j["devices"][0]["ticks"].get<int>() > 50);
 }
 
+TEST_CASE("a replay runs at its trace's rate unless --rate sets one") {
+    TempDir dir;
+    const CommandResult rec = runHapto("run --rate 2000 --duration 0.2 --no-realtime --quiet "
+                                       "--record " +
+                                       (dir / "runs").string());
+    INFO(rec.output);
+    REQUIRE(rec.exitCode == 0);
+    writeFile(dir / "replay.json", R"({"format": "hapto-devices", "version": 1, "devices": [)"
+                                   R"({"name": "again", "kind": "replay",)"
+                                   R"( "replay": {"trace": "runs/left.trace", "loop": true}}]})");
+    const std::string run = "run --duration 0.2 --no-realtime --quiet --devices " +
+                            (dir / "replay.json").string() + " --report " +
+                            (dir / "r.json").string();
+    CommandResult r = runHapto(run);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(json::parse(readFile(dir / "r.json"))["devices"][0]["rate_hz"] == 2000.0);
+    r = runHapto(run + " --rate 500");
+    REQUIRE(r.exitCode == 0);
+    CHECK(json::parse(readFile(dir / "r.json"))["devices"][0]["rate_hz"] == 500.0);
+}
+
+TEST_CASE("hapto run refuses what cannot work before any device starts, and writes nothing") {
+    TempDir dir;
+    writeFile(dir / "r.json", "an older report\n");
+    // A spin as long as the 500 us period of 2 kHz.
+    CommandResult r = runHapto("run --rate 2000 --spin-us 500 --no-realtime --quiet --report " +
+                               (dir / "r.json").string());
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("--spin-us") && Catch::Contains("500 us"));
+    CHECK_THAT(r.output, !Catch::Contains("hapto run: 2 devices")); // nothing started
+    // More devices than one World serves.
+    std::string many = R"({"format": "hapto-devices", "version": 1, "devices": [)";
+    for (int i = 0; i < 65; ++i) {
+        many += (i ? "," : "") + std::string(R"({"name": "h)") + std::to_string(i) +
+                R"(", "kind": "sim"})";
+    }
+    writeFile(dir / "many.json", many + "]}");
+    r = runHapto("run --no-realtime --quiet --devices " + (dir / "many.json").string() +
+                 " --report " + (dir / "r.json").string());
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("65 devices") && Catch::Contains("64"));
+    CHECK(readFile(dir / "r.json") == "an older report\n");
+    CHECK(std::distance(std::filesystem::directory_iterator(dir.path()),
+                        std::filesystem::directory_iterator()) == 2);
+}
+
 TEST_CASE("hapto run drives devices at 20 kHz") {
     TempDir dir;
     const CommandResult r =

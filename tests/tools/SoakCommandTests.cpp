@@ -7,7 +7,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
+#include <fcntl.h>
+#include <filesystem>
 #include <set>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+extern char** environ;
 
 using namespace hapto::test;
 using nlohmann::json;
@@ -71,4 +81,54 @@ TEST_CASE("hapto soak rejects bad arguments with exit 2") {
         const CommandResult r = runHapto(args);
         CHECK(r.exitCode == 2);
     }
+}
+
+TEST_CASE("an interrupted soak gives no verdict: it does not print PASS and exits 1") {
+    TempDir dir;
+    const std::string exe = std::string(HAPTO_BINARY_DIR) + "/tools/hapto";
+    const std::string out = (dir / "out.txt").string();
+    const std::string report = (dir / "soak.json").string();
+    const char* argv[] = {exe.c_str(),     "soak",     "--minutes",    "1",
+                          "--fault-every", "0.5",      "--window",     "0.5",
+                          "--no-realtime", "--report", report.c_str(), nullptr};
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out.c_str(),
+                                     O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+    pid_t pid = 0;
+    REQUIRE(posix_spawn(&pid, exe.c_str(), &actions, nullptr, const_cast<char**>(argv), environ) ==
+            0);
+    posix_spawn_file_actions_destroy(&actions);
+    // The first window's line (flushed as it closes) shows the soak is under way, with its
+    // signal handlers installed; wait for it (at most a minute, on a loaded machine).
+    bool running = false;
+    for (int i = 0; i < 600 && !running; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        running = readFile(out).find("hand0") != std::string::npos;
+    }
+    REQUIRE(kill(pid, SIGINT) == 0);
+    int status = 0;
+    REQUIRE(waitpid(pid, &status, 0) == pid);
+    const std::string output = readFile(out);
+    INFO(output);
+    REQUIRE(running);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 1);
+    CHECK_THAT(output, Catch::Contains("soak: INTERRUPTED"));
+    CHECK_THAT(output, !Catch::Contains("PASS"));
+    const json j = json::parse(readFile(report));
+    CHECK(j["interrupted"] == true);
+    CHECK(j["pass"] == false);
+}
+
+TEST_CASE("a soak too short to reach its first fault is refused before it starts") {
+    TempDir dir;
+    const CommandResult r =
+        runHapto("soak --minutes 0.05 --fault-every 15 --no-realtime --report " +
+                 (dir / "soak.json").string());
+    INFO(r.output);
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("--minutes") && Catch::Contains("first fault"));
+    CHECK_FALSE(std::filesystem::exists(dir / "soak.json"));
 }

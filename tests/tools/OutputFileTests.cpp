@@ -1,0 +1,139 @@
+// Output files written whole or not at all, output-path checks and same-file detection
+// (tools/src/OutputFile.h), in process.
+
+#include "OutputFile.h"
+
+#include "TestSupport.h"
+
+#include "hapto/scenes/InputError.h"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <sys/stat.h>
+#include <vector>
+
+using namespace hapto;
+using namespace hapto::cli;
+using namespace hapto::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> namesIn(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        names.push_back(e.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+} // namespace
+
+TEST_CASE("an output replaces its file only when committed, and leaves no temporary") {
+    TempDir dir;
+    writeFile(dir / "out.csv", "old\n");
+    {
+        AtomicOutputFile file(dir / "out.csv");
+        file.stream() << "new contents\n";
+        file.stream().flush();
+        CHECK(readFile(dir / "out.csv") == "old\n");
+        CHECK(namesIn(dir.path()).size() == 2); // the temporary, beside the target
+        file.commit();
+    }
+    CHECK(readFile(dir / "out.csv") == "new contents\n");
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"out.csv"});
+}
+
+TEST_CASE("an output abandoned before commit leaves the old file and no temporary") {
+    TempDir dir;
+    writeFile(dir / "out.csv", "old\n");
+    {
+        AtomicOutputFile file(dir / "out.csv");
+        file.stream() << std::string(1 << 20, 'x'); // more than the buffer: bytes reach the disk
+    }
+    CHECK(readFile(dir / "out.csv") == "old\n");
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"out.csv"});
+    {
+        AtomicOutputFile file(dir / "new.csv");
+        file.stream() << "never committed";
+    }
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"out.csv"});
+}
+
+TEST_CASE("writing through a symlink replaces the file it names and keeps the link") {
+    TempDir dir;
+    writeFile(dir / "real.json", "old");
+    fs::create_symlink("real.json", dir / "link.json");
+    writeFileAtomically(dir / "link.json", "new");
+    CHECK(fs::is_symlink(fs::symlink_status(dir / "link.json")));
+    CHECK(readFile(dir / "real.json") == "new");
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"link.json", "real.json"});
+}
+
+TEST_CASE("a replaced file keeps its permissions") {
+    TempDir dir;
+    writeFile(dir / "out.txt", "old");
+    fs::permissions(dir / "out.txt",
+                    fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+    writeFileAtomically(dir / "out.txt", "new");
+    CHECK(fs::status(dir / "out.txt").permissions() ==
+          (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
+}
+
+TEST_CASE("a device is written as it is, never replaced") {
+    writeFileAtomically("/dev/null", "into the void\n");
+    struct stat st {};
+    REQUIRE(::stat("/dev/null", &st) == 0);
+    CHECK(S_ISCHR(st.st_mode));
+    // A failed write is reported at commit (here: /dev/full, always out of space).
+    if (fs::exists("/dev/full")) {
+        AtomicOutputFile file("/dev/full");
+        file.stream() << "x";
+        CHECK_THROWS_AS(file.commit(), std::runtime_error);
+    }
+}
+
+TEST_CASE("outputs that cannot be written are refused, naming the option and the path") {
+    TempDir dir;
+    fs::create_directory(dir / "sub");
+    CHECK_THROWS_WITH(checkOutputFile(dir / "sub", "--report"),
+                      Catch::Contains("--report") && Catch::Contains("folder"));
+    CHECK_THROWS_WITH(checkOutputFile(dir / "missing" / "r.json", "-o"),
+                      Catch::Contains("-o") && Catch::Contains("missing") &&
+                          Catch::Contains("does not exist"));
+    CHECK_THROWS_AS(AtomicOutputFile(dir / "sub"), InputError);
+    CHECK_THROWS_AS(AtomicOutputFile(dir / "missing" / "r.json"), InputError);
+    CHECK_NOTHROW(checkOutputFile(dir / "fine.json", "-o"));
+    CHECK_NOTHROW(checkOutputFile("/dev/null", "-o"));
+
+    writeFile(dir / "file", "x");
+    CHECK_THROWS_WITH(checkOutputFolder(dir / "file", "--record"),
+                      Catch::Contains("--record") && Catch::Contains("not a folder"));
+    CHECK_THROWS_AS(checkOutputFolder(dir / "file" / "deeper", "--record"), InputError);
+    CHECK_NOTHROW(checkOutputFolder(dir / "sub", "--record"));
+    CHECK_NOTHROW(checkOutputFolder(dir / "new" / "deeper", "--record"));
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"file", "sub"}); // nothing created
+}
+
+TEST_CASE("the same file is recognised through other spellings, symlinks and hard links") {
+    TempDir dir;
+    writeFile(dir / "a.json", "a");
+    writeFile(dir / "b.json", "b");
+    fs::create_symlink(dir / "a.json", dir / "sym.json");
+    fs::create_hard_link(dir / "a.json", dir / "hard.json");
+    fs::create_directory(dir / "sub");
+    CHECK(sameFile(dir / "a.json", dir / "sub" / ".." / "a.json"));
+    CHECK(sameFile(dir / "a.json", dir / "sym.json"));
+    CHECK(sameFile(dir / "hard.json", dir / "a.json"));
+    CHECK_FALSE(sameFile(dir / "a.json", dir / "b.json"));
+    CHECK(sameFile(dir / "new.json", dir / "sub" / ".." / "new.json")); // neither exists yet
+    CHECK_FALSE(sameFile(dir / "new.json", dir / "other.json"));
+    CHECK_FALSE(sameFile("", dir / "a.json"));
+    CHECK_THROWS_WITH(refuseSameFile(dir / "sym.json", "-o", dir / "a.json", "--scene"),
+                      Catch::Contains("-o") && Catch::Contains("--scene") &&
+                          Catch::Contains("sym.json"));
+    CHECK_NOTHROW(refuseSameFile(dir / "b.json", "-o", dir / "a.json", "--scene"));
+}
