@@ -251,7 +251,7 @@ void addBenchCommands(CLI::App& app) {
     cmd->add_option("--max-index-mb", args->maxIndexMb,
                     "Most memory an index build may take (MB); a larger index is refused")
         ->capture_default_str()
-        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+        ->check(finiteRange(1, kMaxIndexMbOption));
     cmd->add_option("--steps", args->steps, "Walk steps (queries) per index, e.g. 1e5")
         ->capture_default_str();
     cmd->add_option("--seed", args->seed, "Walk seed; same seed, same walk")

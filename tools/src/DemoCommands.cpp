@@ -244,7 +244,7 @@ void addDemoCommands(CLI::App& app) {
     cmd->add_option("--max-index-mb", a->maxIndexMb,
                     "Most memory an index build may take (MB); a larger index is refused")
         ->capture_default_str()
-        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+        ->check(finiteRange(1, kMaxIndexMbOption));
     cmd->add_option("--report", a->report, "Write a JSON report here");
     cmd->add_flag("--realtime", a->realtime, "Ask for SCHED_FIFO for the servo threads");
     cmd->callback([a] { runDemo(*a); });

@@ -218,7 +218,7 @@ void addExperimentCommands(CLI::App& app) {
         cmd->add_option("--max-index-mb", a->maxIndexMb,
                         "Most memory an index build may take (MB); a larger index is refused")
             ->capture_default_str()
-            ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+            ->check(finiteRange(1, kMaxIndexMbOption));
         cmd->add_option("--script", a->script,
                         "Hand script: walk (random hops through the scene) or slide (slide on "
                         "the nearest surface)")

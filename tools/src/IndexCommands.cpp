@@ -1,6 +1,7 @@
 // `hapto query` and `hapto index-stats`: build a spatial index over a scene and ask it things.
 
 #include "Commands.h"
+#include "Options.h"
 #include "OutputFile.h"
 
 #include "hapto/index/Cursor.h"
@@ -213,7 +214,7 @@ void addIndexCommands(CLI::App& app) {
         cmd->add_option("--max-index-mb", *maxIndexMb,
                         "Most memory an index build may take (MB); a larger index is refused")
             ->capture_default_str()
-            ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+            ->check(finiteRange(1, kMaxIndexMbOption));
         cmd->callback([=] { runQuery(*scene, *spec, *points, *out, *maxIndexMb); });
     }
     // index-stats
@@ -232,7 +233,7 @@ void addIndexCommands(CLI::App& app) {
         cmd->add_option("--max-index-mb", *maxIndexMb,
                         "Most memory an index build may take (MB); a larger index is refused")
             ->capture_default_str()
-            ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+            ->check(finiteRange(1, kMaxIndexMbOption));
         cmd->callback([=] {
             const IndexSpec parsed = IndexSpec::parse(*spec).withMaxMegabytes(*maxIndexMb);
             const Scene s = loadSceneOrDefault(*scene);

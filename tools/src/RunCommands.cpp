@@ -203,7 +203,7 @@ void addRunCommands(CLI::App& app) {
     cmd->add_option("--max-index-mb", a->maxIndexMb,
                     "Most memory an index build may take (MB); a larger index is refused")
         ->capture_default_str()
-        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+        ->check(finiteRange(1, kMaxIndexMbOption));
     cmd->add_option("--rate", a->rateHz,
                     "Servo rate for every device (Hz; default: each device's own)")
         ->check(finiteRange(100, 100000));

@@ -487,7 +487,7 @@ void addSoakCommands(CLI::App& app) {
     cmd->add_option("--max-index-mb", a->maxIndexMb,
                     "Most memory an index build may take (MB); a larger index is refused")
         ->capture_default_str()
-        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
+        ->check(finiteRange(1, kMaxIndexMbOption));
     cmd->add_option("--fault-every", a->faultEveryS,
                     "Inject a fault every this many seconds, into the hands in turn: disconnect "
                     "(0.5 s), stall of 0.4 watchdog timeouts (a miss, not a fault), non-finite "
