@@ -7,6 +7,7 @@
 #include "Options.h"
 #include "OutputFile.h"
 #include "SessionChecks.h"
+#include "StopSignals.h"
 #include "experiments/ExperimentSupport.h"
 
 #include "hapto/devices/DeviceFactory.h"
@@ -22,7 +23,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <thread>
@@ -30,12 +30,6 @@
 
 namespace hapto::cli {
 namespace {
-
-std::atomic<bool> gSoakStop{false};
-
-extern "C" void onSoakSignal(int) {
-    gSoakStop.store(true);
-}
 
 struct SoakArgs {
     double minutes = 1.0;
@@ -175,6 +169,7 @@ private:
 };
 
 int runSoak(const SoakArgs& a) {
+    StopSignals signals; // before any thread starts; see `hapto run`
     const double durationS = a.minutes * 60.0;
     const double quietTailS =
         std::min(durationS / 2, 3.0 * a.watchdogMs / 1000 + 1.0 + a.reopenMs / 1000);
@@ -209,6 +204,7 @@ int runSoak(const SoakArgs& a) {
     opt.stallTimeoutNs = static_cast<std::uint64_t>(a.watchdogMs * 1e6);
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
     Runtime runtime(world, std::move(rds), opt);
+    signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
 
     std::fprintf(stderr,
                  "hapto soak: %d devices at %.0f Hz, %u objects, index %s, %.1f min; a fault "
@@ -224,8 +220,6 @@ int runSoak(const SoakArgs& a) {
         std::fprintf(stderr, "hapto soak: not every device could be opened\n");
         return 1;
     }
-    std::signal(SIGINT, onSoakSignal);
-    std::signal(SIGTERM, onSoakSignal);
 
     WorldChurn churn(world, scene);
     std::vector<DeviceTally> tally(static_cast<std::size_t>(a.devices));
@@ -271,7 +265,7 @@ int runSoak(const SoakArgs& a) {
     };
 
     double t = 0;
-    while (!gSoakStop.load() && (t = seconds()) < durationS) {
+    while (!signals.requested() && (t = seconds()) < durationS) {
         runtime.maintain();
         churn.step(t);
         if (t >= a.faultEveryS * static_cast<double>(nextFault + 1) && t < durationS - quietTailS) {
@@ -304,11 +298,9 @@ int runSoak(const SoakArgs& a) {
     }
     runtime.stop();
     world.settle();
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
     // Stopped by a signal, or no fault injected (a machine too slow to reach the first one):
     // then nothing was tested to the end, and the soak cannot pass.
-    const bool interrupted = gSoakStop.load();
+    const bool interrupted = signals.requested();
     const RunReport r = runtime.report();
 
     // Verdicts.
