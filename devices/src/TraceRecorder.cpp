@@ -113,6 +113,16 @@ std::size_t TraceRecorder::drain() {
     return total;
 }
 
+void TraceRecorder::abandon() noexcept {
+    if (!mFile) {
+        return;
+    }
+    mOpen.store(false, std::memory_order_release);
+    std::fclose(mFile);
+    mFile = nullptr;
+    ::unlink(mTemporary.c_str());
+}
+
 void TraceRecorder::close() {
     if (!mFile) {
         return;

@@ -263,6 +263,21 @@ TEST_CASE("trace recorder: the trace appears whole at close; until then the old 
     CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace"}); // no temporary left
 }
 
+TEST_CASE("trace recorder: an abandoned recording leaves the old trace and no temporary") {
+    test::TempDir dir;
+    const auto p = dir / "t.trace";
+    writeTrace(p, randomSamples(5, 6));
+    const std::string before = test::readFile(p);
+    {
+        TraceRecorder rec(p, header(), 64);
+        REQUIRE(rec.push(randomSamples(1, 9).front()));
+        rec.abandon();
+        CHECK_FALSE(rec.push(randomSamples(1, 9).front())); // closed: it drops
+    } // the destructor, after abandon(), commits nothing
+    CHECK(test::readFile(p) == before);
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace"});
+}
+
 TEST_CASE("trace recorder: a symlink at the trace's name is replaced, never followed") {
     test::TempDir dir;
     test::writeFile(dir / "victim.txt", "keep me");

@@ -144,6 +144,9 @@ int runSession(const RunArgs& a) {
                 why += "hapto run: " + d.name + ": " + d.fault + "\n";
             }
             terminal.say(why + "hapto run: no device could be opened\n");
+            for (auto& rec : recorders) {
+                rec->abandon(); // nothing recorded: an older trace of that name stays
+            }
             return 1;
         }
         const auto start = std::chrono::steady_clock::now();

@@ -148,11 +148,15 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
     const int width =
         spec.panelWidthPx * static_cast<int>(std::max<std::size_t>(1, spec.panels.size()));
     const std::string plot = body(spec, blocks);
+    // `out` names the images without their extension; hapto sets it (gnuplot -e) to a
+    // temporary name and renames the finished images into place, so a figure is never half
+    // written. Run by hand, the script writes NAME.png and NAME.svg directly.
+    script << "if (!exists(\"out\")) out = " << gq(spec.name) << "\n";
     script << "set terminal pngcairo size " << width << "," << spec.heightPx
-           << " noenhanced font 'sans,10'\nset output " << gq(spec.name + ".png") << "\n"
+           << " noenhanced font 'sans,10'\nset output out.\".png\"\n"
            << plot << "set output\n";
     script << "set terminal svg size " << width << "," << spec.heightPx
-           << " noenhanced font 'sans,10'\nset output " << gq(spec.name + ".svg") << "\n"
+           << " noenhanced font 'sans,10'\nset output out.\".svg\"\n"
            << plot << "set output\n";
     const std::filesystem::path gp = dir / (spec.name + ".gp");
     try {
@@ -167,10 +171,19 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
         return r;
     }
     const std::string log = spec.name + ".gp.log";
-    const std::string cmd = "cd " + shq(dir.string()) + " && gnuplot " + shq(spec.name + ".gp") +
-                            " > " + shq(log) + " 2>&1";
+    const std::string temporary = spec.name + ".tmp-plot-" + std::to_string(::getpid());
+    const std::string cmd = "cd " + shq(dir.string()) + " && gnuplot -e " +
+                            shq("out=" + gq(temporary)) + " " + shq(spec.name + ".gp") + " > " +
+                            shq(log) + " 2>&1";
     const int status = std::system(cmd.c_str());
+    const auto dropTemporaries = [&] {
+        std::error_code ignored;
+        for (const char* ext : {".png", ".svg"}) {
+            std::filesystem::remove(dir / (temporary + ext), ignored);
+        }
+    };
     if (status != 0) {
+        dropTemporaries();
         r.problem = "gnuplot failed on " + gp.string() + " (exit " +
                     std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + "; see " +
                     (dir / log).string() + ")";
@@ -179,8 +192,16 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
     std::error_code ec;
     std::filesystem::remove(dir / log, ec);
     for (const char* ext : {".png", ".svg"}) {
+        const std::filesystem::path made = dir / (temporary + ext);
         const std::filesystem::path f = dir / (spec.name + ext);
-        if (std::filesystem::exists(f)) {
+        if (std::filesystem::exists(made)) {
+            std::filesystem::rename(made, f, ec); // whole, in one step
+            if (ec) {
+                r.problem =
+                    "cannot rename " + made.string() + " to " + f.string() + ": " + ec.message();
+                dropTemporaries();
+                return r;
+            }
             r.files.push_back(f);
         }
     }

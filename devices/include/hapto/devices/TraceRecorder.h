@@ -46,6 +46,11 @@ public:
     /// twice; after it, push() drops. Throws std::runtime_error on a write failure. [control]
     void close();
 
+    /// Drops the recording: the temporary is removed and path() left as it was (a session
+    /// that never started must not replace an older trace with an empty one). Safe after
+    /// close() (then it does nothing). [control]
+    void abandon() noexcept;
+
     /// Samples dropped because the ring was full (or the recorder closed). [any thread]
     std::uint64_t dropped() const noexcept { return mDropped.load(std::memory_order_relaxed); }
     /// Samples written to the file so far. [control]
