@@ -151,3 +151,24 @@ TEST_CASE("a second signal forces the exit at once, with the devices stopped", "
     REQUIRE(kill(s.pid, SIGINT) == 0);
     CHECK(s.finish() == 128 + SIGINT);
 }
+
+TEST_CASE("a host stall (the process stopped 200 ms, then continued) is a fault that is "
+          "recovered: the run goes on to its duration and exits 0",
+          "[realtime]") {
+    TempDir dir;
+    Session s({"--duration", "2", "--no-realtime", "--report", (dir / "r.json").string()});
+    REQUIRE(s.waitForOutput("hapto run:"));
+    REQUIRE(kill(s.pid, SIGSTOP) == 0);
+    // The stimulus is wall time itself: four watchdog timeouts with the whole process stopped.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    REQUIRE(kill(s.pid, SIGCONT) == 0);
+    CHECK(s.finish() == 0);
+    const auto j = nlohmann::json::parse(readFile(dir / "r.json"));
+    CHECK(j["total"]["duration_s"].get<double>() >= 2.0); // it did not end at the stall
+    for (const auto& d : j["devices"]) {
+        INFO(d.dump());
+        CHECK(d["fault"] == "");            // nothing left down
+        CHECK(d["reopens"] == d["faults"]); // every watchdog fault was recovered
+        CHECK(d["ticks"].get<std::uint64_t>() > 0);
+    }
+}
