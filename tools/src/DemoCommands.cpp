@@ -2,7 +2,6 @@
 
 #include "Commands.h"
 #include "Options.h"
-#include "OutputFile.h"
 #include "SessionChecks.h"
 #include "StopSignals.h"
 
@@ -16,6 +15,7 @@
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include <nlohmann/json.hpp>
 

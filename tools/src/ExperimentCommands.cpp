@@ -4,8 +4,8 @@
 #include "Commands.h"
 #include "Options.h"
 
-#include "experiments/ExperimentSupport.h"
-#include "experiments/Experiments.h"
+#include "hapto/experiments/ExperimentSupport.h"
+#include "hapto/experiments/Experiments.h"
 
 #include "hapto/scenes/InputError.h"
 

@@ -2,13 +2,13 @@
 
 #include "Commands.h"
 #include "Options.h"
-#include "OutputFile.h"
 
 #include "hapto/index/Cursor.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/scenes/InputError.h"
 #include "hapto/scenes/InputFile.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include <nlohmann/json.hpp>
 

@@ -3,7 +3,6 @@
 #include "Commands.h"
 #include "LiveLines.h"
 #include "Options.h"
-#include "OutputFile.h"
 #include "SessionChecks.h"
 #include "StopSignals.h"
 
@@ -14,6 +13,7 @@
 #include "hapto/index/IndexSpec.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include <atomic>
 #include <chrono>

@@ -2,10 +2,10 @@
 
 #include "Commands.h"
 #include "Options.h"
-#include "OutputFile.h"
 
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/OutputFile.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include <chrono>

@@ -2,10 +2,9 @@
 
 #include "SessionChecks.h"
 
-#include "OutputFile.h"
-
 #include "hapto/runtime/World.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include <cstdio>
 #include <filesystem>

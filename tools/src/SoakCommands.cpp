@@ -5,16 +5,16 @@
 
 #include "Commands.h"
 #include "Options.h"
-#include "OutputFile.h"
 #include "SessionChecks.h"
 #include "StopSignals.h"
-#include "experiments/ExperimentSupport.h"
+#include "hapto/experiments/ExperimentSupport.h"
 
 #include "hapto/devices/DeviceFactory.h"
 #include "hapto/devices/FaultInjectingDevice.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/OutputFile.h"
 #include "hapto/scenes/Random.h"
 
 #include <nlohmann/json.hpp>

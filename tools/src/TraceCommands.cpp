@@ -1,10 +1,10 @@
 // `hapto trace export|info`: look inside trace files written by `hapto run --record`.
 
 #include "Commands.h"
-#include "OutputFile.h"
 
 #include "hapto/devices/TraceReader.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include <algorithm>
 #include <charconv>

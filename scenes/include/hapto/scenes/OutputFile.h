@@ -17,7 +17,7 @@
 #include <string>
 #include <string_view>
 
-namespace hapto::cli {
+namespace hapto {
 
 /// One output file being written: a stream onto a temporary beside the target, renamed into
 /// place by commit(). Destroyed without commit(), it removes the temporary. [control]
@@ -64,4 +64,4 @@ bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
 void refuseSameFile(const std::filesystem::path& output, std::string_view outOption,
                     const std::filesystem::path& input, std::string_view inWhat);
 
-} // namespace hapto::cli
+} // namespace hapto

@@ -1,7 +1,7 @@
 // `hapto experiment paper2`: the paper's experiment 2, random scenes of 5 cm cubes.
 
-#include "Experiments.h"
-#include "Sweep.h"
+#include "hapto/experiments/Experiments.h"
+#include "hapto/experiments/Sweep.h"
 
 #include "hapto/scenes/Generators.h"
 

@@ -1,8 +1,8 @@
 // Timed servo sessions of simulated hands, medians, clear start points and output files.
 
-#include "ExperimentSupport.h"
+#include "hapto/experiments/ExperimentSupport.h"
 
-#include "../OutputFile.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
@@ -339,7 +339,7 @@ std::filesystem::path prepareOutDir(const std::string& dir) {
 }
 
 void writeText(const std::filesystem::path& path, const std::string& text) {
-    cli::writeFileAtomically(path, text);
+    writeFileAtomically(path, text);
 }
 
 namespace {

@@ -1,6 +1,6 @@
 // The progress bar of `hapto experiment`.
 
-#include "Progress.h"
+#include "hapto/experiments/Progress.h"
 
 #include <algorithm>
 #include <cstdio>

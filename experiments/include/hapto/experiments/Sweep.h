@@ -11,9 +11,9 @@
 /// index whose memory, extrapolated from the previous size, would pass `maxIndexMb` is not
 /// built. A skipped cell counts as unstable.
 
-#include "ExperimentSupport.h"
-#include "Experiments.h"
-#include "Progress.h"
+#include "hapto/experiments/ExperimentSupport.h"
+#include "hapto/experiments/Experiments.h"
+#include "hapto/experiments/Progress.h"
 
 #include "hapto/index/IndexSpec.h"
 

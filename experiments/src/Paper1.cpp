@@ -1,7 +1,7 @@
 // `hapto experiment paper1`: the paper's experiment 1, lattices of K x K x K cubes.
 
-#include "Experiments.h"
-#include "Sweep.h"
+#include "hapto/experiments/Experiments.h"
+#include "hapto/experiments/Sweep.h"
 
 #include "hapto/scenes/Generators.h"
 

@@ -1,7 +1,7 @@
 // Output files written whole or not at all, output-path checks and same-file detection
-// (tools/src/OutputFile.h), in process.
+// (hapto/scenes/OutputFile.h), in process.
 
-#include "OutputFile.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include "TestSupport.h"
 
@@ -15,7 +15,6 @@
 #include <vector>
 
 using namespace hapto;
-using namespace hapto::cli;
 using namespace hapto::test;
 namespace fs = std::filesystem;
 

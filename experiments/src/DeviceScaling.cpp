@@ -1,21 +1,21 @@
 // `hapto experiment devices`: haptic load against the number of devices sharing one world,
 // and cursor steps per locate against N for the three cursor strategies.
 
-#include "Experiments.h"
+#include "hapto/experiments/Experiments.h"
 
-#include "ExperimentSupport.h"
-#include "Plot.h"
-#include "Progress.h"
-#include "Sweep.h"
+#include "hapto/experiments/ExperimentSupport.h"
+#include "hapto/experiments/Plot.h"
+#include "hapto/experiments/Progress.h"
+#include "hapto/experiments/Sweep.h"
 
-#include "../../bench/HandWalk.h"
-#include "../Commands.h"
+#include "HandWalk.h"
 
 #include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
 #include "hapto/scenes/Random.h"
+#include "hapto/scenes/SceneFile.h"
 
 #include <algorithm>
 #include <chrono>
@@ -242,7 +242,7 @@ int runDevices(const DevicesArgs& args) {
     IndexSpec cursorSpec = spec.kind == IndexSpec::Kind::Octree
                                ? spec
                                : IndexSpec::octree(2, 0.005).withMaxMegabytes(args.maxIndexMb);
-    const Scene scene = cli::loadSceneOrDefault(args.scene);
+    const Scene scene = args.scene.empty() ? makeDefaultScene() : loadSceneFile(args.scene);
     const std::vector<int> counts = deviceCounts(args.maxDevices);
 
     Progress progress("devices", args.ratesHz.size() * counts.size() *

@@ -1,8 +1,8 @@
 // gnuplot scripts for `hapto experiment` figures.
 
-#include "Plot.h"
+#include "hapto/experiments/Plot.h"
 
-#include "../OutputFile.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include <algorithm>
 #include <cmath>
@@ -160,7 +160,7 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
            << plot << "set output\n";
     const std::filesystem::path gp = dir / (spec.name + ".gp");
     try {
-        cli::writeFileAtomically(gp, script.str());
+        writeFileAtomically(gp, script.str());
     } catch (const std::exception& e) {
         r.problem = e.what();
         return r;

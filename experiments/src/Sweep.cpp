@@ -1,8 +1,8 @@
 // The growing-scene sweep behind `hapto experiment paper1` and `paper2`.
 
-#include "Sweep.h"
+#include "hapto/experiments/Sweep.h"
 
-#include "Plot.h"
+#include "hapto/experiments/Plot.h"
 
 #include "hapto/runtime/World.h"
 

@@ -1,6 +1,6 @@
 // Output files written whole or not at all (temporary beside the target, then rename).
 
-#include "OutputFile.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include "hapto/scenes/InputError.h"
 
@@ -14,7 +14,7 @@
 #include <unistd.h>
 #include <vector>
 
-namespace hapto::cli {
+namespace hapto {
 namespace fs = std::filesystem;
 namespace {
 
@@ -269,4 +269,4 @@ void refuseSameFile(const fs::path& output, std::string_view outOption, const fs
     }
 }
 
-} // namespace hapto::cli
+} // namespace hapto

@@ -1,7 +1,7 @@
 #pragma once
 /// The three `hapto experiment` runs, as functions of their parsed arguments.
 
-#include "ExperimentSupport.h"
+#include "hapto/experiments/ExperimentSupport.h"
 
 #include <cstddef>
 #include <cstdint>
