@@ -1,6 +1,7 @@
 #include "hapto/devices/FalconDevice.h"
 
-#include "hapto/devices/Mailbox.h"
+#include "hapto/core/Clock.h"
+#include "hapto/core/Mailbox.h"
 
 #include "hapto/devices/FalconKinematics.h"
 #include "hapto/devices/FalconPacket.h"
@@ -45,9 +46,9 @@ constexpr std::uint16_t kBaudUpload = 0x0015;
 constexpr std::uint16_t kBaudNormal = 0x0002; // 1.5 Mbaud
 constexpr int kHandshakeAttempts = 10;
 
+/// The monotonic clock (core), signed so that differences of stamps can be negative.
 std::int64_t nowNs() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
-        .count();
+    return static_cast<std::int64_t>(monotonicNs());
 }
 
 std::string usbError(int rc) {

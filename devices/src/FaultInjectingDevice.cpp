@@ -1,21 +1,13 @@
 #include "hapto/devices/FaultInjectingDevice.h"
 
+#include "hapto/core/Clock.h"
+
 #include <cerrno>
 #include <cmath>
 #include <ctime>
 #include <limits>
 
 namespace hapto {
-namespace {
-
-std::uint64_t monotonicNs() noexcept {
-    timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<std::uint64_t>(ts.tv_sec) * 1'000'000'000ull +
-           static_cast<std::uint64_t>(ts.tv_nsec);
-}
-
-} // namespace
 
 const char* injectedFaultName(InjectedFault fault) noexcept {
     switch (fault) {

@@ -26,7 +26,8 @@
 
 #include "hapto/devices/PhantomDevice.h"
 
-#include "hapto/devices/Mailbox.h"
+#include "hapto/core/Finite.h"
+#include "hapto/core/Mailbox.h"
 
 #include "PhantomHdApi.h"
 
@@ -162,10 +163,6 @@ hd::HDCallbackCode phantomServoCallback(void* userData) {
 DeviceStatus statusForHdError(std::uint32_t code) {
     return (code == hd::kCommError || code == hd::kCommConfigError) ? DeviceStatus::Disconnected
                                                                     : DeviceStatus::Error;
-}
-
-bool finite(const Vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
 std::string stringParam(const hd::HdApi& api, hd::HDenum name) {

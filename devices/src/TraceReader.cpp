@@ -1,5 +1,6 @@
 #include "hapto/devices/TraceReader.h"
 
+#include "hapto/core/Finite.h"
 #include "hapto/scenes/InputError.h"
 #include "hapto/scenes/InputFile.h"
 
@@ -27,10 +28,6 @@ bool text(const char* field, std::size_t size, std::string& out) {
         }
     }
     return true;
-}
-
-bool finite(const Vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
 } // namespace

@@ -1,19 +1,13 @@
 #include "hapto/runtime/ForceSafety.h"
 
+#include "hapto/core/Finite.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace hapto {
-
-namespace {
-
-bool isFinite(const Vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-} // namespace
 
 ForceSafety::ForceSafety(const SafetyConfig& config) : mConfig(config) {
     if (!(config.maxForceN > 0.0) || !std::isfinite(config.maxForceN)) {
@@ -54,7 +48,7 @@ ForceSafety& ForceSafety::operator=(const ForceSafety& other) noexcept {
 Vec3 ForceSafety::filter(const Vec3& forceN) noexcept {
     bump(mFiltered);
     Vec3 f = forceN;
-    if (!isFinite(f)) {
+    if (!finite(f)) {
         const bool anyNan = std::isnan(f.x) || std::isnan(f.y) || std::isnan(f.z);
         if (anyNan) { // no direction: nothing safe to send but zero
             bump(mNonFinite);
@@ -94,7 +88,7 @@ Vec3 ForceSafety::filter(const Vec3& forceN) noexcept {
         f = mLast + step * (mConfig.maxForceStepN / stepN);
         bump(mRateLimited);
     }
-    if (!isFinite(f)) {
+    if (!finite(f)) {
         bump(mNonFinite);
         f = Vec3(0.0);
     }

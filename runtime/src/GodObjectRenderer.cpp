@@ -37,6 +37,8 @@
 
 #include "hapto/runtime/GodObjectRenderer.h"
 
+#include "hapto/core/Finite.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -59,10 +61,6 @@ constexpr double kFeasibleM = 1e-12;   ///< Half-space feasibility slack (m).
 constexpr double kNearMarginM = 1e-3;  ///< Extra radius of the near ball (m).
 constexpr double kFrictionCover = 1.0; ///< Near ball also covers a friction lag up to mu_d = 1.
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-bool isFinite(const Vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 double length2(const Vec3& v) {
     return glm::dot(v, v);
@@ -290,7 +288,7 @@ GodObjectRenderer::GodObjectRenderer(const RendererConfig& config) : mConfig(con
 void GodObjectRenderer::reset(const Vec3& devicePosition) noexcept {
     mProxy = devicePosition;
     mLastDevice = devicePosition;
-    mHasLastDevice = isFinite(devicePosition);
+    mHasLastDevice = finite(devicePosition);
     mSlipping = false;
     mContactCount = 0;
     mNearRadius = -1.0;
@@ -493,21 +491,21 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     mNearRadius = -1.0;
     mNearCount = 0;
     mNearOverflow = false;
-    if (!isFinite(devicePosition)) {
+    if (!finite(devicePosition)) {
         out.status = RenderStatus::NonFiniteInput;
         out.proxy = mProxy;
         ++mCounters.nonFiniteInput;
         return out;
     }
-    if (!isFinite(mProxy)) {
+    if (!finite(mProxy)) {
         reset(devicePosition);
     }
     Vec3 velocity = deviceVelocity;
-    if (!isFinite(velocity)) {
+    if (!finite(velocity)) {
         velocity = Vec3(0.0);
         if (mHasLastDevice && dtSeconds > 0.0 && std::isfinite(dtSeconds)) {
             velocity = (devicePosition - mLastDevice) / dtSeconds;
-            if (!isFinite(velocity)) {
+            if (!finite(velocity)) {
                 velocity = Vec3(0.0);
             }
         }
@@ -650,11 +648,11 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     if (candidates.overflowed) {
         ++mCounters.candidatesDropped;
     }
-    if (!isFinite(out.force) || !isFinite(out.proxy)) {
+    if (!finite(out.force) || !finite(out.proxy)) {
         out.status = RenderStatus::NonFiniteOutput;
         ++mCounters.nonFiniteOutput;
         out.force = Vec3(0.0);
-        out.proxy = isFinite(start) ? start : goal;
+        out.proxy = finite(start) ? start : goal;
         out.contactCount = 0;
         out.sliding = false;
     }

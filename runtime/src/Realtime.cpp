@@ -1,5 +1,8 @@
 #include "hapto/runtime/Realtime.h"
 
+#include "hapto/core/Clock.h"
+#include "hapto/core/CpuPause.h"
+
 #include <cerrno>
 #include <cstring>
 #include <ctime>
@@ -13,10 +16,7 @@ thread_local bool tInServoLoop = false;
 }
 
 std::uint64_t nowNs() noexcept {
-    timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<std::uint64_t>(ts.tv_sec) * 1'000'000'000ull +
-           static_cast<std::uint64_t>(ts.tv_nsec);
+    return monotonicNs();
 }
 
 void sleepUntilNs(std::uint64_t deadlineNs, std::uint64_t spinNs) noexcept {
@@ -28,7 +28,7 @@ void sleepUntilNs(std::uint64_t deadlineNs, std::uint64_t spinNs) noexcept {
     }
     if (spinNs > 0) {
         while (nowNs() < deadlineNs) {
-            __builtin_ia32_pause();
+            cpuPause();
         }
     }
 }

@@ -1,4 +1,3 @@
-#include "hapto/devices/SpscRing.h"
 #include "hapto/devices/TraceReader.h"
 #include "hapto/devices/TraceRecorder.h"
 #include "hapto/scenes/InputError.h"
@@ -296,27 +295,4 @@ TEST_CASE("trace recorder: a folder or a missing folder is refused and nothing i
     CHECK_THROWS_AS(TraceRecorder(dir / "missing" / "t.trace", header()), InputError);
     CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace"});
     CHECK(std::filesystem::is_empty(dir / "t.trace"));
-}
-
-TEST_CASE("spsc ring: order, capacity rounding, wrap-around") {
-    SpscRing<int> ring(5);
-    CHECK(ring.capacity() == 8);
-    int out = 0;
-    CHECK_FALSE(ring.tryPop(out));
-    for (int round = 0; round < 10; ++round) {
-        for (int i = 0; i < 8; ++i) {
-            REQUIRE(ring.tryPush(round * 8 + i));
-        }
-        REQUIRE_FALSE(ring.tryPush(-1));
-        CHECK(ring.sizeApprox() == 8);
-        int batch[3];
-        REQUIRE(ring.popInto(batch) == 3);
-        CHECK(batch[0] == round * 8);
-        CHECK(batch[2] == round * 8 + 2);
-        for (int i = 3; i < 8; ++i) {
-            REQUIRE(ring.tryPop(out));
-            REQUIRE(out == round * 8 + i);
-        }
-        CHECK(ring.sizeApprox() == 0);
-    }
 }

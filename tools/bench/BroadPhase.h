@@ -8,7 +8,7 @@
 /// for all, so their times compare. `query` is defined out of line in every class, so each pays
 /// the same one call.
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 
 #include <cstdint>
 

@@ -10,7 +10,7 @@
 /// maxSpeedMPerS x tickS apart (0.5 mm at 0.5 m/s and 1 kHz).
 /// Cost: a few flops and two normal draws per axis per step; no allocation in next().
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 #include "hapto/scenes/Random.h"
 
 #include <algorithm>

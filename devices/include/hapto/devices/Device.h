@@ -1,7 +1,7 @@
 #pragma once
 /// The Device interface: what a servo thread reads from and writes to a force-feedback device.
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 
 #include <cstdint>
 #include <string>

@@ -1,8 +1,8 @@
 #pragma once
 /// The device configuration file (`--devices D.json`): which devices, where, how fast, how hard.
 
+#include "hapto/core/Geometry.h"
 #include "hapto/devices/FalconKinematics.h"
-#include "hapto/scenes/Geometry.h"
 
 #include <cstdint>
 #include <filesystem>

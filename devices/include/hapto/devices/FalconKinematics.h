@@ -20,7 +20,7 @@
 // (z along the grip axis, away from the device body), where the workspace centre sits at
 // kWorkspaceOrigin; FalconDevice reports positions relative to that centre.
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 
 #include <array>
 #include <cstdint>

@@ -1,7 +1,7 @@
 #pragma once
 /// A hand holding a device handle: a point mass pulled towards a target by a spring-damper.
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 
 namespace hapto {
 

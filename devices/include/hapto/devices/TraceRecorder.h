@@ -1,7 +1,7 @@
 #pragma once
 /// Records a device's servo ticks to a trace file without ever making the servo thread wait.
 
-#include "hapto/devices/SpscRing.h"
+#include "hapto/core/SpscRing.h"
 #include "hapto/devices/TraceFormat.h"
 
 #include <atomic>

@@ -6,7 +6,7 @@
 /// a missed overlap is a hole the pointer falls through, a spurious one costs one more candidate.
 /// Touching counts as overlap.
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 #include "hapto/scenes/SceneObject.h"
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 #pragma once
 /// The last stage before a device: clamps, rate-limits and sanitises every force.
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 
 #include <atomic>
 #include <cstdint>

@@ -1,9 +1,9 @@
 #pragma once
 /// The runtime: one servo thread per device over one shared World, and the load they measure.
 
+#include "hapto/core/Mailbox.h"
 #include "hapto/devices/Device.h"
 #include "hapto/devices/DeviceConfig.h"
-#include "hapto/devices/Mailbox.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/runtime/DeviceMetrics.h"
 #include "hapto/runtime/ForceSafety.h"

@@ -2,7 +2,7 @@
 /// Reading hapto's JSON input files (scenes, device configurations) with messages that name the
 /// file and the JSON path of every bad value. For hapto's own loaders; all [control].
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,7 +1,7 @@
 #pragma once
 /// One rigid object of a scene: an oriented box or a sphere with an id and a material.
 
-#include "hapto/scenes/Geometry.h"
+#include "hapto/core/Geometry.h"
 
 #include <cstdint>
 #include <string_view>
