@@ -1,5 +1,6 @@
 #include "hapto/runtime/World.h"
 
+#include "hapto/runtime/Realtime.h"
 #include "hapto/scenes/InputError.h"
 
 #include <algorithm>
@@ -71,13 +72,13 @@ void World::moveObject(ObjectId id, const Vec3& center, const Quat& rotation) {
     }
     auto scene = std::make_shared<Scene>(*cur.scene);
     scene->setPose(*slot, center, rotation);
-    const auto now = Clock::now();
+    const std::uint64_t now = nowNs();
     const auto it =
         std::find_if(mMovers.begin(), mMovers.end(), [&](auto& m) { return m.id == id; });
     if (it == mMovers.end()) {
         mMovers.push_back({id, now});
     } else {
-        it->lastMove = now;
+        it->lastMoveNs = now;
     }
     publish(std::move(scene), cur.index);
 }
@@ -90,7 +91,7 @@ void World::addObject(const SceneObject& object) {
     std::vector<SceneObject> objects(cur.scene->objects().begin(), cur.scene->objects().end());
     objects.push_back(object);
     auto scene = std::make_shared<const Scene>(cur.scene->bounds(), std::move(objects));
-    mMovers.push_back({object.id, Clock::now()});
+    mMovers.push_back({object.id, nowNs()});
     // The old index knows nothing of the new slot; slots of the others are unchanged.
     publish(std::move(scene), cur.index);
 }
@@ -123,24 +124,30 @@ std::shared_ptr<const Scene> World::without(const Scene& scene, const std::vecto
 void World::startBuild() {
     auto build = std::make_unique<PendingBuild>();
     build->removed = std::exchange(mPendingRemovals, {});
-    build->started = Clock::now();
+    build->startedNs = nowNs();
     std::shared_ptr<const Scene> scene =
         build->removed.empty() ? current().scene : without(*current().scene, build->removed);
-    build->index = std::async(std::launch::async,
-                              [scene, spec = mSpec]() -> std::shared_ptr<const SpatialIndex> {
-                                  return buildIndex(*scene, spec);
-                              });
+    if (mClock) { // deterministic mode: built here, published by the caller at once
+        std::promise<std::shared_ptr<const SpatialIndex>> built;
+        built.set_value(buildIndex(*scene, mSpec));
+        build->index = built.get_future();
+    } else {
+        build->index = std::async(std::launch::async,
+                                  [scene, spec = mSpec]() -> std::shared_ptr<const SpatialIndex> {
+                                      return buildIndex(*scene, spec);
+                                  });
+    }
     mBuild = std::move(build);
 }
 
 void World::finishBuild() {
     std::shared_ptr<const SpatialIndex> index = mBuild->index.get();
-    const auto started = mBuild->started;
+    const std::uint64_t started = mBuild->startedNs;
     const std::vector<ObjectId> removed = std::move(mBuild->removed);
     mBuild.reset();
     // Objects that moved after the build started stay on the brute-force path.
     std::erase_if(mMovers, [&](const Mover& m) {
-        return m.lastMove < started ||
+        return m.lastMoveNs < started ||
                std::find(removed.begin(), removed.end(), m.id) != removed.end();
     });
     ++mBuildsPublished;
@@ -159,12 +166,14 @@ void World::maintain() {
         reclaim();
         return;
     }
-    const auto now = Clock::now();
-    const bool anyRested = std::any_of(mMovers.begin(), mMovers.end(), [&](const Mover& m) {
-        return now - m.lastMove >= mRestDelay;
-    });
+    const std::uint64_t now = nowNs();
+    const bool anyRested = std::any_of(mMovers.begin(), mMovers.end(),
+                                       [&](const Mover& m) { return rested(m, now); });
     if (anyRested || !mPendingRemovals.empty()) {
         startBuild();
+        if (mClock) {
+            finishBuild(); // built inline: publish it now
+        }
     }
     reclaim();
 }
@@ -176,14 +185,25 @@ void World::settle() {
             mBuild->index.wait();
             finishBuild();
         }
+        const std::uint64_t now = nowNs();
         if (mPendingRemovals.empty() &&
             std::none_of(mMovers.begin(), mMovers.end(),
-                         [&](const Mover& m) { return Clock::now() - m.lastMove >= mRestDelay; })) {
+                         [&](const Mover& m) { return rested(m, now); })) {
             break;
         }
         startBuild();
     }
     reclaim();
+}
+
+std::uint64_t World::nowNs() const noexcept {
+    return mClock ? mClock->nowNs() : rt::nowNs();
+}
+
+bool World::rested(const Mover& m, std::uint64_t now) const noexcept {
+    return now >= m.lastMoveNs &&
+           now - m.lastMoveNs >= static_cast<std::uint64_t>(std::max<std::int64_t>(
+                                     0, static_cast<std::int64_t>(mRestDelay.count())));
 }
 
 void World::reclaim() {

@@ -8,6 +8,7 @@
 #include "hapto/runtime/DeviceMetrics.h"
 #include "hapto/runtime/ForceSafety.h"
 #include "hapto/runtime/GodObjectRenderer.h"
+#include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/World.h"
 
 #include <array>
@@ -103,6 +104,11 @@ struct RunReport {
 /// thread) runs on the runtime's own supervisor thread, and every close and open on a worker
 /// thread of that device: nothing a servo thread depends on waits for the control thread, a
 /// terminal, a disk or another device's open (Falcon homing can take 30 s).
+///
+/// Step mode: startStepped() instead of start() opens the devices and starts no thread; the
+/// caller then drives the same servo tick and the same supervision pass from its own thread
+/// with a clock it gives (runUntil, stepAll, or step and supervise), so a test or a tool gets
+/// the same results every run: same fault rules, same reports, same forces.
 /// Threading: every public member is [control] except where marked.
 class Runtime {
 public:
@@ -118,6 +124,35 @@ public:
     /// the supervisor thread. A device that fails to open is reported as faulted and the
     /// others run. Returns the number of servo threads started. [control]
     std::size_t start();
+    /// Step mode: opens every device like start(), in order, and starts no thread; `clock`
+    /// (which must outlive the runtime) is the time from now on, its value now the session's
+    /// start. Drive it with runUntil(), stepAll(), or step() and supervise(). Returns the
+    /// number of devices opened. [control]
+    std::size_t startStepped(ManualClock& clock);
+    /// Step mode: runs every device at each of its deadlines (an on-time wake-up) and a
+    /// supervision pass after each, in time order, up to and including `untilNs`; a faulted
+    /// device is reopened at its reopen times. Ends with the clock at `untilNs`. [control]
+    void runUntil(std::uint64_t untilNs);
+    /// Step mode: at `nowNs`, one tick of every device whose deadline has come (a `nowNs`
+    /// past a deadline is a late wake-up), in device order, then one supervision pass. Before
+    /// each device's tick the clock is set to `nowNs`; the device may advance it inside its
+    /// read() or write() (that tick then takes that long: its load, misses and next deadline
+    /// follow); afterwards the clock is set back to `nowNs`, since the other devices' threads
+    /// did not wait for it. [control]
+    void stepAll(std::uint64_t nowNs);
+    /// Step mode: one tick of device i woken at `nowNs` (clock as in stepAll()), when its
+    /// servo runs and its deadline has come; a device not stepped meanwhile is a thread that
+    /// could not run. A servo stopped by the watchdog commands zero and leaves here. Returns
+    /// true when a tick completed. [control]
+    bool step(std::size_t i, std::uint64_t nowNs);
+    /// Step mode: one supervision pass at `nowNs`: the watchdog over heartbeats, closing a
+    /// faulted device, reopening it once reopenAfterNs has passed (open and close run inline,
+    /// the clock set back to `nowNs` after each). [control]
+    void supervise(std::uint64_t nowNs);
+    /// When device i's next tick is due (ns, the runtime's clock). [control]
+    std::uint64_t nextDeadlineNs(std::size_t i) const;
+    /// True after startStepped(). [control]
+    bool stepped() const { return mClock != nullptr; }
     /// World upkeep (re-indexing rested objects, freeing old snapshots): call every few
     /// milliseconds from the thread that updates the world. Supervision does not depend on
     /// it. [control]
@@ -128,7 +163,8 @@ public:
     /// The last resort when stop() cannot be waited for (a second Ctrl-C): tells every servo
     /// thread to stop, waits at most `waitNs` for them to command zero force and leave, and
     /// closes each device whose thread has left. Safe from a thread other than the control
-    /// thread while the control thread is blocked; the process should exit right after. [any
+    /// thread while the control thread is blocked; the process should exit right after. In
+    /// step mode it commands zero and closes at once, and belongs to the stepping thread. [any
     /// thread]
     void emergencyStop(std::uint64_t waitNs = 200'000'000) noexcept;
     /// True while some device is driven or will be again (a faulted device waiting to be
@@ -155,16 +191,31 @@ public:
 
 private:
     struct Channel;
-    void servoMain(Channel& channel);
+    // Runtime.cpp: set-up and shutdown.
+    std::size_t openAll();
+    std::uint64_t now() const noexcept;
+    void requireStepped(const char* what) const;
+    // ServoLoop.cpp: the servo, threaded or stepped.
+    void startServo(Channel& channel, std::uint64_t nowNs) noexcept;
+    bool servoTick(Channel& channel, std::uint64_t wakeNs) noexcept;
+    void leaveServo(Channel& channel) noexcept;
     void startThread(Channel& channel);
+    void servoMain(Channel& channel);
+    // Supervision.cpp: the watchdog, closing and reopening.
     void superviseMain();
+    void superviseChannel(Channel& channel, std::uint64_t nowNs);
     void recoverMain(Channel& channel);
+    void closeFaulted(Channel& channel);
+    bool openAgain(Channel& channel, std::uint64_t& backNs);
+    void markReopened(Channel& channel, std::uint64_t backNs);
+    void reopenStepped(Channel& channel, std::uint64_t nowNs);
     bool waitUnlessStopping(std::uint64_t ns);
     void addEvent(Channel& channel, std::uint64_t nowNs, const std::string& what);
 
     World& mWorld;
     RuntimeOptions mOptions;
     std::vector<std::unique_ptr<Channel>> mChannels;
+    ManualClock* mClock = nullptr; // step mode's clock; nullptr: threaded, CLOCK_MONOTONIC
     std::uint64_t mStartNs = 0;
     std::atomic<std::uint64_t> mStopNs{0};
     std::string mRealtimeNote;

@@ -3,6 +3,7 @@
 /// thread and read by every servo thread without locks, waiting or allocation.
 
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/runtime/ManualClock.h"
 #include "hapto/scenes/Scene.h"
 
 #include <array>
@@ -43,7 +44,8 @@ struct alignas(64) SnapshotReader {
 /// (O(N) on the control thread) and reuses the index: while an object moves, its stale index
 /// entries only add candidates (harmless: the renderer tests real geometry) and the moving
 /// list makes sure it is tested where it now is. Once it has rested for `restDelay`, a new
-/// index is built on a background thread (TBB inside) and published.
+/// index is built on a background thread (TBB inside) and published. Time is CLOCK_MONOTONIC,
+/// or a ManualClock given to useClock(), which also makes builds run inline: deterministic.
 class World {
 public:
     /// Readers a world can serve (servo threads plus tools).
@@ -97,6 +99,12 @@ public:
 
     /// How long an object must stay still before it goes back into the index.
     void setRestDelay(std::chrono::nanoseconds delay) { mRestDelay = delay; }
+    /// Deterministic mode, for the runtime's step mode, tests and tools: times (moves, the
+    /// rest delay, build starts) come from `clock` (which must outlive the world), and an
+    /// index build runs inline in the maintain() that starts it and is published there, not
+    /// on a background thread; the same calls at the same clock times give the same
+    /// snapshots. Call it before any update. [control]
+    void useClock(const ManualClock& clock) { mClock = &clock; }
     /// The index specification every build uses. [any thread]
     const IndexSpec& spec() const { return mSpec; }
     /// Index builds published so far (the first one included). [control]
@@ -105,14 +113,13 @@ public:
     std::size_t retiredCount() const { return mRetired.size(); }
 
 private:
-    using Clock = std::chrono::steady_clock;
     struct Mover {
         ObjectId id;
-        Clock::time_point lastMove;
+        std::uint64_t lastMoveNs;
     };
     struct PendingBuild {
         std::vector<ObjectId> removed; // ids this build leaves out
-        Clock::time_point started;
+        std::uint64_t startedNs;
         std::future<std::shared_ptr<const SpatialIndex>> index;
     };
 
@@ -123,6 +130,8 @@ private:
                                                 const std::vector<ObjectId>& ids);
     void finishBuild();
     void reclaim();
+    std::uint64_t nowNs() const noexcept;
+    bool rested(const Mover& mover, std::uint64_t nowNs) const noexcept;
 
     IndexSpec mSpec;
     std::atomic<const WorldSnapshot*> mCurrent{nullptr};
@@ -133,6 +142,7 @@ private:
     std::unique_ptr<PendingBuild> mBuild;
     std::vector<ObjectId> mPendingRemovals; // removals wait for a build
     std::chrono::nanoseconds mRestDelay = std::chrono::milliseconds(100);
+    const ManualClock* mClock = nullptr; // deterministic mode; nullptr: CLOCK_MONOTONIC
     std::uint64_t mVersion = 0;
     std::uint64_t mBuildsPublished = 0;
 };

@@ -1,0 +1,119 @@
+#pragma once
+/// One device's block inside the Runtime (private to runtime/src): the servo thread's hot
+/// state, what it shares with other threads, and the cold record supervision and reports use.
+///
+/// Design note. A Channel is laid out in four parts, by who touches them how often:
+///   ServoState      hot: everything one tick reads or writes and nothing else (the device
+///                   pointer, the frames, the deadline, the sample, the haptic tick). Only the
+///                   servo thread (or the stepping thread) touches it while the servo runs;
+///                   1984 bytes, asserted below: 256 of tick state, 1728 of HapticTick.
+///   DeviceMetrics   written every tick by the servo, read by any thread (its own lines).
+///   two Mailboxes   contacts out, external force in, every tick (their own lines).
+///   ChannelRecord   cold: the configuration and its strings, the threads, recovery flags,
+///                   the fault record and event list under a mutex. Never touched by a tick.
+/// Strings, vectors and mutexes live only in the record, so a tick's cache lines hold tick data.
+
+#include "hapto/runtime/HapticTick.h"
+#include "hapto/runtime/Realtime.h"
+#include "hapto/runtime/Runtime.h"
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace hapto {
+
+using Triple = std::array<double, 3>;
+inline Triple triple(const Vec3& v) {
+    return {v.x, v.y, v.z};
+}
+inline Vec3 vec(const Triple& t) {
+    return {t[0], t[1], t[2]};
+}
+
+// ContactReport as plain words for the mailbox (GLM vectors are not trivially copyable).
+struct ContactWire {
+    std::uint64_t tick;
+    Triple devicePoint, proxy, force;
+    std::array<ObjectId, 3> objects;
+    std::array<Triple, 3> normals;
+    std::uint32_t contactCount;
+};
+
+/// The servo's hot state: what a tick reads and writes. [servo] while the servo runs;
+/// [control] (or the supervisor) only while it does not.
+struct alignas(64) ServoState {
+    // Fixed from construction (reader: from open).
+    Device* device = nullptr;
+    TraceRecorder* recorder = nullptr;
+    SnapshotReader* reader = nullptr;
+    WorkspaceTransform transform;
+    std::uint64_t periodNs = 1'000'000;
+    std::uint64_t lateNs = 0;    ///< A wake-up later than this is counted late.
+    std::uint64_t starvedNs = 0; ///< One this late (K periods) commands zero.
+    std::uint64_t stallNs = 0;   ///< The watchdog's limit between two ticks.
+    double dtS = 1e-3;           ///< The period (s).
+    int missLimit = 3;           ///< K.
+
+    // Per tick.
+    std::uint64_t deadlineNs = 0; ///< The next wake-up.
+    std::uint64_t tick = 0;       ///< Ticks completed, over every start of the servo.
+    int consecutiveMisses = 0;    ///< Saturates at missLimit.
+    bool first = true;            ///< The next tick is the first since the servo started.
+    std::atomic<bool> stop{false};
+    Vec3 lastPosition{0.0}; ///< The last device point (m, world).
+    DeviceState sample;     ///< The last reading.
+    HapticTick haptic;
+
+    ServoState(const RendererConfig& renderer, const SafetyConfig& safety)
+        : haptic(renderer, safety) {}
+};
+static_assert(sizeof(ServoState) == 1984, "update the size in the note above");
+
+/// The cold record of a channel.
+struct ChannelRecord {
+    RuntimeDevice rd; ///< The device (owned), its configuration, its recorder.
+    int cpu = -1;     ///< The core its servo thread is pinned to, or -1.
+    std::thread thread;
+    bool opened = false; ///< open() succeeded at start(); control thread only.
+    std::string openError;
+    rt::RealtimeGrant grant;
+
+    // Fault recovery. Supervision hands a faulted device to recovery (recovering), which
+    // closes it (down), reopens it and starts its servo again; with reopening off it stays
+    // closed (gaveUp). `closed` makes sure one thread, and one only, closes it.
+    std::atomic<bool> recovering{false}, down{false}, gaveUp{false}, closed{false};
+    std::thread worker;            ///< The recovery worker (threaded mode).
+    std::uint64_t nextReopenNs = 0; ///< Step mode: when to try to open again.
+
+    mutable std::mutex mutex;      // guards the fields below: recovery writes, report() reads
+    std::uint64_t downSinceNs = 0; // when the fault happened
+    std::uint64_t faults = 0, reopens = 0, downNs = 0;
+    std::string lastFault;       // what the last fault was, for the report
+    std::string lastReopenError; // so a device that stays away is logged once, not per try
+    std::vector<std::string> events;
+    std::uint64_t eventsDropped = 0;
+};
+
+struct alignas(64) Runtime::Channel {
+    ServoState servo;               ///< Hot.
+    DeviceMetrics metrics;          ///< Servo -> any thread.
+    Mailbox<ContactWire> contacts;  ///< Servo -> control, every tick.
+    Mailbox<Triple> externalForce;  ///< Control -> servo, world frame (N).
+    ChannelRecord record;           ///< Cold.
+
+    Channel(RuntimeDevice d, const RuntimeOptions& o);
+};
+
+/// Stores a vector into three relaxed atomics. [servo]
+inline void storeVec(std::atomic<double> (&dst)[3], const Vec3& v) noexcept {
+    for (int i = 0; i < 3; ++i) {
+        dst[i].store(v[i], std::memory_order_relaxed);
+    }
+}
+
+} // namespace hapto

@@ -1,0 +1,169 @@
+// Reports: the run's summary from each device's metrics and record, as values, as JSON (the
+// `hapto run --report` format) and as one live line per device. Nothing here runs on a servo
+// thread; report() takes each device's record lock briefly, never a servo's.
+
+#include "Channel.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+
+namespace hapto {
+
+const char* faultName(FaultKind kind) noexcept {
+    switch (kind) {
+    case FaultKind::None:
+        return "none";
+    case FaultKind::OpenFailed:
+        return "open-failed";
+    case FaultKind::ReadFailed:
+        return "read-failed";
+    case FaultKind::WriteFailed:
+        return "write-failed";
+    case FaultKind::NonFinite:
+        return "non-finite";
+    case FaultKind::Watchdog:
+        return "watchdog";
+    }
+    return "unknown";
+}
+
+RunReport Runtime::report() const {
+    RunReport r;
+    r.cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    r.stable = !mChannels.empty();
+    for (const auto& chp : mChannels) {
+        const Channel& ch = *chp;
+        const ChannelRecord& c = ch.record;
+        const DeviceMetrics& m = ch.metrics;
+        DeviceReport d;
+        d.name = c.rd.config.name;
+        d.kind = c.rd.config.kind;
+        d.rateHz = c.rd.config.rateHz;
+        d.ticks = m.ticks.load();
+        HistogramSummary t = m.tickNs.summary();
+        const double period = static_cast<double>(ch.servo.periodNs);
+        d.loadFraction = {t.count,        t.mean / period, t.p50 / period,
+                          t.p99 / period, t.p999 / period, t.max / period};
+        d.latenessNs = m.latenessNs.summary();
+        d.ioNs = m.ioNs.summary();
+        d.lateWakeups = m.lateWakeups.load();
+        d.missedDeadlines = m.missedDeadlines.load();
+        d.zeroedForMisses = m.zeroedForMisses.load();
+        const double ticks = static_cast<double>(std::max<std::uint64_t>(1, d.ticks));
+        d.locateStepsMean = static_cast<double>(m.locateStepsSum.load()) / ticks;
+        d.candidatesMean = static_cast<double>(m.candidatesSum.load()) / ticks;
+        d.outsideTicks = m.outsideTicks.load();
+        d.contactTicks = m.contactTicks.load();
+        d.snapshotsSeen = m.snapshotsSeen.load();
+        d.safety = ch.servo.haptic.safety().counters();
+        d.realtime = m.realtime.load(std::memory_order_relaxed);
+        std::lock_guard lock(c.mutex);
+        const FaultKind f = m.fault.load();
+        const bool down = c.down.load(std::memory_order_acquire);
+        if (f == FaultKind::OpenFailed) {
+            d.fault = std::string("open-failed: ") + c.openError;
+        } else if (down) {
+            d.fault = c.lastFault;
+        } else if (f != FaultKind::None) { // faulted, not yet taken by the supervisor
+            d.fault = std::string(faultName(f)) + ": " +
+                      std::string(statusName(static_cast<DeviceStatus>(m.faultStatus.load())));
+        }
+        d.faults = c.faults + (f != FaultKind::None && f != FaultKind::OpenFailed && !down);
+        d.reopens = c.reopens;
+        const std::uint64_t nowNs = now();
+        const std::uint64_t downNow = down && nowNs > c.downSinceNs ? nowNs - c.downSinceNs : 0;
+        d.downS = static_cast<double>(c.downNs + downNow) * 1e-9;
+        d.events = c.events;
+        if (c.eventsDropped > 0) {
+            d.events.push_back("... and " + std::to_string(c.eventsDropped) + " more events");
+        }
+        d.stable = d.fault.empty() && d.faults == 0 && d.ticks > 0 && d.loadFraction.p999 < 1.0 &&
+                   static_cast<double>(d.missedDeadlines) <= 0.001 * static_cast<double>(d.ticks);
+        r.loadSum += d.loadFraction.mean;
+        r.stable = r.stable && d.stable;
+        r.devices.push_back(std::move(d));
+    }
+    r.loadPerCore = r.loadSum / r.cores;
+    const std::uint64_t stoppedAt = mStopNs.load();
+    const std::uint64_t end = stoppedAt ? stoppedAt : now();
+    r.durationS = mStartNs ? static_cast<double>(end - mStartNs) * 1e-9 : 0.0;
+    r.realtimeNote = mRealtimeNote;
+    return r;
+}
+
+std::string Runtime::liveLine(std::size_t i) const {
+    const Channel& ch = *mChannels.at(i);
+    const DeviceMetrics& m = ch.metrics;
+    const HistogramSummary t = m.tickNs.summary();
+    const double period = static_cast<double>(ch.servo.periodNs);
+    const Vec3 f(m.forceN[0].load(), m.forceN[1].load(), m.forceN[2].load());
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "%-10s %9llu ticks  load p50 %5.1f%%  p99.9 %5.1f%%  max %6.1f%%  missed %llu  "
+                  "|F| %5.2f N%s",
+                  ch.record.rd.config.name.c_str(), static_cast<unsigned long long>(m.ticks.load()),
+                  100.0 * t.p50 / period, 100.0 * t.p999 / period, 100.0 * t.max / period,
+                  static_cast<unsigned long long>(m.missedDeadlines.load()), glm::length(f),
+                  m.fault.load() != FaultKind::None ? "  FAULTED" : "");
+    return line;
+}
+
+std::string reportToJson(const RunReport& r) {
+    using nlohmann::json;
+    const auto load = [](const HistogramSummary& s) {
+        return json{
+            {"mean", s.mean}, {"p50", s.p50}, {"p99", s.p99}, {"p999", s.p999}, {"max", s.max}};
+    };
+    json devices = json::array();
+    for (const DeviceReport& d : r.devices) {
+        devices.push_back(json{
+            {"name", d.name},
+            {"kind", d.kind},
+            {"rate_hz", d.rateHz},
+            {"ticks", d.ticks},
+            {"load", load(d.loadFraction)},
+            {"late_wakeups", d.lateWakeups},
+            {"missed_deadlines", d.missedDeadlines},
+            {"zeroed_for_misses", d.zeroedForMisses},
+            {"lateness_ns", load(d.latenessNs)},
+            {"io",
+             {{"mean_ns", d.ioNs.mean},
+              {"p99_ns", d.ioNs.p99},
+              {"max_ns", d.ioNs.max},
+              {"fraction_of_tick", d.loadFraction.mean > 0
+                                       ? d.ioNs.mean / (d.loadFraction.mean * 1e9 / d.rateHz)
+                                       : 0.0}}},
+            {"locate_steps_mean", d.locateStepsMean},
+            {"candidates_mean", d.candidatesMean},
+            {"outside_ticks", d.outsideTicks},
+            {"contact_ticks", d.contactTicks},
+            {"snapshots_seen", d.snapshotsSeen},
+            {"safety",
+             {{"clamped", d.safety.clamped},
+              {"rate_limited", d.safety.rateLimited},
+              {"non_finite", d.safety.nonFinite},
+              {"overflowed", d.safety.overflowed}}},
+            {"faults", d.faults},
+            {"fault", d.fault},
+            {"reopens", d.reopens},
+            {"down_s", d.downS},
+            {"events", d.events},
+            {"realtime", d.realtime},
+            {"stable", d.stable},
+        });
+    }
+    json total{{"load_sum", r.loadSum},
+               {"load_per_core", r.loadPerCore},
+               {"cores", r.cores},
+               {"stable", r.stable},
+               {"duration_s", r.durationS}};
+    json out{{"devices", devices}, {"total", total}};
+    if (!r.realtimeNote.empty()) {
+        out["realtime_note"] = r.realtimeNote;
+    }
+    return out.dump(2) + "\n";
+}
+
+} // namespace hapto

@@ -1,0 +1,267 @@
+// The servo: one tick of one device, and the loop that runs it. Design note: a tick is read,
+// claim the snapshot, the haptic tick (HapticTick: locate both cursors, candidates, render,
+// effects, safety), the fault rules, write, record. Faults become zero force and a recorded
+// FaultKind, never an exception. The tick is written once, as servoTick(): a servo thread
+// sleeps to each absolute deadline and calls it (servoMain); the step mode calls it from the
+// caller's thread at the times the caller gives (step). Nothing below servoTick's entry
+// allocates, locks, throws or makes a syscall beyond the device's own I/O and the clock.
+//
+// The fault rules, per tick:
+//   - read() or write() fails: fault, zero, the servo ends (supervision closes and reopens);
+//   - a non-finite position or velocity: fault, zero, the servo ends;
+//   - the read returns more than the stall timeout after the last tick: the watchdog's fault
+//     (the supervisor may have seen it first, while the read hung), zero, the servo ends;
+//   - K missed deadlines in a row, or a wake-up K periods late (the thread could not run
+//     while the device held its last force): that tick commands zero, and force grows from
+//     zero at the safety filter's rate once ticks are on time again.
+
+#include "Channel.h"
+
+#include "hapto/core/Finite.h"
+#include "hapto/devices/TraceRecorder.h"
+
+#include <algorithm>
+#include <unistd.h>
+
+namespace hapto {
+
+void Runtime::startServo(Channel& ch, std::uint64_t nowNs) noexcept {
+    ServoState& s = ch.servo;
+    s.stop.store(false, std::memory_order_release);
+    s.haptic.reset(); // the proxy starts on the first point; force grows from zero
+    s.first = true;
+    s.consecutiveMisses = 0;
+    s.deadlineNs = nowNs + s.periodNs;
+    ch.metrics.heartbeatNs.store(nowNs);
+    ch.metrics.running.store(true);
+}
+
+bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
+    ServoState& s = ch.servo;
+    DeviceMetrics& m = ch.metrics;
+    const auto fault = [&](FaultKind k, DeviceStatus st, std::uint64_t atNs) {
+        m.faultStatus.store(static_cast<std::uint8_t>(st), std::memory_order_relaxed);
+        m.faultNs.store(atNs, std::memory_order_relaxed);
+        m.fault.store(k, std::memory_order_release);
+        (void)s.device->write(Vec3(0.0));
+    };
+    const std::uint64_t lateness = wake > s.deadlineNs ? wake - s.deadlineNs : 0;
+
+    DeviceStatus st = s.device->read(s.sample);
+    const std::uint64_t readDone = now();
+    if (st != DeviceStatus::Ok) {
+        fault(FaultKind::ReadFailed, st, readDone);
+        return false;
+    }
+    if (s.stop.load(std::memory_order_acquire)) {
+        return false; // stopped (or the watchdog fired) while inside read(): zero, on leaving
+    }
+    const std::uint64_t beat = m.heartbeatNs.load(std::memory_order_relaxed);
+    if (readDone > beat && readDone - beat > s.stallNs) {
+        // No tick for longer than the watchdog allows: the same fault the supervisor gives
+        // a hung servo (whichever sees it first), so a tick never ends such a gap with force.
+        FaultKind none = FaultKind::None;
+        if (m.fault.compare_exchange_strong(none, FaultKind::Watchdog)) {
+            m.faultNs.store(beat, std::memory_order_relaxed);
+        }
+        return false;
+    }
+    if (!finite(s.sample.position) || (s.sample.hasVelocity && !finite(s.sample.velocity))) {
+        fault(FaultKind::NonFinite, DeviceStatus::BadData, readDone);
+        return false;
+    }
+
+    const WorldSnapshot& snap = mWorld.acquire(*s.reader);
+    const Vec3 p = s.transform.positionToWorld(s.sample.position);
+    if (s.first) {
+        s.lastPosition = p;
+        s.first = false;
+    }
+    const Vec3 v = s.sample.hasVelocity ? s.transform.velocityToWorld(s.sample.velocity)
+                                        : (p - s.lastPosition) / s.dtS;
+    s.lastPosition = p;
+    Triple external{0.0, 0.0, 0.0};
+    (void)ch.externalForce.read(external);
+    const TickOutput out = s.haptic.tick(snap, p, v, s.dtS, vec(external));
+    if (out.newSnapshot) {
+        DeviceMetrics::bump(m.snapshotsSeen);
+    }
+    if (s.stop.load(std::memory_order_acquire)) {
+        return false; // stopped while rendering: leaving writes zero, not this force
+    }
+
+    Vec3 force = out.forceN;
+    if (s.consecutiveMisses >= s.missLimit || lateness >= s.starvedNs) {
+        force = Vec3(0.0);
+        s.haptic.zeroForce();
+        DeviceMetrics::bump(m.zeroedForMisses);
+    }
+    const Vec3 deviceForce = s.transform.forceToDevice(force);
+    const std::uint64_t writeStart = now();
+    st = s.device->write(deviceForce);
+    const std::uint64_t done = now();
+    if (st != DeviceStatus::Ok) {
+        fault(FaultKind::WriteFailed, st, done);
+        return false;
+    }
+
+    // Record.
+    const std::uint64_t tickNs = done - wake;
+    const std::uint64_t ioNs = (readDone - wake) + (done - writeStart);
+    m.tickNs.record(tickNs);
+    m.latenessNs.record(lateness);
+    m.ioNs.record(ioNs);
+    if (lateness > s.lateNs) {
+        DeviceMetrics::bump(m.lateWakeups);
+    }
+    DeviceMetrics::bump(m.locateStepsSum, out.locateSteps);
+    DeviceMetrics::bump(m.candidatesSum, out.render.objectsTested);
+    if (out.outside) {
+        DeviceMetrics::bump(m.outsideTicks);
+    }
+    if (out.render.contactCount > 0) {
+        DeviceMetrics::bump(m.contactTicks);
+    }
+    storeVec(m.forceN, force);
+    storeVec(m.positionM, p);
+    ContactWire report{s.tick,
+                       triple(p),
+                       triple(out.render.proxy),
+                       triple(force),
+                       {kNoObject, kNoObject, kNoObject},
+                       {},
+                       out.render.contactCount};
+    for (std::uint32_t c = 0; c < out.render.contactCount && c < report.objects.size(); ++c) {
+        report.objects[c] = out.render.contacts[c].id;
+        report.normals[c] = triple(out.render.contacts[c].normal);
+    }
+    ch.contacts.publish(report);
+    if (s.recorder) {
+        TraceSample sample{};
+        sample.tick = s.tick;
+        sample.timeNs = wake - mStartNs;
+        sample.positionM = s.sample.position;
+        sample.forceN = deviceForce;
+        sample.computeNs = static_cast<std::uint32_t>(std::min<std::uint64_t>(tickNs, UINT32_MAX));
+        sample.ioNs = static_cast<std::uint32_t>(std::min<std::uint64_t>(ioNs, UINT32_MAX));
+        sample.status = st;
+        sample.buttons = s.sample.buttons;
+        (void)s.recorder->push(sample);
+    }
+    ++s.tick;
+    DeviceMetrics::bump(m.ticks);
+    m.heartbeatNs.store(done, std::memory_order_relaxed);
+
+    // The next deadline. A tick whose force came after the next deadline missed it; skip the
+    // slots it overran instead of bursting to catch up.
+    s.deadlineNs += s.periodNs;
+    if (done > s.deadlineNs) {
+        DeviceMetrics::bump(m.missedDeadlines);
+        s.consecutiveMisses = std::min(s.consecutiveMisses + 1, s.missLimit); // saturates
+        s.deadlineNs += ((done - s.deadlineNs) / s.periodNs + 1) * s.periodNs;
+    } else {
+        s.consecutiveMisses = 0;
+    }
+    return true;
+}
+
+void Runtime::leaveServo(Channel& ch) noexcept {
+    ServoState& s = ch.servo;
+    DeviceMetrics& m = ch.metrics;
+    (void)s.device->write(Vec3(0.0));
+    storeVec(m.forceN, Vec3(0.0));
+    // Tell the control thread this hand touches nothing now (a grasp must not hold on to it).
+    ch.contacts.publish(ContactWire{s.tick,
+                                    triple(s.lastPosition),
+                                    triple(s.lastPosition),
+                                    {0.0, 0.0, 0.0},
+                                    {kNoObject, kNoObject, kNoObject},
+                                    {},
+                                    0});
+    m.running.store(false, std::memory_order_release);
+}
+
+void Runtime::startThread(Channel& ch) {
+    startServo(ch, now());
+    ch.record.thread = std::thread([this, &ch] { servoMain(ch); });
+}
+
+void Runtime::servoMain(Channel& ch) {
+    // Set-up: may allocate (the real-time grant's note), nothing below the loop entry does.
+    ChannelRecord& c = ch.record;
+    if (mOptions.realtime) {
+        c.grant = rt::makeCurrentThreadRealtime(mOptions.fifoPriority, c.cpu);
+    } else {
+        rt::tightenTimerSlack();
+        c.grant.note = "real-time scheduling not requested";
+    }
+    DeviceMetrics& m = ch.metrics;
+    m.threadId.store(static_cast<int>(gettid()), std::memory_order_relaxed);
+    m.realtime.store(c.grant.fifo, std::memory_order_relaxed);
+    ServoState& s = ch.servo;
+    s.deadlineNs = rt::nowNs() + s.periodNs;
+
+    rt::setInServoLoop(true);
+    while (!s.stop.load(std::memory_order_acquire)) {
+        rt::sleepUntilNs(s.deadlineNs, mOptions.spinNs);
+        if (!servoTick(ch, rt::nowNs())) {
+            break;
+        }
+    }
+    leaveServo(ch);
+    rt::setInServoLoop(false);
+}
+
+bool Runtime::step(std::size_t i, std::uint64_t nowNs) {
+    requireStepped("step");
+    Channel& ch = *mChannels.at(i);
+    ServoState& s = ch.servo;
+    if (!ch.metrics.running.load(std::memory_order_acquire) || nowNs < s.deadlineNs) {
+        return false; // not running, or asleep until its deadline
+    }
+    mClock->set(nowNs);
+    rt::setInServoLoop(true);
+    const bool ticked = !s.stop.load(std::memory_order_acquire) && servoTick(ch, nowNs);
+    if (!ticked) {
+        leaveServo(ch);
+    }
+    rt::setInServoLoop(false);
+    mClock->set(nowNs); // the other devices' threads did not wait for this one
+    return ticked;
+}
+
+void Runtime::stepAll(std::uint64_t nowNs) {
+    requireStepped("stepAll");
+    for (std::size_t i = 0; i < mChannels.size(); ++i) {
+        (void)step(i, nowNs);
+    }
+    supervise(nowNs);
+}
+
+void Runtime::runUntil(std::uint64_t untilNs) {
+    requireStepped("runUntil");
+    std::uint64_t at = mClock->nowNs();
+    for (;;) {
+        // The next event: a running servo's deadline, or a recovering device's reopen time.
+        std::uint64_t next = UINT64_MAX;
+        for (const auto& chp : mChannels) {
+            const Channel& ch = *chp;
+            if (ch.metrics.running.load(std::memory_order_acquire)) {
+                next = std::min(next, std::max(ch.servo.deadlineNs, at));
+            } else if (ch.record.recovering.load(std::memory_order_acquire)) {
+                next = std::min(next, std::max(ch.record.nextReopenNs, at));
+            }
+        }
+        if (next > untilNs) {
+            break;
+        }
+        stepAll(next);
+        at = next;
+    }
+    mClock->set(untilNs);
+    if (at < untilNs) {
+        supervise(untilNs);
+    }
+}
+
+} // namespace hapto
