@@ -7,6 +7,7 @@
 #include "hapto/experiments/Plot.h"
 #include "hapto/experiments/Progress.h"
 #include "hapto/experiments/Sweep.h"
+#include "hapto/experiments/Table.h"
 
 #include "HandWalk.h"
 
@@ -93,12 +94,6 @@ std::vector<int> deviceCounts(int maxDevices) {
     return counts;
 }
 
-std::string g(double v) {
-    char text[48];
-    std::snprintf(text, sizeof text, "%.6g", v);
-    return text;
-}
-
 /// One (rate, device count) over its repeats.
 struct ScalingRow {
     double rateHz = 0;
@@ -107,15 +102,19 @@ struct ScalingRow {
     double loadSumPct = 0;        ///< Sum of the devices' mean loads (% of one core), median.
     double loadPerCorePct = 0;    ///< loadSum / cores (%), median.
     double deviceMeanLoadPct = 0; ///< Mean over devices of their mean load (%), median.
-    double worstP50Pct = 0, worstP999Pct = 0, worstMaxPct = 0; ///< Worst device (%), medians.
+    double worstP50Pct = 0, worstP99Pct = 0, worstP999Pct = 0, worstMaxPct = 0; ///< Worst (%).
     double worstMissedPct = 0; ///< Worst device's missed deadlines (% of ticks), median.
     double lateWakeups = 0;    ///< Late wake-ups over all devices, median.
     int stableRuns = 0;        ///< Repeats in which every device was stable.
     bool realtime = true;      ///< SCHED_FIFO granted to every servo thread.
     int cores = 1;
     std::string note;
-    /// DESIGN.md's verdict on the medians of the worst device. [any thread]
-    bool stable() const { return note.empty() && worstP999Pct < 100.0 && worstMissedPct <= 0.1; }
+    Tail tail = Tail::P999; ///< The percentile the verdict reads.
+    /// DESIGN.md's verdict on the medians of the worst device (p99 for quick runs). [any thread]
+    bool stable() const {
+        return note.empty() && (tail == Tail::P99 ? worstP99Pct : worstP999Pct) < 100.0 &&
+               worstMissedPct <= 0.1;
+    }
 };
 
 struct PerDeviceRow {
@@ -257,6 +256,8 @@ int runDevices(const DevicesArgs& args) {
     servo.durationS = args.common.durationS;
     servo.repeats = args.common.repeats;
     servo.realtime = args.common.realtime;
+    servo.tail = tailFor(args.common.quick);
+    const bool quick = args.common.quick;
 
     std::vector<ScalingRow> rows;
     std::vector<PerDeviceRow> perDevice;
@@ -274,7 +275,8 @@ int runDevices(const DevicesArgs& args) {
             row.rateHz = rate;
             row.devices = d;
             row.repeats = args.common.repeats;
-            std::vector<double> sum, perCore, devMean, w50, w999, wMax, wMissed, late;
+            row.tail = servo.tail;
+            std::vector<double> sum, perCore, devMean, w50, w99, w999, wMax, wMissed, late;
             for (int k = 0; k < args.common.repeats; ++k) {
                 progress.show(std::to_string(d) + " devices at " + rateText(rate));
                 const SessionResult s = runSession(world, hands, servo);
@@ -283,13 +285,14 @@ int runDevices(const DevicesArgs& args) {
                 if (!r.realtimeNote.empty()) {
                     realtimeNote = r.realtimeNote;
                 }
-                double mean = 0, a = 0, b = 0, c = 0, m = 0, l = 0;
+                double mean = 0, a = 0, a99 = 0, b = 0, c = 0, m = 0, l = 0;
                 bool allStable = r.stable;
                 for (std::size_t i = 0; i < r.devices.size(); ++i) {
-                    const LoadFigures f = figuresOf(r.devices[i]);
+                    const LoadFigures f = figuresOf(r.devices[i], servo.tail);
                     perDevice.push_back({rate, d, k, static_cast<int>(i), f});
                     mean += f.meanPct;
                     a = std::max(a, f.p50Pct);
+                    a99 = std::max(a99, f.p99Pct);
                     b = std::max(b, f.p999Pct);
                     c = std::max(c, f.maxPct);
                     m = std::max(m, f.missedPct);
@@ -304,6 +307,7 @@ int runDevices(const DevicesArgs& args) {
                 perCore.push_back(100.0 * r.loadPerCore);
                 devMean.push_back(mean / std::max<std::size_t>(1, r.devices.size()));
                 w50.push_back(a);
+                w99.push_back(a99);
                 w999.push_back(b);
                 wMax.push_back(c);
                 wMissed.push_back(m);
@@ -315,6 +319,7 @@ int runDevices(const DevicesArgs& args) {
             row.loadPerCorePct = median(perCore);
             row.deviceMeanLoadPct = median(devMean);
             row.worstP50Pct = median(w50);
+            row.worstP99Pct = median(w99);
             row.worstP999Pct = median(w999);
             row.worstMaxPct = median(wMax);
             row.worstMissedPct = median(wMissed);
@@ -333,50 +338,84 @@ int runDevices(const DevicesArgs& args) {
         }
     }
 
-    // Files.
-    {
-        std::vector<std::vector<std::string>> csv;
-        for (const ScalingRow& r : rows) {
-            csv.push_back({g(r.rateHz), std::to_string(r.devices), std::to_string(r.repeats),
-                           g(r.loadSumPct), g(r.loadPerCorePct), g(r.deviceMeanLoadPct),
-                           g(r.worstP50Pct), g(r.worstP999Pct), g(r.worstMaxPct),
-                           g(r.worstMissedPct), g(r.lateWakeups), std::to_string(r.stableRuns),
-                           r.stable() ? "1" : "0", r.realtime ? "1" : "0", std::to_string(r.cores),
-                           r.note});
-        }
-        writeCsv(out / "devices.csv",
-                 {"rate_hz", "devices", "repeats", "load_sum_pct", "load_per_core_pct",
-                  "device_load_mean_pct", "worst_load_p50_pct", "worst_load_p999_pct",
-                  "worst_load_max_pct", "worst_missed_pct", "late_wakeups", "stable_runs", "stable",
-                  "realtime", "cores", "note"},
-                 csv);
-        std::vector<std::vector<std::string>> pd;
-        for (const PerDeviceRow& r : perDevice) {
-            pd.push_back({g(r.rateHz), std::to_string(r.devices), std::to_string(r.repeat),
-                          std::to_string(r.device), g(r.f.meanPct), g(r.f.p50Pct), g(r.f.p999Pct),
-                          g(r.f.maxPct), g(r.f.ticks), g(r.f.missed), g(r.f.missedPct),
-                          g(r.f.lateWakeups), g(r.f.contactPct), g(r.f.candidatesMean),
-                          r.f.stable() ? "1" : "0", r.f.fault});
-        }
-        writeCsv(out / "devices-per-device.csv",
-                 {"rate_hz", "devices", "repeat", "device", "load_mean_pct", "load_p50_pct",
-                  "load_p999_pct", "load_max_pct", "ticks", "missed", "missed_pct", "late_wakeups",
-                  "contact_pct", "candidates_mean", "stable", "fault"},
-                 pd);
-        std::vector<std::vector<std::string>> cc;
-        for (const CursorRow& r : cursorRows) {
-            cc.push_back({std::to_string(r.objects), std::to_string(r.perSide),
-                          std::to_string(r.depth), std::to_string(r.leaves), g(r.log8NOverM),
-                          r.strategy, std::to_string(r.locates), std::to_string(r.leafChanges),
-                          g(r.stepsPerLocate()), g(r.stepsPerChange()), g(r.nsPerLocate),
-                          std::to_string(r.mismatches)});
-        }
-        writeCsv(out / "cursor.csv",
-                 {"objects", "per_side", "depth", "leaves", "log8_n_over_m", "strategy", "locates",
-                  "leaf_changes", "steps_per_locate", "steps_per_leaf_change", "ns_per_locate",
-                  "leaf_mismatches"},
-                 cc);
+    // Files: each table declared once, written as CSV and JSON (and markdown below).
+    const auto I = [](auto v) { return Cell(static_cast<std::int64_t>(v)); };
+    Table devicesTable({
+        {"rate_hz", "Hz", -1, "", ColumnIn::Data},
+        {"devices", "", -1, "devices"},
+        {"repeats", "", -1, "", ColumnIn::Data},
+        {"load_sum_pct", "%", 2, "load sum % (one core)"},
+        {"load_per_core_pct", "%", 2, "per core %"},
+        {"device_load_mean_pct", "%", 2, "per device mean %"},
+        {"worst_load_p50_pct", "%", 2, "worst p50 %"},
+        {"worst_load_p99_pct", "%", 1, "worst p99 %", quick ? ColumnIn::All : ColumnIn::Data},
+        {"worst_load_p999_pct", "%", 1, "worst p99.9 %"},
+        {"worst_load_max_pct", "%", 1, "worst max %"},
+        {"worst_missed_pct", "%", 2, "worst missed %"},
+        {"late_wakeups", "", -1, "", ColumnIn::Data},
+        {"stable_runs", "", -1, "", ColumnIn::Data},
+        {"stable", "", -1, "", ColumnIn::Data},
+        {"realtime", "", -1, "", ColumnIn::Data},
+        {"cores", "", -1, "", ColumnIn::Data},
+        {"note", "", -1, "", ColumnIn::Data},
+        {"verdict", "", -1, "verdict", ColumnIn::Markdown},
+    });
+    for (const ScalingRow& r : rows) {
+        devicesTable.add({r.rateHz, I(r.devices), I(r.repeats), r.loadSumPct, r.loadPerCorePct,
+                          r.deviceMeanLoadPct, r.worstP50Pct, r.worstP99Pct, r.worstP999Pct,
+                          r.worstMaxPct, r.worstMissedPct, r.lateWakeups, I(r.stableRuns),
+                          r.stable(), r.realtime, I(r.cores), r.note,
+                          std::string(r.stable() ? "stable" : "UNSTABLE") + " (" +
+                              std::to_string(r.stableRuns) + "/" + std::to_string(r.repeats) +
+                              " runs)"});
     }
+    Table perDeviceTable({
+        {"rate_hz", "Hz"},
+        {"devices", ""},
+        {"repeat", ""},
+        {"device", ""},
+        {"load_mean_pct", "%"},
+        {"load_p50_pct", "%"},
+        {"load_p99_pct", "%"},
+        {"load_p999_pct", "%"},
+        {"load_max_pct", "%"},
+        {"ticks", ""},
+        {"missed", ""},
+        {"missed_pct", "%"},
+        {"late_wakeups", ""},
+        {"contact_pct", "%"},
+        {"candidates_mean", ""},
+        {"stable", ""},
+        {"fault", ""},
+    });
+    for (const PerDeviceRow& r : perDevice) {
+        perDeviceTable.add({r.rateHz, I(r.devices), I(r.repeat), I(r.device), r.f.meanPct,
+                            r.f.p50Pct, r.f.p99Pct, r.f.p999Pct, r.f.maxPct, r.f.ticks, r.f.missed,
+                            r.f.missedPct, r.f.lateWakeups, r.f.contactPct, r.f.candidatesMean,
+                            r.f.stable(), r.f.fault});
+    }
+    Table cursorTable({
+        {"objects", ""},
+        {"per_side", ""},
+        {"depth", ""},
+        {"leaves", ""},
+        {"log8_n_over_m", ""},
+        {"strategy", ""},
+        {"locates", ""},
+        {"leaf_changes", ""},
+        {"steps_per_locate", ""},
+        {"steps_per_leaf_change", ""},
+        {"ns_per_locate", "ns"},
+        {"leaf_mismatches", ""},
+    });
+    for (const CursorRow& r : cursorRows) {
+        cursorTable.add({I(r.objects), I(r.perSide), I(r.depth), I(r.leaves), r.log8NOverM,
+                         r.strategy, I(r.locates), I(r.leafChanges), r.stepsPerLocate(),
+                         r.stepsPerChange(), r.nsPerLocate, I(r.mismatches)});
+    }
+    devicesTable.writeCsv(out / "devices.csv");
+    perDeviceTable.writeCsv(out / "devices-per-device.csv");
+    cursorTable.writeCsv(out / "cursor.csv");
     Json j;
     j["experiment"] = "devices";
     j["machine"] = machineJson();
@@ -390,63 +429,23 @@ int runDevices(const DevicesArgs& args) {
                     {"repeats", args.common.repeats},
                     {"realtime_requested", args.common.realtime},
                     {"quick", args.common.quick},
+                    {"verdict_percentile", tailName(servo.tail)},
                     {"cursor_index", cursorSpec.toString()},
                     {"cursor_objects", args.cursorObjects},
                     {"walk_steps", args.walkSteps}};
     j["realtime_note"] = realtimeNote;
-    Json jd = Json::array();
-    for (const ScalingRow& r : rows) {
-        Json e;
-        e["rate_hz"] = r.rateHz;
-        e["devices"] = r.devices;
-        e["repeats"] = r.repeats;
-        e["load_sum_pct"] = r.loadSumPct;
-        e["load_per_core_pct"] = r.loadPerCorePct;
-        e["device_load_mean_pct"] = r.deviceMeanLoadPct;
-        e["worst_load_p50_pct"] = r.worstP50Pct;
-        e["worst_load_p999_pct"] = r.worstP999Pct;
-        e["worst_load_max_pct"] = r.worstMaxPct;
-        e["worst_missed_pct"] = r.worstMissedPct;
-        e["late_wakeups"] = r.lateWakeups;
-        e["stable_runs"] = r.stableRuns;
-        e["stable"] = r.stable();
-        e["realtime"] = r.realtime;
-        e["cores"] = r.cores;
-        e["note"] = r.note;
+    Json jd = devicesTable.json();
+    for (std::size_t i = 0; i < rows.size(); ++i) {
         Json devs = Json::array();
-        for (const PerDeviceRow& p : perDevice) {
-            if (p.rateHz == r.rateHz && p.devices == r.devices) {
-                devs.push_back({{"repeat", p.repeat},
-                                {"device", p.device},
-                                {"load_mean_pct", p.f.meanPct},
-                                {"load_p50_pct", p.f.p50Pct},
-                                {"load_p999_pct", p.f.p999Pct},
-                                {"load_max_pct", p.f.maxPct},
-                                {"missed", p.f.missed},
-                                {"missed_pct", p.f.missedPct},
-                                {"stable", p.f.stable()}});
+        for (std::size_t k = 0; k < perDevice.size(); ++k) {
+            if (perDevice[k].rateHz == rows[i].rateHz && perDevice[k].devices == rows[i].devices) {
+                devs.push_back(perDeviceTable.json(k));
             }
         }
-        e["per_device"] = devs;
-        jd.push_back(e);
+        jd[i]["per_device"] = devs;
     }
     j["devices"] = jd;
-    Json jc = Json::array();
-    for (const CursorRow& r : cursorRows) {
-        jc.push_back({{"objects", r.objects},
-                      {"per_side", r.perSide},
-                      {"depth", r.depth},
-                      {"leaves", r.leaves},
-                      {"log8_n_over_m", r.log8NOverM},
-                      {"strategy", r.strategy},
-                      {"locates", r.locates},
-                      {"leaf_changes", r.leafChanges},
-                      {"steps_per_locate", r.stepsPerLocate()},
-                      {"steps_per_leaf_change", r.stepsPerChange()},
-                      {"ns_per_locate", r.nsPerLocate},
-                      {"leaf_mismatches", r.mismatches}});
-    }
-    j["cursor"] = jc;
+    j["cursor"] = cursorTable.json();
     writeText(out / "devices.json", j.dump(2) + "\n");
 
     // Plots.
@@ -528,25 +527,10 @@ int runDevices(const DevicesArgs& args) {
                      "Every device has its own servo thread over one shared World. Loads in % "
                      "(wake-up to force written over the period); medians of " +
                      std::to_string(args.common.repeats) + " run(s) of " +
-                     fmt(args.common.durationS, 2) + " s.\n";
+                     fmt(args.common.durationS, 2) + " s. " + verdictNote(servo.tail) + "\n";
     for (const double rate : args.ratesHz) {
-        std::vector<std::vector<std::string>> t;
-        for (const ScalingRow& r : rows) {
-            if (r.rateHz != rate) {
-                continue;
-            }
-            t.push_back({std::to_string(r.devices), fmt(r.loadSumPct, 2), fmt(r.loadPerCorePct, 2),
-                         fmt(r.deviceMeanLoadPct, 2), fmt(r.worstP50Pct, 2), fmt(r.worstP999Pct, 1),
-                         fmt(r.worstMaxPct, 1), fmt(r.worstMissedPct, 2),
-                         std::string(r.stable() ? "stable" : "UNSTABLE") + " (" +
-                             std::to_string(r.stableRuns) + "/" + std::to_string(r.repeats) +
-                             " runs)"});
-        }
         md += "\n### " + rateText(rate) + "\n\n";
-        md += markdownTable({"devices", "load sum % (one core)", "per core %", "per device mean %",
-                             "worst p50 %", "worst p99.9 %", "worst max %", "worst missed %",
-                             "verdict"},
-                            t);
+        md += devicesTable.markdown([&](std::size_t i) { return rows[i].rateHz == rate; });
     }
     if (!realtimeNote.empty()) {
         md += "\nNote: " + realtimeNote + "\n";

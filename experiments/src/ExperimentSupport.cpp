@@ -175,8 +175,20 @@ void requireClear(const Scene& scene, const Vec3& point, double marginM, std::st
 // ---------------------------------------------------------------------------------------------
 // Figures
 
-LoadFigures figuresOf(const DeviceReport& d) {
+std::string_view tailName(Tail tail) {
+    return tail == Tail::P99 ? "p99" : "p99.9";
+}
+
+std::string verdictNote(Tail tail) {
+    return tail == Tail::P99
+               ? "Quick run: verdicts read p99 load, not p99.9 (a run of a few hundred ticks has "
+                 "no p99.9 but its maximum, so one preempted tick would decide it)."
+               : "Verdicts read p99.9 load.";
+}
+
+LoadFigures figuresOf(const DeviceReport& d, Tail tail) {
     LoadFigures f;
+    f.tail = tail;
     const double periodNs = 1e9 / d.rateHz;
     f.meanPct = 100.0 * d.loadFraction.mean;
     f.p50Pct = 100.0 * d.loadFraction.p50;
@@ -231,6 +243,7 @@ LoadFigures medianOf(const std::vector<LoadFigures>& runs) {
         m.*field = med(field);
     }
     m.realtime = std::all_of(runs.begin(), runs.end(), [](auto& r) { return r.realtime; });
+    m.tail = runs.front().tail;
     for (const LoadFigures& r : runs) {
         if (!r.fault.empty()) {
             m.fault = r.fault;
@@ -340,37 +353,6 @@ std::filesystem::path prepareOutDir(const std::string& dir) {
 
 void writeText(const std::filesystem::path& path, const std::string& text) {
     writeFileAtomically(path, text);
-}
-
-namespace {
-
-std::string csvField(const std::string& s) {
-    if (s.find_first_of(",\"\n") == std::string::npos) {
-        return s;
-    }
-    std::string q = "\"";
-    for (const char c : s) {
-        q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    }
-    return q + "\"";
-}
-
-} // namespace
-
-void writeCsv(const std::filesystem::path& path, const std::vector<std::string>& header,
-              const std::vector<std::vector<std::string>>& rows) {
-    std::ostringstream out;
-    const auto line = [&](const std::vector<std::string>& fields) {
-        for (std::size_t i = 0; i < fields.size(); ++i) {
-            out << (i ? "," : "") << csvField(fields[i]);
-        }
-        out << "\n";
-    };
-    line(header);
-    for (const auto& r : rows) {
-        line(r);
-    }
-    writeText(path, out.str());
 }
 
 std::string fmt(double value, int decimals) {

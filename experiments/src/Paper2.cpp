@@ -77,6 +77,7 @@ int runPaper2(const Paper2Args& args) {
     options.servo.durationS = args.common.durationS;
     options.servo.repeats = args.common.repeats;
     options.servo.realtime = args.common.realtime;
+    options.servo.tail = tailFor(args.common.quick);
     options.maxIndexMb = args.maxIndexMb;
     options.verdict = args.verdict;
 

@@ -3,6 +3,7 @@
 #include "hapto/experiments/Sweep.h"
 
 #include "hapto/experiments/Plot.h"
+#include "hapto/experiments/Table.h"
 
 #include "hapto/runtime/World.h"
 
@@ -172,7 +173,8 @@ std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
                                       &planScenes[ci]};
                         for (int k = 0; k < options.servo.repeats; ++k) {
                             const SessionResult s = runSession(*world, {hand}, options.servo);
-                            row.runs.push_back(figuresOf(s.report.devices.at(0)));
+                            row.runs.push_back(
+                                figuresOf(s.report.devices.at(0), options.servo.tail));
                             row.reachedPhase = row.reachedPhase && s.reached.at(0);
                         }
                         row.median = medianOf(row.runs);
@@ -245,128 +247,74 @@ std::vector<SweepLimit> sweepLimits(const std::vector<SweepRenderer>& renderers,
 
 namespace {
 
-const std::vector<std::string>& csvHeader(const std::string& sizeColumn) {
-    static std::map<std::string, std::vector<std::string>> headers;
-    auto& h = headers[sizeColumn];
-    if (h.empty()) {
-        h = {"renderer",
-             "index",
-             "rate_hz",
-             sizeColumn,
-             "objects",
-             "seed",
-             "condition",
-             "script",
-             "repeats",
-             "ticks",
-             "load_mean_pct",
-             "load_p50_pct",
-             "load_p99_pct",
-             "load_p999_pct",
-             "load_max_pct",
-             "tick_p50_ns",
-             "tick_p999_ns",
-             "tick_max_ns",
-             "missed",
-             "missed_pct",
-             "late_wakeups",
-             "contact_pct",
-             "candidates_mean",
-             "locate_steps_mean",
-             "late_p999_us",
-             "late_max_us",
-             "stable",
-             "load_stable",
-             "skipped",
-             "reached_phase",
-             "realtime",
-             "index_build_s",
-             "index_mb",
-             "probe_tick_us",
-             "note"};
-    }
-    return h;
+using Int = std::int64_t;
+
+/// The figures of one run, as columns (the CSV's median columns and the JSON's runs).
+const std::vector<Column> kFigureColumns = {
+    {"ticks", ""},          {"load_mean_pct", "%"},  {"load_p50_pct", "%"},
+    {"load_p99_pct", "%"},  {"load_p999_pct", "%"},  {"load_max_pct", "%"},
+    {"tick_p50_ns", "ns"},  {"tick_p999_ns", "ns"},  {"tick_max_ns", "ns"},
+    {"missed", ""},         {"missed_pct", "%"},     {"late_wakeups", ""},
+    {"contact_pct", "%"},   {"candidates_mean", ""}, {"locate_steps_mean", ""},
+    {"late_p999_us", "us"}, {"late_max_us", "us"},
+};
+
+std::vector<Cell> figureCells(const LoadFigures& m) {
+    return {m.ticks,      m.meanPct,     m.p50Pct,     m.p99Pct,         m.p999Pct,
+            m.maxPct,     m.tickNsP50,   m.tickNsP999, m.tickNsMax,      m.missed,
+            m.missedPct,  m.lateWakeups, m.contactPct, m.candidatesMean, m.locateStepsMean,
+            m.lateP999Us, m.lateMaxUs};
 }
 
-std::string g(double v) {
-    char text[48];
-    std::snprintf(text, sizeof text, "%.6g", v);
-    return text;
+/// The rows as one table: CSV and JSON share its columns.
+Table sweepTable(const std::vector<SweepRow>& rows, const std::string& sizeColumn) {
+    std::vector<Column> columns = {{"renderer", ""},  {"index", ""},   {"rate_hz", "Hz"},
+                                   {sizeColumn, ""},  {"objects", ""}, {"seed", ""},
+                                   {"condition", ""}, {"script", ""},  {"repeats", ""}};
+    columns.insert(columns.end(), kFigureColumns.begin(), kFigureColumns.end());
+    for (const Column& c : std::vector<Column>{{"stable", ""},
+                                               {"load_stable", ""},
+                                               {"skipped", ""},
+                                               {"reached_phase", ""},
+                                               {"realtime", ""},
+                                               {"index_build_s", "s"},
+                                               {"index_mb", "MB"},
+                                               {"probe_tick_us", "us"},
+                                               {"note", ""}}) {
+        columns.push_back(c);
+    }
+    Table table(std::move(columns));
+    for (const SweepRow& r : rows) {
+        std::vector<Cell> cells = {r.renderer,
+                                   r.index,
+                                   r.rateHz,
+                                   Int(r.size),
+                                   Int(r.objects),
+                                   Int(r.seed),
+                                   std::string(conditionName(r.condition)),
+                                   std::string(conditionScript(r.condition)),
+                                   Int(r.runs.size())};
+        for (Cell& c : figureCells(r.median)) {
+            cells.push_back(std::move(c));
+        }
+        for (Cell c :
+             std::vector<Cell>{r.stable(), r.loadStable(), r.skipped, r.reachedPhase,
+                               r.median.realtime, r.buildS, r.indexMb, r.probeTickUs, r.note}) {
+            cells.push_back(std::move(c));
+        }
+        table.add(std::move(cells));
+    }
+    return table;
 }
 
 } // namespace
 
 void writeSweepCsv(const std::filesystem::path& path, const std::vector<SweepRow>& rows,
                    const std::string& sizeColumn) {
-    std::vector<std::vector<std::string>> out;
-    for (const SweepRow& r : rows) {
-        const LoadFigures& m = r.median;
-        out.push_back({r.renderer,
-                       r.index,
-                       g(r.rateHz),
-                       std::to_string(r.size),
-                       std::to_string(r.objects),
-                       std::to_string(r.seed),
-                       std::string(conditionName(r.condition)),
-                       std::string(conditionScript(r.condition)),
-                       std::to_string(r.runs.size()),
-                       g(m.ticks),
-                       g(m.meanPct),
-                       g(m.p50Pct),
-                       g(m.p99Pct),
-                       g(m.p999Pct),
-                       g(m.maxPct),
-                       g(m.tickNsP50),
-                       g(m.tickNsP999),
-                       g(m.tickNsMax),
-                       g(m.missed),
-                       g(m.missedPct),
-                       g(m.lateWakeups),
-                       g(m.contactPct),
-                       g(m.candidatesMean),
-                       g(m.locateStepsMean),
-                       g(m.lateP999Us),
-                       g(m.lateMaxUs),
-                       r.stable() ? "1" : "0",
-                       r.loadStable() ? "1" : "0",
-                       r.skipped ? "1" : "0",
-                       r.reachedPhase ? "1" : "0",
-                       m.realtime ? "1" : "0",
-                       g(r.buildS),
-                       g(r.indexMb),
-                       g(r.probeTickUs),
-                       r.note});
-    }
-    writeCsv(path, csvHeader(sizeColumn), out);
+    sweepTable(rows, sizeColumn).writeCsv(path);
 }
 
 namespace {
-
-Json figuresJson(const LoadFigures& m) {
-    Json j;
-    j["ticks"] = m.ticks;
-    j["load_mean_pct"] = m.meanPct;
-    j["load_p50_pct"] = m.p50Pct;
-    j["load_p99_pct"] = m.p99Pct;
-    j["load_p999_pct"] = m.p999Pct;
-    j["load_max_pct"] = m.maxPct;
-    j["tick_p50_ns"] = m.tickNsP50;
-    j["tick_p999_ns"] = m.tickNsP999;
-    j["tick_max_ns"] = m.tickNsMax;
-    j["missed"] = m.missed;
-    j["missed_pct"] = m.missedPct;
-    j["late_wakeups"] = m.lateWakeups;
-    j["contact_pct"] = m.contactPct;
-    j["candidates_mean"] = m.candidatesMean;
-    j["locate_steps_mean"] = m.locateStepsMean;
-    j["late_p999_us"] = m.lateP999Us;
-    j["late_max_us"] = m.lateMaxUs;
-    j["realtime"] = m.realtime;
-    j["stable"] = m.stable();
-    j["load_stable"] = m.loadStable();
-    j["fault"] = m.fault;
-    return j;
-}
 
 Json optionalJson(const auto& v) {
     return v ? Json(*v) : Json(nullptr);
@@ -377,32 +325,19 @@ Json optionalJson(const auto& v) {
 Json sweepJson(const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
                const std::vector<SweepRow>& rows, Verdict verdict, const std::string& sizeColumn) {
     Json j;
-    Json jr = Json::array();
-    for (const SweepRow& r : rows) {
-        Json e;
-        e["renderer"] = r.renderer;
-        e["index"] = r.index;
-        e["rate_hz"] = r.rateHz;
-        e[sizeColumn] = r.size;
-        e["objects"] = r.objects;
-        e["seed"] = r.seed;
-        e["condition"] = conditionName(r.condition);
-        e["script"] = conditionScript(r.condition);
-        e["stable"] = r.stable();
-        e["load_stable"] = r.loadStable();
-        e["skipped"] = r.skipped;
-        e["reached_phase"] = r.reachedPhase;
-        e["index_build_s"] = r.buildS;
-        e["index_mb"] = r.indexMb;
-        e["probe_tick_us"] = r.probeTickUs;
-        e["note"] = r.note;
-        e["median"] = figuresJson(r.median);
-        Json runs = Json::array();
-        for (const LoadFigures& f : r.runs) {
-            runs.push_back(figuresJson(f));
+    const Table table = sweepTable(rows, sizeColumn);
+    Json jr = table.json();
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        std::vector<Column> columns = kFigureColumns;
+        columns.insert(columns.end(),
+                       {{"realtime", ""}, {"stable", ""}, {"load_stable", ""}, {"fault", ""}});
+        Table runs(std::move(columns));
+        for (const LoadFigures& f : rows[i].runs) {
+            std::vector<Cell> cells = figureCells(f);
+            cells.insert(cells.end(), {f.realtime, f.stable(), f.loadStable(), f.fault});
+            runs.add(std::move(cells));
         }
-        e["runs"] = runs;
-        jr.push_back(e);
+        jr[i]["runs"] = runs.json();
     }
     j["rows"] = jr;
     j["verdict"] = verdictName(verdict);
@@ -476,11 +411,13 @@ std::string limitsTable(const std::vector<SweepRenderer>& renderers,
 std::string platformNote(const std::vector<SweepRow>& rows, Verdict verdict) {
     std::vector<double> late, missed;
     std::size_t measured = 0, fifo = 0, loadOnly = 0;
+    Tail tail = Tail::P999;
     for (const SweepRow& r : rows) {
         if (r.skipped) {
             continue;
         }
         ++measured;
+        tail = r.median.tail;
         fifo += r.median.realtime ? 1 : 0;
         late.push_back(r.median.lateP999Us);
         missed.push_back(r.median.missedPct);
@@ -495,7 +432,8 @@ std::string platformNote(const std::vector<SweepRow>& rows, Verdict verdict) {
            "cells: " +
            fmt(median(late), 0) +
            " us; deadlines missed, median over cells: " + fmt(median(missed), 2) +
-           " %; cells within load but over 0.1 % missed: " + std::to_string(loadOnly) + ".\n";
+           " %; cells within load but over 0.1 % missed: " + std::to_string(loadOnly) + ". " +
+           verdictNote(tail) + "\n";
 }
 
 std::string loadCell(const SweepRow& row) {
@@ -579,6 +517,7 @@ writeSweepFiles(const std::filesystem::path& out, const std::string& name, Json 
     options["quick"] = common.quick;
     options["max_index_mb"] = maxIndexMb;
     options["verdict"] = verdictName(verdict);
+    options["verdict_percentile"] = tailName(tailFor(common.quick));
     Json j;
     j["experiment"] = name;
     j["machine"] = machineJson();

@@ -8,6 +8,7 @@
 #include "SessionChecks.h"
 #include "StopSignals.h"
 #include "hapto/experiments/ExperimentSupport.h"
+#include "hapto/experiments/Table.h"
 
 #include "hapto/devices/DeviceFactory.h"
 #include "hapto/devices/FaultInjectingDevice.h"
@@ -306,10 +307,31 @@ int runSoak(const SoakArgs& a) {
     // Verdicts.
     bool faultsOk = true;
     std::uint64_t ticks = 0, missed = 0;
-    nlohmann::json devices = nlohmann::json::array();
-    std::printf("\n%-8s %10s %9s %18s %14s %8s %8s %7s %9s\n", "device", "ticks", "missed %",
-                "drift ppm/worst/h", "faults exp/seen", "reopens", "down s", "zeroed",
-                "p99.9 load");
+    // One table per device, declared once: printed as markdown, written as the report's JSON.
+    using experiments::Column;
+    using experiments::ColumnIn;
+    using Int = std::int64_t;
+    experiments::Table table({
+        {"name", "", -1, "device"},
+        {"ticks", "", -1, "ticks"},
+        {"missed_deadlines", "", -1, "", ColumnIn::Data},
+        {"missed_pct", "%", 4, "missed %", ColumnIn::Markdown},
+        {"late_wakeups", "", -1, "", ColumnIn::Data},
+        {"zeroed_for_misses", "", -1, "zeroed"},
+        {"drift_ppm", "ppm", 0, "drift ppm"},
+        {"worst_window_drift_ppm", "ppm", 0, "worst window ppm"},
+        {"drift_trend_ppm_per_hour", "ppm/h", 0, "drift trend ppm/h"},
+        {"faults_injected", "", -1, "", ColumnIn::Data},
+        {"faults_expected", "", -1, "faults expected"},
+        {"faults", "", -1, "faults seen"},
+        {"reopens", "", -1, "reopens"},
+        {"down_s", "s", 3, "down s"},
+        {"fault", "", -1, "", ColumnIn::Data},
+        {"load_p999", "", -1, "", ColumnIn::Data},
+        {"load_p999_pct", "%", 2, "p99.9 load %", ColumnIn::Markdown},
+        {"lateness_max_ns", "ns", -1, "", ColumnIn::Data},
+        {"ok", "", -1, "faults handled"},
+    });
     for (std::size_t i = 0; i < r.devices.size(); ++i) {
         const DeviceReport& d = r.devices[i];
         const bool taken = injectors[i]->injected() == tally[i].injected;
@@ -331,35 +353,20 @@ int runSoak(const SoakArgs& a) {
         const double wholeRate =
             static_cast<double>(d.ticks) / std::max(1e-9, r.durationS - d.downS);
         const double wholeDriftPpm = (wholeRate / d.rateHz - 1.0) * 1e6;
-        std::printf("%-8s %10llu %9.4f %+6.0f/%+6.0f/%+5.0f %7llu/%-6llu %8llu %8.3f %7llu "
-                    "%8.2f%%%s\n",
-                    d.name.c_str(), static_cast<unsigned long long>(d.ticks),
-                    100.0 * static_cast<double>(d.missedDeadlines) /
-                        static_cast<double>(std::max<std::uint64_t>(1, d.ticks)),
-                    wholeDriftPpm, worstDrift, driftTrend,
-                    static_cast<unsigned long long>(tally[i].expectedFaults),
-                    static_cast<unsigned long long>(d.faults),
-                    static_cast<unsigned long long>(d.reopens), d.downS,
-                    static_cast<unsigned long long>(d.zeroedForMisses), 100.0 * d.loadFraction.p999,
-                    ok ? "" : "  <- fault handling FAILED");
-        devices.push_back({{"name", d.name},
-                           {"ticks", d.ticks},
-                           {"missed_deadlines", d.missedDeadlines},
-                           {"late_wakeups", d.lateWakeups},
-                           {"zeroed_for_misses", d.zeroedForMisses},
-                           {"drift_ppm", wholeDriftPpm},
-                           {"worst_window_drift_ppm", worstDrift},
-                           {"drift_trend_ppm_per_hour", driftTrend},
-                           {"faults_injected", tally[i].injected},
-                           {"faults_expected", tally[i].expectedFaults},
-                           {"faults", d.faults},
-                           {"reopens", d.reopens},
-                           {"down_s", d.downS},
-                           {"fault", d.fault},
-                           {"load_p999", d.loadFraction.p999},
-                           {"lateness_max_ns", d.latenessNs.max},
-                           {"events", d.events},
-                           {"ok", ok}});
+        table.add({d.name, Int(d.ticks), Int(d.missedDeadlines),
+                   100.0 * static_cast<double>(d.missedDeadlines) /
+                       static_cast<double>(std::max<std::uint64_t>(1, d.ticks)),
+                   Int(d.lateWakeups), Int(d.zeroedForMisses), wholeDriftPpm, worstDrift,
+                   driftTrend, Int(tally[i].injected), Int(tally[i].expectedFaults), Int(d.faults),
+                   Int(d.reopens), d.downS, d.fault, d.loadFraction.p999,
+                   100.0 * d.loadFraction.p999, static_cast<double>(d.latenessNs.max), ok});
+    }
+    std::printf("\n%s", table.markdown().c_str());
+    nlohmann::json devices = nlohmann::json::array();
+    for (std::size_t i = 0; i < r.devices.size(); ++i) {
+        nlohmann::json device = table.json(i);
+        device["events"] = r.devices[i].events;
+        devices.push_back(device);
     }
     // Memory: the median of the last third of the windows against the median of the first
     // third, the very first window left out (allocators and caches warm up in it). Single
