@@ -1,6 +1,7 @@
 #include "hapto/devices/FalconDevice.h"
 
 #include "hapto/core/Clock.h"
+#include "hapto/core/Finite.h"
 #include "hapto/core/Mailbox.h"
 
 #include "hapto/devices/FalconKinematics.h"
@@ -57,20 +58,22 @@ std::string usbError(int rc) {
 
 /// The newest decoded sample, written by the I/O thread.
 struct Sample {
-    double position[3];      ///< Device frame, workspace-centred (m).
-    std::int16_t encoder[3]; ///< Raw encoder counts.
-    std::uint8_t buttons;    ///< Grip buttons.
-    std::uint8_t homedMask;  ///< Homed flags.
-    std::uint64_t sequence;  ///< 1, 2, ... per published sample.
-    std::int64_t timeNs;     ///< steady_clock time of arrival (ns).
+    Vec3 positionM{0.0};        ///< Device frame, workspace-centred (m).
+    std::int16_t encoder[3]{};  ///< Raw encoder counts.
+    std::uint8_t buttons = 0;   ///< Grip buttons.
+    std::uint8_t homedMask = 0; ///< Homed flags.
+    std::uint64_t sequence = 0; ///< 1, 2, ... per published sample.
+    std::int64_t timeNs = 0;    ///< Monotonic time of arrival (ns).
 };
-static_assert(sizeof(Sample) == 48, "Sample is six words");
+static_assert(std::is_trivially_copyable_v<Sample> && sizeof(Sample) == 48,
+              "Sample is six plain words");
 
 /// The newest force, written by the servo (or control) thread.
 struct Command {
-    double forceN[3];    ///< Device frame (N).
-    std::int64_t timeNs; ///< steady_clock time of the write (ns).
+    Vec3 forceN{0.0};        ///< Device frame (N).
+    std::int64_t timeNs = 0; ///< Command-clock time of the write (ns).
 };
+static_assert(std::is_trivially_copyable_v<Command>);
 
 enum class IoState : std::uint8_t { Running, Disconnected, Error };
 
@@ -470,9 +473,7 @@ struct FalconDevice::Impl {
         lastAngles = angles;
         havePose = true;
         Sample s{};
-        s.position[0] = p->x;
-        s.position[1] = p->y;
-        s.position[2] = p->z - falcon::kWorkspaceOriginZ;
+        s.positionM = Vec3(p->x, p->y, p->z - falcon::kWorkspaceOriginZ);
         for (int i = 0; i < 3; ++i) {
             s.encoder[i] = reading->encoder[static_cast<std::size_t>(i)];
         }
@@ -557,8 +558,7 @@ struct FalconDevice::Impl {
         if (!j) {
             return {0, 0, 0};
         }
-        const Vec3 tau = falcon::FalconKinematics::forceToTorque(
-            *j, Vec3(c.forceN[0], c.forceN[1], c.forceN[2]));
+        const Vec3 tau = falcon::FalconKinematics::forceToTorque(*j, c.forceN);
         return falcon::FalconKinematics::torqueToMotorWords(tau, config.motorWordLimit);
     }
 
@@ -831,7 +831,7 @@ DeviceStatus FalconDevice::read(DeviceState& state) {
     Sample s{};
     const bool have = m.samples.read(s);
     if (have) {
-        state.position = Vec3(s.position[0], s.position[1], s.position[2]);
+        state.position = s.positionM;
         state.hasVelocity = false;
         state.buttons = s.buttons;
         state.sequence = s.sequence;
@@ -857,14 +857,14 @@ DeviceStatus FalconDevice::write(const Vec3& forceN) {
         return DeviceStatus::NotOpen;
     }
     Vec3 f = forceN;
-    if (!std::isfinite(f.x) || !std::isfinite(f.y) || !std::isfinite(f.z)) {
+    if (!finite(f)) {
         f = Vec3(0.0);
     }
     const double len = glm::length(f);
     if (len > m.maxForceN) {
         f *= m.maxForceN / len;
     }
-    m.commands.publish(Command{{f.x, f.y, f.z}, m.commandClock()});
+    m.commands.publish(Command{f, m.commandClock()});
     switch (m.ioState.load(std::memory_order_acquire)) {
     case IoState::Running:
         return DeviceStatus::Ok;

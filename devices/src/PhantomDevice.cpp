@@ -26,6 +26,7 @@
 
 #include "hapto/devices/PhantomDevice.h"
 
+#include "hapto/core/Clock.h"
 #include "hapto/core/Finite.h"
 #include "hapto/core/Mailbox.h"
 
@@ -42,9 +43,19 @@ namespace detail {
 
 /// One force command as the servo left it.
 struct PhantomForce {
-    double forceN[3];    ///< Device frame (N).
-    std::int64_t timeNs; ///< When write() published it, on the command clock (ns).
+    Vec3 forceN{0.0};        ///< Device frame (N).
+    std::int64_t timeNs = 0; ///< When write() published it, on the command clock (ns).
 };
+static_assert(std::is_trivially_copyable_v<PhantomForce>);
+
+/// One HD tick's reading as the HD callback left it.
+struct PhantomSample {
+    Vec3 positionM{0.0};       ///< Device frame (m).
+    Vec3 velocityMps{0.0};     ///< Device frame (m/s).
+    std::uint32_t buttons = 0; ///< HD_CURRENT_BUTTONS.
+    std::int64_t ageNs = 0;    ///< When it was taken, counted from the link's origin (ns).
+};
+static_assert(std::is_trivially_copyable_v<PhantomSample>);
 
 /// Everything the HD callback and the servo thread share for one device, aligned so the HD
 /// thread's and the servo thread's hot words sit on separate cache lines.
@@ -56,7 +67,7 @@ struct alignas(64) PhantomLink {
     std::int64_t commandTimeoutNs = 0;            ///< Set before scheduling: max force age (ns).
 
     /// {px, py, pz (m), vx, vy, vz (m/s), buttons, time since origin (ns)}.
-    alignas(64) Mailbox<std::array<double, 8>> sample;
+    alignas(64) Mailbox<PhantomSample> sample;
     /// The newest force and when it was written.
     alignas(64) Mailbox<PhantomForce> force;
 
@@ -69,7 +80,7 @@ struct alignas(64) PhantomLink {
 
     alignas(64) std::atomic<std::uint64_t> staleReads{0}; ///< Servo writes, anyone reads.
     std::uint64_t lastWrites = 0;                         ///< Servo only.
-    std::array<double, 8> lastSample{};                   ///< Servo only.
+    PhantomSample lastSample{};                           ///< Servo only.
 
     /// Back to "just opened": only while the callback is not scheduled. [control]
     void reset() {
@@ -80,7 +91,7 @@ struct alignas(64) PhantomLink {
         faultCode.store(hd::kSuccess);
         faultInternal.store(0);
         ticks.store(0);
-        heldForce = PhantomForce{{0.0, 0.0, 0.0}, 0};
+        heldForce = PhantomForce{};
         staleReads.store(0);
         lastWrites = 0;
         lastSample = {};
@@ -96,12 +107,11 @@ namespace {
 
 using detail::PhantomForce;
 using detail::PhantomLink;
+using detail::PhantomSample;
 
-/// The default command clock: std::chrono::steady_clock (ns since its epoch).
+/// The default command clock: the monotonic clock (core), signed for differences (ns).
 std::int64_t steadyNowNs() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
+    return static_cast<std::int64_t>(monotonicNs());
 }
 constexpr double kMmToM = 1.0e-3;
 constexpr std::chrono::seconds kFirstSampleTimeout{2};
@@ -125,14 +135,16 @@ hd::HDCallbackCode phantomServoCallback(void* userData) {
                       link.faultCode.load(std::memory_order_relaxed) != hd::kSuccess;
     hd::HDdouble force[3] = {0.0, 0.0, 0.0};
     if (!zero) {
-        PhantomForce f;
+        PhantomForce f{};
         std::uint64_t writes = 0;
         if (link.force.read(f, writes) && writes > 0) {
             link.heldForce = f; // else keep the last force: the writer is mid-update
         }
         // A stalled servo leaves its last force behind: apply it only while it is young.
         if (link.commandClock() - link.heldForce.timeNs <= link.commandTimeoutNs) {
-            std::copy(std::begin(link.heldForce.forceN), std::end(link.heldForce.forceN), force);
+            for (int i = 0; i < 3; ++i) {
+                force[i] = link.heldForce.forceN[i];
+            }
         }
     }
     api.setDoublev(hd::kCurrentForce, force);
@@ -147,11 +159,10 @@ hd::HDCallbackCode phantomServoCallback(void* userData) {
     } else {
         const auto age = std::chrono::steady_clock::now() - link.origin;
         link.sample.publish(
-            {position[0] * kMmToM, position[1] * kMmToM, position[2] * kMmToM, velocity[0] * kMmToM,
-             velocity[1] * kMmToM, velocity[2] * kMmToM,
-             static_cast<double>(static_cast<std::uint32_t>(buttons)),
-             static_cast<double>(
-                 std::chrono::duration_cast<std::chrono::nanoseconds>(age).count())});
+            PhantomSample{Vec3(position[0], position[1], position[2]) * kMmToM,
+                          Vec3(velocity[0], velocity[1], velocity[2]) * kMmToM,
+                          static_cast<std::uint32_t>(buttons),
+                          std::chrono::duration_cast<std::chrono::nanoseconds>(age).count()});
     }
     if (zero) {
         link.zeroForceApplied.store(true, std::memory_order_release);
@@ -312,7 +323,7 @@ DeviceStatus PhantomDevice::open() {
     // Wait (bounded) for the first sample so read() right after open() has data.
     const auto deadline = std::chrono::steady_clock::now() + kFirstSampleTimeout;
     for (;;) {
-        std::array<double, 8> s;
+        PhantomSample s{};
         std::uint64_t writes = 0;
         if (const std::uint32_t code = link.faultCode.load(std::memory_order_acquire);
             code != hd::kSuccess) {
@@ -390,7 +401,7 @@ DeviceStatus PhantomDevice::read(DeviceState& state) {
         code != hd::kSuccess) {
         return statusForHdError(code);
     }
-    std::array<double, 8> s;
+    PhantomSample s{};
     std::uint64_t writes = 0;
     if (link.sample.read(s, writes) && writes > 0) {
         if (writes == link.lastWrites) {
@@ -405,21 +416,18 @@ DeviceStatus PhantomDevice::read(DeviceState& state) {
         writes = link.lastWrites;
     }
     const auto now = std::chrono::steady_clock::now() - link.origin;
-    const double ageNs =
-        static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count()) -
-        s[7];
-    if (writes == 0 || ageNs > static_cast<double>(mStaleTimeout.count())) {
+    const std::int64_t ageNs =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(now).count() - s.ageNs;
+    if (writes == 0 || ageNs > mStaleTimeout.count()) {
         return DeviceStatus::Stalled;
     }
-    const Vec3 position(s[0], s[1], s[2]);
-    const Vec3 velocity(s[3], s[4], s[5]);
-    if (!finite(position) || !finite(velocity)) {
+    if (!finite(s.positionM) || !finite(s.velocityMps)) {
         return DeviceStatus::BadData;
     }
-    state.position = position;
-    state.velocity = velocity;
+    state.position = s.positionM;
+    state.velocity = s.velocityMps;
     state.hasVelocity = true;
-    state.buttons = static_cast<std::uint32_t>(s[6]);
+    state.buttons = s.buttons;
     state.sequence = writes;
     return DeviceStatus::Ok;
 }
@@ -434,7 +442,7 @@ DeviceStatus PhantomDevice::write(const Vec3& forceN) {
         return statusForHdError(code);
     }
     if (!finite(forceN)) {
-        link.force.publish(detail::PhantomForce{{0.0, 0.0, 0.0}, mCommandClock()});
+        link.force.publish(detail::PhantomForce{Vec3(0.0), mCommandClock()});
         return DeviceStatus::BadData;
     }
     Vec3 f = forceN;
@@ -442,7 +450,7 @@ DeviceStatus PhantomDevice::write(const Vec3& forceN) {
     if (magnitude > mForceLimitN) {
         f *= mForceLimitN / magnitude; // magnitude > limit >= 0, so no division by zero
     }
-    link.force.publish(detail::PhantomForce{{f.x, f.y, f.z}, mCommandClock()});
+    link.force.publish(detail::PhantomForce{f, mCommandClock()});
     return DeviceStatus::Ok;
 }
 

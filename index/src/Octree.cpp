@@ -295,7 +295,7 @@ void Octree::buildNodes(const Scene& scene) {
                 child[o] = OverlapCell::of(box);
             }
             const OverlapCell whole = OverlapCell::of(nodeBounds(levelBegin + k));
-            Vec3 mid;
+            Vec3 mid(0.0);
             for (int a = 0; a < 3; ++a) {
                 mid[a] = coord(level + 1, 2 * n.cell[a] + 1, a);
             }

@@ -43,7 +43,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
     // n - 1 reaches the scene's upper face, and the index's bounds end exactly there.
     const Aabb& sb = scene.bounds();
     Aabb bounds = sb;
-    Vec3 step;
+    Vec3 step(0.0);
     for (int a = 0; a < 3; ++a) {
         step[a] = (sb.max[a] - sb.min[a]) / n;
         while (sb.min[a] + static_cast<double>(n) * step[a] < sb.max[a]) {

@@ -1,3 +1,4 @@
+#include "hapto/core/Geometry.h"
 #include "hapto/core/Mailbox.h"
 
 #include <catch2/catch.hpp>
@@ -13,21 +14,20 @@ namespace {
 
 /// A payload of several words whose fields all carry the same counter: a torn read shows.
 struct Payload {
-    double a[3]{};
-    double b[3]{};
+    Vec3 a{0.0};
+    Vec3 b{0.0};
     std::uint64_t n = 0;
 };
 static_assert(std::is_trivially_copyable_v<Payload>);
 
 Payload payload(std::uint64_t n) {
     const double d = static_cast<double>(n);
-    return {{d, d + 1, d + 2}, {-d, -d, -d}, n};
+    return {Vec3(d, d + 1, d + 2), Vec3(-d), n};
 }
 
 bool consistent(const Payload& p) {
     const double d = static_cast<double>(p.n);
-    return p.a[0] == d && p.a[1] == d + 1 && p.a[2] == d + 2 && p.b[0] == -d && p.b[1] == -d &&
-           p.b[2] == -d;
+    return p.a == Vec3(d, d + 1, d + 2) && p.b == Vec3(-d);
 }
 
 } // namespace

@@ -97,7 +97,7 @@ FalconConfig noHoming() {
 /// those counts mean.
 struct Pose {
     std::array<std::int16_t, 3> encoders;
-    Vec3 mechPosition;
+    Vec3 mechPosition{0.0};
     Angles angles;
 };
 

@@ -131,7 +131,7 @@ inline std::vector<Vec3> queryPoints(const Scene& scene, std::uint64_t seed, int
     // Lattice points of octree levels 1..6 and grids 5 and 16: faces, edges, corners.
     for (const int div : {2, 4, 8, 16, 32, 64, 5}) {
         for (int i = 0; i < 60; ++i) {
-            Vec3 q;
+            Vec3 q(0.0);
             for (int a = 0; a < 3; ++a) {
                 const bool onPlane = rng.uniform() < 0.7;
                 q[a] = onPlane
@@ -144,7 +144,7 @@ inline std::vector<Vec3> queryPoints(const Scene& scene, std::uint64_t seed, int
     addBoxPoints(b, p);
     // Outside the bounds, in a shell a fifth of their size deep: objects reach out there too.
     for (int i = 0; i < randomCount / 4; ++i) {
-        Vec3 q;
+        Vec3 q(0.0);
         for (int a = 0; a < 3; ++a) {
             q[a] = rng.uniform(b.min[a] - 0.2 * size[a], b.max[a] + 0.2 * size[a]);
         }

@@ -71,7 +71,7 @@ private:
     Aabb mBox;
     HandWalkOptions mOptions;
     Random mRandom;
-    Vec3 mPosition;
+    Vec3 mPosition{0.0};
     Vec3 mVelocity{0.0};
 };
 

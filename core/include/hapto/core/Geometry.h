@@ -5,6 +5,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <limits>
+#include <type_traits>
 
 namespace hapto {
 
@@ -13,6 +14,12 @@ using Vec3 =
 using Quat =
     glm::dquat; ///< A unit quaternion; GLM stores it (x, y, z, w), constructs it (w, x, y, z).
 using Mat3 = glm::dmat3; ///< A 3x3 matrix, column-major (GLM).
+
+// Plain values: they cross threads through Mailbox and SpscRing by memcpy. A default-declared
+// `Vec3 v;` is uninitialised (like a double): write `Vec3 v{0.0}`; `Quat()` is all zeros, not
+// the identity: write `Quat{1, 0, 0, 0}`.
+static_assert(std::is_trivially_copyable_v<Vec3> && std::is_trivially_copyable_v<Quat> &&
+              std::is_trivially_copyable_v<Mat3>);
 
 /// An axis-aligned box [min, max] in metres. An empty box has min > max.
 struct Aabb {

@@ -19,11 +19,8 @@ namespace hapto {
 /// side caches the other's index on its own cache line, so a push touches shared memory only
 /// when the ring looks full.
 template <class T> class SpscRing {
-    // Plain values whose copy never throws, allocates or locks. (glm vectors are not trivially
-    // copyable under GLM_FORCE_CTOR_INIT, nor is their assignment noexcept, so that is not
-    // asked; trivially destructible keeps out strings and vectors.)
-    static_assert(std::is_copy_assignable_v<T> && std::is_trivially_destructible_v<T> &&
-                      std::is_default_constructible_v<T>,
+    // Plain values whose copy never throws, allocates or locks.
+    static_assert(std::is_trivially_copyable_v<T> && std::is_default_constructible_v<T>,
                   "SpscRing holds plain values");
 
 public:

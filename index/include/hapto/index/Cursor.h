@@ -51,8 +51,8 @@ public:
 private:
     void forget() noexcept;
 
-    Vec3 mLo;     // cached leaf box, lower corner (inclusive)
-    Vec3 mHiOpen; // upper corner (exclusive; nudged up on the bounds' faces)
+    Vec3 mLo{0.0};     // cached leaf box, lower corner (inclusive)
+    Vec3 mHiOpen{0.0}; // upper corner (exclusive; nudged up on the bounds' faces)
     const SpatialIndex* mIndex = nullptr;
     std::uint32_t mLeaf = kNoLeaf;
     CursorStrategy mStrategy = CursorStrategy::NeighbourLinks;

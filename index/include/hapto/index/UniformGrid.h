@@ -45,8 +45,8 @@ private:
     }
 
     std::uint32_t mN;
-    Vec3 mStep;
-    Vec3 mInvStep;
+    Vec3 mStep{0.0};
+    Vec3 mInvStep{0.0};
     std::vector<std::uint32_t> mCellStart; // n^3 + 1 offsets into mSlots (CSR)
     std::vector<std::uint32_t> mSlots;
 };
