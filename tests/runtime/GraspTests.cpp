@@ -1,3 +1,7 @@
+// Two-handed grasping on the runtime's step mode: the servo ticks and the control loop take
+// turns on the test's thread, one millisecond of the test's clock at a time, so every run
+// moves the cube along the same path.
+
 #include "ScriptedDevice.h"
 
 #include "hapto/index/Cursor.h"
@@ -8,7 +12,6 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
-#include <thread>
 
 using namespace hapto;
 using test::ScriptedDevice;
@@ -35,9 +38,9 @@ ScriptedDevice::Path keyframes(std::vector<std::pair<std::uint64_t, Vec3>> keys)
 // The grasp scene's cube (id 0) spans x -0.075..-0.025 at y -0.075. A hand on each side:
 // approach (0.3 s), squeeze 2 mm (about 1.6 N each at 800 N/m) until 1.2 s, lift by `lift`
 // (1 s), move by `carry` (2 s), move by `lower` (1 s), then open: each hand moves `open`
-// outwards (0.3 s). Hand speeds stay at or under 5 cm/s, as in the simulated grasp scripts,
-// so the (non real-time) control thread lagging a few milliseconds behind the servo threads
-// moves the object a fraction of a millimetre behind the hands, well within the squeeze.
+// outwards (0.3 s). Hand speeds stay at or under 5 cm/s, as in the simulated grasp scripts:
+// the control loop, one millisecond behind the servo ticks, moves the object a fraction of a
+// millimetre behind the hands, well within the squeeze.
 struct Hands {
     ScriptedDevice::Path left, right;
 };
@@ -57,6 +60,8 @@ Hands graspPaths(Vec3 lift, Vec3 carry, Vec3 lower, double open) {
 }
 
 struct GraspRig {
+    static constexpr std::uint64_t kMs = 1'000'000;
+    ManualClock clock;
     World world;
     std::unique_ptr<Runtime> runtime;
     std::unique_ptr<GraspController> grasp;
@@ -64,6 +69,7 @@ struct GraspRig {
 
     GraspRig(Scene scene, Hands hands)
         : world(std::move(scene), IndexSpec::parse("octree:2:0.005")) {
+        world.useClock(clock);
         world.setRestDelay(std::chrono::milliseconds(50));
         std::vector<RuntimeDevice> rds;
         const char* names[2] = {"left", "right"};
@@ -77,28 +83,28 @@ struct GraspRig {
         }
         RuntimeOptions o;
         o.realtime = false;
-        // These tests are about grasping, not timing: under a sanitizer ticks run late, and
-        // the miss limit (tested in RuntimeTests) would zero the squeeze.
-        o.missLimit = 1'000'000;
         runtime = std::make_unique<Runtime>(world, std::move(rds), o);
         grasp = std::make_unique<GraspController>(world, *runtime, 0, 1);
     }
 
-    // Runs the control loop at ~1 kHz until `ticks` device ticks have passed.
+    // One millisecond: the servo ticks due in it, world upkeep, one control step.
+    void millisecond() {
+        runtime->runUntil(clock.nowNs() + kMs);
+        runtime->maintain();
+        grasp->step(0.001);
+        positions.push_back(object().center);
+    }
+    // Runs until `ticks` device ticks have passed, then lets a falling object land.
     void run(std::uint64_t ticks) {
-        runtime->start();
+        REQUIRE(runtime->startStepped(clock) == 2);
         while (runtime->metrics(0).ticks.load() < ticks && runtime->anyRunning()) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-            runtime->maintain();
-            grasp->step(0.001);
-            positions.push_back(object().center);
+            millisecond();
         }
-        // Let a falling object land.
         for (int i = 0; i < 2000 && grasp->state() == GraspState::Falling; ++i) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-            grasp->step(0.001);
-            positions.push_back(object().center);
+            millisecond();
         }
+        CHECK(runtime->report().devices[0].faults == 0);
+        CHECK(runtime->report().devices[1].faults == 0);
         runtime->stop();
         world.setRestDelay(std::chrono::nanoseconds(0));
         world.settle();
@@ -126,6 +132,12 @@ TEST_CASE("two hands lift, carry and put down the cube; the index then finds it 
     rig.run(5800);
     CHECK(rig.grasp->graspStarts().size() == 1);
     CHECK(rig.grasp->graspEnds().size() == 1); // let go once, after putting it down
+    // Step mode: the same session again moves the cube along the very same path.
+    GraspRig again(makeGraspScene(),
+                   graspPaths(Vec3(0, 0.05, 0), Vec3(0.10, 0, 0), Vec3(0, -0.05, 0), 0.03));
+    again.run(5800);
+    CHECK(again.positions == rig.positions);
+    CHECK(again.grasp->graspStarts() == rig.grasp->graspStarts());
     CHECK(rig.grasp->graspedSteps() > 2500);
     const Vec3 end = rig.object().center;
     CHECK(end.x == Approx(start.x + 0.10).margin(0.004));

@@ -1,3 +1,9 @@
+// The runtime on its threads ([realtime]: the wall clock, real servo threads and a real
+// supervisor). These wait, with a generous bound, for what must eventually happen and assert
+// no counts of ticks or sleeps; the exact counts, the fault rules tick by tick and the world
+// updates are tested on the step mode (SteppedRuntimeTests.cpp), which runs the same tick and
+// the same supervision pass.
+
 #include "ScriptedDevice.h"
 
 #include "hapto/devices/FaultInjectingDevice.h"
@@ -55,36 +61,40 @@ struct Rig {
         runtime = std::make_unique<Runtime>(world, std::move(rds), options);
     }
 
-    // Runs until every device has at least `ticks` reads or `limit` passes.
-    void runFor(std::uint64_t ticks, std::chrono::seconds limit = std::chrono::seconds(30)) {
-        runtime->start();
-        const auto until = std::chrono::steady_clock::now() + limit;
-        while (std::chrono::steady_clock::now() < until) {
+    /// Calls maintain() until `done`, at most 30 s; true if it came.
+    template <class F> bool pump(F done) {
+        const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+        while (!done() && std::chrono::steady_clock::now() < until) {
             runtime->maintain();
-            bool all = true;
-            for (std::size_t i = 0; i < devices.size(); ++i) {
-                all = all && (devices[i]->reads() >= ticks ||
-                              runtime->metrics(i).fault.load() != FaultKind::None);
-            }
-            if (all) {
-                break;
-            }
-            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
         }
-        runtime->stop();
+        return done();
     }
 };
 
 } // namespace
 
-TEST_CASE("D devices tick, feel the cube, and the report agrees with what they saw") {
-    // A sanitizer build under a parallel ctest can stall a thread for tens of ms: a generous
-    // watchdog here, and no reopen, so a real fault shows.
+TEST_CASE("servo threads: D devices tick, feel the cube, and the report agrees with what they "
+          "saw",
+          "[realtime]") {
+    // A sanitizer build can stall a thread for tens of ms: a generous watchdog here, and no
+    // reopen, so a real fault shows.
     RuntimeOptions opt;
     opt.stallTimeoutNs = 250'000'000;
     opt.reopenAfterNs = 0;
     Rig rig(cubeScene(), 4, 2000.0, {}, opt);
-    rig.runFor(3000);
+    rig.runtime->start();
+    // Until each presses 2 mm into the cube and feels it (about 1 N), or faults.
+    REQUIRE(rig.pump([&] {
+        for (std::size_t i = 0; i < 4; ++i) {
+            const DeviceMetrics& m = rig.runtime->metrics(i);
+            if (m.forceN[1].load() < 0.99 && m.fault.load() == FaultKind::None) {
+                return false;
+            }
+        }
+        return true;
+    }));
+    rig.runtime->stop();
     const RunReport r = rig.runtime->report();
     REQUIRE(r.devices.size() == 4);
     for (std::size_t i = 0; i < 4; ++i) {
@@ -92,7 +102,7 @@ TEST_CASE("D devices tick, feel the cube, and the report agrees with what they s
         INFO(d.name << " fault '" << d.fault << "' missed " << d.missedDeadlines << " zeroed "
                     << d.zeroedForMisses);
         CHECK(d.fault.empty());
-        CHECK(d.ticks >= 3000);
+        CHECK(d.ticks > 0);
         CHECK(d.ticks == rig.runtime->metrics(i).ticks.load());
         CHECK(d.ticks <= rig.devices[i]->reads());
         CHECK(rig.devices[i]->writes() >= d.ticks); // every tick wrote, plus the final zero
@@ -101,7 +111,8 @@ TEST_CASE("D devices tick, feel the cube, and the report agrees with what they s
         CHECK(d.loadFraction.p50 <= d.loadFraction.p99);
         CHECK(d.loadFraction.p99 <= d.loadFraction.p999);
         CHECK(d.loadFraction.p999 <= d.loadFraction.max);
-        CHECK(d.contactTicks > d.ticks / 2); // pressing 2 mm into the cube most of the run
+        CHECK(d.contactTicks > 0);
+        CHECK(d.contactTicks <= d.ticks);
         CHECK(d.candidatesMean >= 1.0);
         CHECK(d.rateHz == 2000.0);
         // 2 mm into a 500 N/m cube: about 1 N, never above the 5 N clamp.
@@ -129,7 +140,8 @@ TEST_CASE("D devices tick, feel the cube, and the report agrees with what they s
     }
 }
 
-TEST_CASE("each injected fault zeroes that device and leaves the others running") {
+TEST_CASE("servo threads: each injected fault zeroes that device and leaves the others running",
+          "[realtime]") {
     struct Case {
         Inject inject;
         FaultKind expected;
@@ -150,23 +162,12 @@ TEST_CASE("each injected fault zeroes that device and leaves the others running"
         },
         never);
     rig.runtime->start();
-    // Wait for the fault, then for the healthy devices to go on well past it.
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (rig.runtime->metrics(1).fault.load() == FaultKind::None &&
-           std::chrono::steady_clock::now() < until) {
-        rig.runtime->maintain();
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
+    // Wait for the fault, then for the healthy devices to go on past it.
+    REQUIRE(rig.pump([&] { return rig.runtime->metrics(1).fault.load() != FaultKind::None; }));
     const std::uint64_t ticksAtFault = rig.runtime->metrics(0).ticks.load();
-    while (rig.runtime->metrics(0).ticks.load() < ticksAtFault + 300 &&
-           std::chrono::steady_clock::now() < until) {
-        rig.runtime->maintain();
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
+    REQUIRE(rig.pump([&] { return rig.runtime->metrics(0).ticks.load() > ticksAtFault; }));
     // The faulted thread ends by itself (the stalled one once its read returns).
-    while (rig.runtime->metrics(1).running.load() && std::chrono::steady_clock::now() < until) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
+    REQUIRE(rig.pump([&] { return !rig.runtime->metrics(1).running.load(); }));
     CHECK(rig.runtime->metrics(1).fault.load() == c.expected);
     CHECK_FALSE(rig.runtime->metrics(1).running.load());
     CHECK(glm::length(rig.devices[1]->lastForce()) == 0.0); // zero before the thread ended
@@ -181,7 +182,7 @@ TEST_CASE("each injected fault zeroes that device and leaves the others running"
     CHECK_FALSE(r.devices[1].stable);
     CHECK(r.devices[0].fault.empty());
     CHECK(r.devices[0].faults == 0);
-    CHECK(r.devices[0].ticks >= ticksAtFault + 300);
+    CHECK(r.devices[0].ticks > ticksAtFault);
     for (auto* d : rig.devices) {
         CHECK(glm::length(d->lastForce()) == 0.0);
     }
@@ -210,8 +211,9 @@ bool hasEvent(const DeviceReport& d, const std::string& text) {
 
 } // namespace
 
-TEST_CASE("a device that disconnects and comes back is zeroed at once, reopened and driven again "
-          "while the others go on") {
+TEST_CASE("servo threads: a device that disconnects and comes back is zeroed at once, reopened "
+          "and driven again while the others go on",
+          "[realtime]") {
     RuntimeOptions opt;
     opt.reopenAfterNs = 100'000'000; // try every 100 ms
     Rig rig(
@@ -224,14 +226,7 @@ TEST_CASE("a device that disconnects and comes back is zeroed at once, reopened 
         opt);
     Runtime& runtime = *rig.runtime;
     runtime.start();
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    const auto pump = [&](const std::function<bool()>& done) {
-        while (!done() && std::chrono::steady_clock::now() < until) {
-            runtime.maintain();
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        }
-        return done();
-    };
+    const auto pump = [&](const std::function<bool()>& done) { return rig.pump(done); };
     // Both press into the cube and feel it.
     REQUIRE(pump([&] { return rig.devices[0]->reads() >= 200 && rig.devices[1]->reads() >= 200; }));
     CHECK(glm::length(rig.devices[1]->lastForce()) > 0.0);
@@ -278,70 +273,27 @@ TEST_CASE("a device that disconnects and comes back is zeroed at once, reopened 
     CHECK(j["devices"][1]["events"].size() == back.events.size());
 }
 
-TEST_CASE("a device that fails to open is reported and the others run") {
-    Rig rig(cubeScene(), 2, 1000.0, [](int i, ScriptedDevice& d) {
-        if (i == 0) {
-            d.inject(Inject::OpenFails, 0);
-        }
-    });
-    rig.runFor(300);
-    const RunReport r = rig.runtime->report();
-    CHECK(r.devices[0].fault.find("open-failed") == 0);
-    CHECK(r.devices[0].fault.find("injected open failure") != std::string::npos);
-    CHECK(r.devices[0].ticks == 0);
-    CHECK(r.devices[1].ticks >= 300);
-    CHECK_FALSE(r.stable);
-}
-
-TEST_CASE("after K missed deadlines in a row the device gets zero force until it catches up") {
-    RuntimeOptions opt;
-    opt.missLimit = 2;
-    // Every tick from 100 on takes 3 periods: every one misses its deadline.
-    Rig rig(
-        cubeScene(), 1, 1000.0,
-        [](int, ScriptedDevice& d) { d.inject(Inject::SlowTicks, 100, 3'000'000); }, opt);
-    rig.runtime->start();
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    // Wait well into the slow ticks: a loaded machine (sanitizers) can miss K in a row before
-    // them too, and those ticks go back to force once they catch up.
-    while ((rig.devices[0]->reads() < 110 || rig.runtime->metrics(0).zeroedForMisses.load() < 5) &&
-           std::chrono::steady_clock::now() < until) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-    // While every tick misses, the force sent is zero.
-    CHECK(rig.runtime->metrics(0).zeroedForMisses.load() >= 5);
-    CHECK(glm::length(rig.devices[0]->lastForce()) == 0.0);
-    rig.runtime->stop();
-    const RunReport r = rig.runtime->report();
-    CHECK(r.devices[0].missedDeadlines >= 5);
-    CHECK_FALSE(r.devices[0].stable);
-}
-
-TEST_CASE("servo threads pick up a new snapshot at their next tick") {
+TEST_CASE("servo threads pick up a new snapshot at their next tick", "[realtime]") {
     Rig rig(cubeScene(), 2, 1000.0);
     rig.runtime->start();
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    REQUIRE(rig.pump([&] {
+        return rig.runtime->metrics(0).ticks.load() > 0 && rig.runtime->metrics(1).ticks.load() > 0;
+    }));
     rig.world.moveObject(7, Vec3(0, 0.001, 0), Quat(1, 0, 0, 0));
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while ((rig.runtime->metrics(0).snapshotsSeen.load() == 0 ||
-            rig.runtime->metrics(1).snapshotsSeen.load() == 0) &&
-           std::chrono::steady_clock::now() < until) {
-        rig.runtime->maintain();
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    CHECK(rig.runtime->metrics(0).snapshotsSeen.load() >= 1);
-    CHECK(rig.runtime->metrics(1).snapshotsSeen.load() >= 1);
+    CHECK(rig.pump([&] {
+        return rig.runtime->metrics(0).snapshotsSeen.load() >= 1 &&
+               rig.runtime->metrics(1).snapshotsSeen.load() >= 1;
+    }));
     rig.runtime->stop();
 }
 
-TEST_CASE("a publisher flooding snapshot updates never stops or faults a servo thread") {
+TEST_CASE("servo threads: a publisher flooding snapshot updates never stops or faults a servo "
+          "thread",
+          "[realtime]") {
     Rig rig(cubeScene(), 3, 2000.0);
     rig.world.setRestDelay(std::chrono::milliseconds(2)); // re-index often, too
     rig.runtime->start();
-    const std::uint64_t before = rig.runtime->metrics(0).ticks.load();
-    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(800);
-    int published = 0;
-    while (std::chrono::steady_clock::now() < until) {
+    for (int published = 0; published < 2000; ++published) {
         // As fast as the control thread can: a move, and now and then an add and a remove.
         rig.world.moveObject(7, Vec3(0, 1e-6 * (published % 100), 0), Quat(1, 0, 0, 0));
         if (published % 50 == 0) {
@@ -351,19 +303,23 @@ TEST_CASE("a publisher flooding snapshot updates never stops or faults a servo t
             rig.world.removeObject(1000 + published - 25);
         }
         rig.runtime->maintain();
-        ++published;
     }
+    // Every servo picks up the newest snapshot.
+    CHECK(rig.pump([&] {
+        for (std::size_t i = 0; i < 3; ++i) {
+            if (rig.runtime->metrics(i).snapshotsSeen.load() == 0) {
+                return false;
+            }
+        }
+        return true;
+    }));
     rig.runtime->stop();
     rig.world.settle();
-    INFO("published " << published);
-    CHECK(published > 1000);
     const RunReport r = rig.runtime->report();
     for (const DeviceReport& d : r.devices) {
         CHECK(d.fault.empty());
-        CHECK(d.snapshotsSeen > 100); // they kept up with the stream
     }
-    CHECK(rig.runtime->metrics(0).ticks.load() > before + 800); // ~1600 nominal at 2 kHz
-    CHECK(rig.world.retiredCount() == 0);                       // every old snapshot was freed
+    CHECK(rig.world.retiredCount() == 0); // every old snapshot was freed
     for (auto* d : rig.devices) {
         CHECK(glm::length(d->lastForce()) == 0.0);
     }

@@ -1,15 +1,19 @@
 #pragma once
 /// A test device: follows a position function of the tick, records every force written, and
-/// injects faults on request.
+/// injects faults on request. Given a ManualClock (useClock), time it "takes" (a stall, a slow
+/// tick, an absence) moves that clock on instead of sleeping: the runtime's step mode.
 
 #include "hapto/devices/Device.h"
+#include "hapto/runtime/ManualClock.h"
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 namespace hapto::test {
 
@@ -25,11 +29,26 @@ public:
     /// Replaces the position function (before start). [control]
     void setPath(Path path) { mPath = std::move(path); }
 
-    void inject(Inject what, std::uint64_t fromTick, std::uint64_t slowNs = 0) {
+    /// Injects `what` from read `fromTick` on (SlowTicks: each read takes slowNs, up to read
+    /// `untilTick`; Stall: read `fromTick` takes 300 ms). [control]
+    void inject(Inject what, std::uint64_t fromTick, std::uint64_t slowNs = 0,
+                std::uint64_t untilTick = ~0ull) {
         mInject = what;
         mFromTick = fromTick;
         mSlowNs = slowNs;
+        mUntilTick = untilTick;
     }
+    /// Step mode: stalls and slow ticks advance `clock` instead of sleeping, and forces are
+    /// kept as a history (forces()). [control]
+    void useClock(ManualClock* clock) { mClock = clock; }
+    /// Step mode: from read `fromRead` on the device is unplugged (reads and opens say
+    /// Disconnected) until the clock reaches `backAtNs`. [control]
+    void goAway(std::uint64_t fromRead, std::uint64_t backAtNs) {
+        mAwayFrom = fromRead;
+        mBackAtNs = backAtNs;
+    }
+    /// Step mode: every open() takes `ns` of the clock. [control]
+    void setOpenTakes(std::uint64_t ns) { mOpenNs = ns; }
 
     std::string_view name() const override { return mName; }
     std::string_view kind() const override { return "scripted"; }
@@ -40,6 +59,13 @@ public:
         if (mInject == Inject::OpenFails) {
             return DeviceStatus::Error;
         }
+        if (mClock) {
+            mClock->advance(mOpenNs);
+            if (gone()) {
+                return DeviceStatus::Disconnected;
+            }
+        }
+        ++mOpens;
         mOpen = true;
         return DeviceStatus::Ok;
     }
@@ -50,9 +76,12 @@ public:
         mOpen = false;
         mClosed = true;
     }
-    DeviceStatus read(DeviceState& s) override {
+    DeviceStatus read(DeviceState& s) noexcept override {
         const std::uint64_t t = mReads.load(std::memory_order_relaxed);
         mReads.store(t + 1, std::memory_order_relaxed);
+        if (mClock && t >= mAwayFrom && gone()) {
+            return DeviceStatus::Disconnected;
+        }
         if (t >= mFromTick) {
             switch (mInject) {
             case Inject::ReadError:
@@ -64,11 +93,13 @@ public:
                 return DeviceStatus::Ok;
             case Inject::Stall:
                 if (t == mFromTick) {
-                    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+                    pass(300'000'000);
                 }
                 break;
             case Inject::SlowTicks:
-                std::this_thread::sleep_for(std::chrono::nanoseconds(mSlowNs));
+                if (t < mUntilTick) {
+                    pass(mSlowNs);
+                }
                 break;
             default:
                 break;
@@ -79,7 +110,7 @@ public:
         s.sequence = t;
         return DeviceStatus::Ok;
     }
-    DeviceStatus write(const Vec3& f) override {
+    DeviceStatus write(const Vec3& f) noexcept override {
         recordForce(f);
         return DeviceStatus::Ok;
     }
@@ -88,6 +119,16 @@ public:
     }
 
     std::uint64_t reads() const { return mReads.load(); }
+    std::uint64_t opens() const { return mOpens; }
+    /// Step mode: every force written, with the read count when it was written. [control]
+    struct Written {
+        std::uint64_t reads;
+        Vec3 force;
+    };
+    std::vector<Written> forces() const {
+        std::lock_guard lock(mHistoryMutex);
+        return mHistory;
+    }
     std::uint64_t writes() const { return mWrites.load(); }
     Vec3 lastForce() const { return {mLast[0].load(), mLast[1].load(), mLast[2].load()}; }
     double maxForceSeen() const { return mMaxForce.load(); }
@@ -98,10 +139,24 @@ public:
     bool closed() const { return mClosed; }
 
 private:
+    bool gone() const { return mClock && mAwayFrom != ~0ull && mClock->nowNs() < mBackAtNs; }
+    void pass(std::uint64_t ns) {
+        if (mClock) {
+            mClock->advance(ns);
+        } else {
+            std::this_thread::sleep_for(std::chrono::nanoseconds(ns));
+        }
+    }
     void recordForce(const Vec3& f) {
-        const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                     std::chrono::steady_clock::now().time_since_epoch())
-                                     .count();
+        const std::int64_t now =
+            mClock ? static_cast<std::int64_t>(mClock->nowNs())
+                   : std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::steady_clock::now().time_since_epoch())
+                         .count();
+        if (mClock) {
+            std::lock_guard lock(mHistoryMutex);
+            mHistory.push_back({mReads.load(), f});
+        }
         const auto last = mLastWriteNs.exchange(now);
         if (last != 0 && now - last > 20'000'000 && mForceAfterGap.load() < 0) {
             mForceAfterGap.store(glm::length(f));
@@ -119,7 +174,11 @@ private:
     std::string mName;
     Path mPath;
     Inject mInject = Inject::Nothing;
-    std::uint64_t mFromTick = 0, mSlowNs = 0;
+    std::uint64_t mFromTick = 0, mSlowNs = 0, mUntilTick = ~0ull;
+    ManualClock* mClock = nullptr;
+    std::uint64_t mAwayFrom = ~0ull, mBackAtNs = 0, mOpenNs = 0, mOpens = 0;
+    mutable std::mutex mHistoryMutex;
+    std::vector<Written> mHistory;
     std::atomic<std::uint64_t> mReads{0}, mWrites{0};
     std::atomic<double> mLast[3]{};
     std::atomic<double> mMaxForce{0};

@@ -1,6 +1,7 @@
 // A servo thread starved by a CPU hog: a SCHED_FIFO thread of higher priority spinning on the
 // servo thread's core. Needs SCHED_FIFO (root or CAP_SYS_NICE) and two cores; its own binary
-// so ctest runs it alone (the hog stalls everything else on that core).
+// so ctest runs it alone (the hog stalls everything else on that core). [realtime]: the same
+// scenario, tick by tick, is in SteppedRuntimeTests ("a device whose thread cannot run").
 
 #include "ScriptedDevice.h"
 
@@ -42,7 +43,8 @@ std::string becomeHog(int cpu, int priority) {
 } // namespace
 
 TEST_CASE("a servo thread starved by a CPU hog gets zero force when it runs again, is reported "
-          "and reopened, and the device on the other core is not disturbed") {
+          "and reopened, and the device on the other core is not disturbed",
+          "[realtime]") {
     REQUIRE(std::thread::hardware_concurrency() >= 2);
     Material m;
     m.stiffness = 500.0;

@@ -52,7 +52,7 @@ public:
         mWaiting.store(false);
         return ScriptedDevice::open();
     }
-    DeviceStatus read(DeviceState& s) override {
+    DeviceStatus read(DeviceState& s) noexcept override {
         mAllReads.fetch_add(1);
         return ScriptedDevice::read(s);
     }

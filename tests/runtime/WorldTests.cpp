@@ -1,4 +1,5 @@
 #include "hapto/index/Cursor.h"
+#include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/World.h"
 #include "hapto/scenes/Generators.h"
 
@@ -146,4 +147,34 @@ TEST_CASE("8 servo-like threads read while the control thread publishes: version
     CHECK(world.retiredCount() == 0);
     CHECK(world.current().moving.empty());
     CHECK(world.current().scene->size() == 300 + 15 - 6);
+}
+
+TEST_CASE("on a ManualClock an object goes back into the index exactly one rest delay after its "
+          "last move, built inline by maintain()") {
+    ManualClock clock;
+    World world(twoBoxes(), IndexSpec::parse("octree:1:0.005"));
+    world.useClock(clock);
+    world.setRestDelay(std::chrono::milliseconds(100));
+    const std::uint32_t slot = *world.current().scene->slotOf(10);
+    world.moveObject(10, Vec3(-0.05, -0.09, 0), Quat(1, 0, 0, 0));
+    clock.advance(60'000'000);
+    world.moveObject(10, Vec3(-0.05, -0.08, 0), Quat(1, 0, 0, 0)); // moved again at 60 ms
+    clock.advance(99'999'999);
+    world.maintain();
+    CHECK(world.isMoving(10)); // 1 ns short of resting
+    CHECK(world.buildsPublished() == 1);
+    clock.advance(1);
+    world.maintain(); // rested: built and published in this call
+    CHECK_FALSE(world.isMoving(10));
+    CHECK(world.buildsPublished() == 2);
+    const WorldSnapshot& s = world.current();
+    CHECK(s.moving.empty());
+    CHECK(candidatesHold(*s.index, Vec3(-0.05, -0.08, 0), slot));
+
+    // A removal is published by the next maintain(), whatever the clock.
+    world.removeObject(20);
+    CHECK(world.current().scene->slotOf(20).has_value());
+    world.maintain();
+    CHECK_FALSE(world.current().scene->slotOf(20).has_value());
+    CHECK(world.buildsPublished() == 3);
 }

@@ -1,0 +1,140 @@
+// HapticTick, the one haptic tick: locate, candidates, render, effects, safety.
+
+#include "hapto/runtime/HapticTick.h"
+#include "hapto/scenes/Generators.h"
+
+#include <catch2/catch.hpp>
+
+using namespace hapto;
+
+namespace {
+
+Scene boxScene(double stiffness) {
+    Material m;
+    m.stiffness = stiffness;
+    return Scene(Aabb{Vec3(-0.125), Vec3(0.125)},
+                 {makeBox(7, Vec3(0), Vec3(0.025), Quat(1, 0, 0, 0), m)});
+}
+
+/// Moves the device from 1 cm above the top face straight down to `depth` below it in 50
+/// ticks of 1 ms, then holds it there for 50 more; returns the last tick's output.
+TickOutput pressTo(HapticTick& tick, const WorldSnapshot& s, double depth, double x = 0.0) {
+    TickOutput out;
+    for (int i = 0; i <= 100; ++i) {
+        const double u = std::min(1.0, i / 50.0);
+        const Vec3 p(x, 0.025 + 0.01 - u * (0.01 + depth), 0.0);
+        out = tick.tick(s, p, Vec3(0.0), 1e-3, Vec3(0.0));
+    }
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("pressing d into a box face of stiffness k gives k d along the face normal, before the "
+          "safety filter") {
+    const double k = GENERATE(200.0, 800.0, 2000.0);
+    const double d = GENERATE(0.0005, 0.002);
+    INFO("k " << k << " d " << d);
+    World world(boxScene(k), IndexSpec::parse("octree:2:0.005"));
+    HapticTick tick;
+    const TickOutput out = pressTo(tick, world.current(), d);
+    const double expected = k * (d + GodObjectRenderer::kSkinM);
+    CHECK(out.render.contactCount == 1);
+    CHECK(out.render.contacts[0].id == 7);
+    CHECK(out.render.contacts[0].normal == Vec3(0, 1, 0));
+    CHECK(out.render.force.x == Approx(0.0).margin(1e-12));
+    CHECK(out.render.force.y == Approx(expected).epsilon(1e-9));
+    CHECK(out.render.force.z == Approx(0.0).margin(1e-12));
+    CHECK(out.render.proxy.y == Approx(0.025 + GodObjectRenderer::kSkinM).epsilon(1e-12));
+    // Below the 8.5 N default clamp the safety filter passes it as it is.
+    CHECK(out.forceN == out.render.force);
+    CHECK_FALSE(out.outside);
+}
+
+TEST_CASE("a force above the device's limit is clamped by the safety filter, not in the render "
+          "output") {
+    World world(boxScene(5000.0), IndexSpec::parse("octree:2:0.005"));
+    SafetyConfig safety;
+    safety.maxForceN = 3.0;
+    HapticTick tick({}, safety);
+    const TickOutput out = pressTo(tick, world.current(), 0.002);
+    CHECK(out.render.force.y == Approx(5000.0 * (0.002 + GodObjectRenderer::kSkinM)));
+    CHECK(out.forceN.y == Approx(3.0).epsilon(1e-12));
+    CHECK(tick.safety().counters().clamped > 0);
+}
+
+TEST_CASE("in free space the force is zero and the proxy is the device point") {
+    World world(boxScene(800.0), IndexSpec::parse("grid:4"));
+    HapticTick tick;
+    for (const Vec3& p : {Vec3(0.05, 0.05, 0.05), Vec3(-0.1, 0.0, 0.02), Vec3(0.0, 0.03, 0.0)}) {
+        const TickOutput out = tick.tick(world.current(), p, Vec3(0.0), 1e-3, Vec3(0.0));
+        CHECK(out.render.force == Vec3(0.0));
+        CHECK(out.forceN == Vec3(0.0));
+        CHECK(out.render.proxy == p);
+        CHECK(out.render.contactCount == 0);
+    }
+    // Outside the index's bounds: still rendered (nothing reaches out there), and said.
+    const TickOutput out = tick.tick(world.current(), Vec3(0.3, 0, 0), Vec3(0.0), 1e-3, Vec3(0.0));
+    CHECK(out.outside);
+    CHECK(out.forceN == Vec3(0.0));
+}
+
+TEST_CASE("the external force is added before the safety filter: clamped and rate-limited") {
+    World world(boxScene(800.0), IndexSpec::parse("octree:2:0.005"));
+    HapticTick tick; // 8.5 N at most, 1 N per tick at most
+    const Vec3 p(0.05, 0.05, 0.05);
+    for (int i = 1; i <= 12; ++i) {
+        const TickOutput out = tick.tick(world.current(), p, Vec3(0.0), 1e-3, Vec3(0, -20.0, 0));
+        CHECK(out.render.force == Vec3(0.0));
+        CHECK(out.forceN.y == Approx(-std::min(8.5, 1.0 * i)).epsilon(1e-12));
+    }
+}
+
+TEST_CASE("reset() starts afresh and zeroForce() makes the force grow from zero again") {
+    World world(boxScene(800.0), IndexSpec::parse("octree:2:0.005"));
+    HapticTick tick;
+    TickOutput out = pressTo(tick, world.current(), 0.002);
+    const double held = 800.0 * (0.002 + GodObjectRenderer::kSkinM);
+    REQUIRE(out.forceN.y == Approx(held));
+
+    SECTION("zeroForce: the next force is at most one rate-limit step") {
+        tick.zeroForce();
+        out = tick.tick(world.current(), Vec3(0, 0.023, 0), Vec3(0.0), 1e-3, Vec3(0.0));
+        CHECK(out.render.force.y == Approx(held)); // the proxy stayed
+        CHECK(out.forceN.y == Approx(1.0).epsilon(1e-12));
+    }
+    SECTION("reset: the proxy starts on the device point, which is inside the box, so the box "
+            "is ignored until the proxy has left it") {
+        tick.reset();
+        out = tick.tick(world.current(), Vec3(0, 0.023, 0), Vec3(0.0), 1e-3, Vec3(0.0));
+        CHECK(out.render.proxy == Vec3(0, 0.023, 0));
+        CHECK(out.forceN == Vec3(0.0));
+        CHECK_FALSE(out.newSnapshot); // a fresh start is not a new snapshot
+    }
+}
+
+TEST_CASE("a new snapshot re-binds the cursors and is reported once; moving objects are "
+          "candidates") {
+    World world(boxScene(800.0), IndexSpec::parse("octree:2:0.005"));
+    HapticTick tick;
+    const Vec3 p(0.06, 0.023, 0.0);
+    TickOutput out = tick.tick(world.current(), p, Vec3(0.0), 1e-3, Vec3(0.0));
+    CHECK_FALSE(out.newSnapshot); // the first tick binds
+    out = tick.tick(world.current(), p, Vec3(0.0), 1e-3, Vec3(0.0));
+    CHECK_FALSE(out.newSnapshot);
+
+    // An object added around the proxy's path is not in the index yet: only the snapshot's
+    // moving list names it, and the tick tests it.
+    Material m;
+    m.stiffness = 800.0;
+    world.addObject(makeBox(8, Vec3(0.06, 0, 0), Vec3(0.02), Quat(1, 0, 0, 0), m));
+    REQUIRE(world.current().moving.size() == 1);
+    out = tick.tick(world.current(), Vec3(0.06, 0.03, 0.0), Vec3(0.0), 1e-3, Vec3(0.0));
+    CHECK(out.newSnapshot);
+    CHECK(out.render.contactCount == 0);
+    out = tick.tick(world.current(), Vec3(0.06, 0.019, 0.0), Vec3(0.0), 1e-3, Vec3(0.0));
+    CHECK_FALSE(out.newSnapshot);
+    CHECK(out.render.contactCount == 1);
+    CHECK(out.render.contacts[0].id == 8);
+    CHECK(out.render.force.y == Approx(800.0 * (0.001 + GodObjectRenderer::kSkinM)));
+}
