@@ -822,7 +822,7 @@ void FalconDevice::close() {
     }
 }
 
-DeviceStatus FalconDevice::read(DeviceState& state) {
+DeviceStatus FalconDevice::read(DeviceState& state) noexcept {
     Impl& m = *mImpl;
     if (!m.open.load(std::memory_order_acquire)) {
         return DeviceStatus::NotOpen;
@@ -851,7 +851,7 @@ DeviceStatus FalconDevice::read(DeviceState& state) {
     return DeviceStatus::Ok;
 }
 
-DeviceStatus FalconDevice::write(const Vec3& forceN) {
+DeviceStatus FalconDevice::write(const Vec3& forceN) noexcept {
     Impl& m = *mImpl;
     if (!m.open.load(std::memory_order_acquire)) {
         return DeviceStatus::NotOpen;

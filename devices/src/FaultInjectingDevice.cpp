@@ -40,7 +40,7 @@ DeviceStatus FaultInjectingDevice::open() {
     return mInner->open();
 }
 
-DeviceStatus FaultInjectingDevice::read(DeviceState& state) {
+DeviceStatus FaultInjectingDevice::read(DeviceState& state) noexcept {
     const InjectedFault fault = mArmed.exchange(InjectedFault::None, std::memory_order_acq_rel);
     if (fault == InjectedFault::None) {
         return mInner->read(state);
@@ -72,7 +72,7 @@ DeviceStatus FaultInjectingDevice::read(DeviceState& state) {
     return mInner->read(state);
 }
 
-DeviceStatus FaultInjectingDevice::write(const Vec3& forceN) {
+DeviceStatus FaultInjectingDevice::write(const Vec3& forceN) noexcept {
     if (mAwaitingWrite.exchange(false, std::memory_order_relaxed)) {
         mForceAfter.store(
             std::sqrt(forceN.x * forceN.x + forceN.y * forceN.y + forceN.z * forceN.z),

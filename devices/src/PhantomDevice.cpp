@@ -392,7 +392,7 @@ void PhantomDevice::close() {
     }
 }
 
-DeviceStatus PhantomDevice::read(DeviceState& state) {
+DeviceStatus PhantomDevice::read(DeviceState& state) noexcept {
     if (!mOpen.load(std::memory_order_acquire)) {
         return DeviceStatus::NotOpen;
     }
@@ -432,7 +432,7 @@ DeviceStatus PhantomDevice::read(DeviceState& state) {
     return DeviceStatus::Ok;
 }
 
-DeviceStatus PhantomDevice::write(const Vec3& forceN) {
+DeviceStatus PhantomDevice::write(const Vec3& forceN) noexcept {
     if (!mOpen.load(std::memory_order_acquire)) {
         return DeviceStatus::NotOpen;
     }

@@ -67,7 +67,7 @@ void ReplayDevice::close() {
     mOpen = false;
 }
 
-DeviceStatus ReplayDevice::read(DeviceState& state) {
+DeviceStatus ReplayDevice::read(DeviceState& state) noexcept {
     if (!mOpen) {
         return DeviceStatus::NotOpen;
     }
@@ -115,7 +115,7 @@ void useTraceRates(std::span<DeviceConfig> configs) {
     }
 }
 
-DeviceStatus ReplayDevice::write(const Vec3& forceN) {
+DeviceStatus ReplayDevice::write(const Vec3& forceN) noexcept {
     if (!mOpen) {
         return DeviceStatus::NotOpen;
     }

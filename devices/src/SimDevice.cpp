@@ -83,7 +83,7 @@ void SimDevice::close() {
     mOpen = false;
 }
 
-DeviceStatus SimDevice::read(DeviceState& state) {
+DeviceStatus SimDevice::read(DeviceState& state) noexcept {
     if (!mOpen) {
         return DeviceStatus::NotOpen;
     }
@@ -104,7 +104,7 @@ DeviceStatus SimDevice::read(DeviceState& state) {
     return DeviceStatus::Ok;
 }
 
-DeviceStatus SimDevice::write(const Vec3& forceN) {
+DeviceStatus SimDevice::write(const Vec3& forceN) noexcept {
     if (!mOpen) {
         return DeviceStatus::NotOpen;
     }

@@ -61,7 +61,7 @@ DeviceStatus WarmedSimDevice::open() {
     return st;
 }
 
-DeviceStatus WarmedSimDevice::read(DeviceState& state) {
+DeviceStatus WarmedSimDevice::read(DeviceState& state) noexcept {
     const DeviceStatus st = mSim.read(state);
     if (mPrimePending && st == DeviceStatus::Ok) {
         state.position = mPrimeDevice;

@@ -62,9 +62,9 @@ public:
     virtual void close() = 0;
 
     /// Reads the newest sample. [servo]
-    virtual DeviceStatus read(DeviceState& state) = 0;
+    virtual DeviceStatus read(DeviceState& state) noexcept = 0;
     /// Commands a force (N), device frame. [servo]
-    virtual DeviceStatus write(const Vec3& forceN) = 0;
+    virtual DeviceStatus write(const Vec3& forceN) noexcept = 0;
 
     /// What went wrong last, for people. [control]
     virtual std::string errorMessage() const = 0;

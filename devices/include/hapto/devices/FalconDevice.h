@@ -92,10 +92,10 @@ public:
 
     /// Copies the newest sample: Ok, Stalled (older than the stale timeout), BadData (only
     /// undecodable data lately), Disconnected or NotOpen. Never blocks. [servo]
-    DeviceStatus read(DeviceState& state) override;
+    DeviceStatus read(DeviceState& state) noexcept override;
     /// Publishes the force (N, device frame) for the next packet; clamped to the max force,
     /// non-finite -> zero. Never blocks. [servo]
-    DeviceStatus write(const Vec3& forceN) override;
+    DeviceStatus write(const Vec3& forceN) noexcept override;
 
     /// What went wrong last, for people. [control]
     std::string errorMessage() const override;

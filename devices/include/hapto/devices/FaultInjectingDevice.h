@@ -48,8 +48,8 @@ public:
     DeviceCapabilities capabilities() const override { return mInner->capabilities(); }
     DeviceStatus open() override;
     void close() override { mInner->close(); }
-    DeviceStatus read(DeviceState& state) override;
-    DeviceStatus write(const Vec3& forceN) override;
+    DeviceStatus read(DeviceState& state) noexcept override;
+    DeviceStatus write(const Vec3& forceN) noexcept override;
     std::string errorMessage() const override;
 
 private:

@@ -106,11 +106,11 @@ public:
 
     /// The newest HD sample (m, m/s, buttons). Stalled when it is older than the stale timeout;
     /// Disconnected / Error after an HD error; BadData when not finite. [servo]
-    DeviceStatus read(DeviceState& state) override;
+    DeviceStatus read(DeviceState& state) noexcept override;
     /// Leaves a force (N, clamped to the limit), stamped with the command clock, for the next HD
     /// ticks; they apply it until it is older than the command timeout, then zero. A non-finite
     /// force leaves zero and returns BadData. [servo]
-    DeviceStatus write(const Vec3& forceN) override;
+    DeviceStatus write(const Vec3& forceN) noexcept override;
 
     /// What went wrong last, with the HD error code, name and text for HD errors. [control]
     std::string errorMessage() const override;

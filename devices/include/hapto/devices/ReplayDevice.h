@@ -33,9 +33,9 @@ public:
     /// Stops; read/write then return NotOpen. [control]
     void close() override;
     /// Plays the next tick. [servo]
-    DeviceStatus read(DeviceState& state) override;
+    DeviceStatus read(DeviceState& state) noexcept override;
     /// Keeps the force (N) for comparison; a non-finite one is refused with BadData. [servo]
-    DeviceStatus write(const Vec3& forceN) override;
+    DeviceStatus write(const Vec3& forceN) noexcept override;
     /// The last failure. [control]
     std::string errorMessage() const override { return mError; }
 

@@ -36,10 +36,10 @@ public:
     /// Stops the device; read/write then return NotOpen. [control]
     void close() override;
     /// Advances one tick of 1 / rate and reports position and velocity (device frame). [servo]
-    DeviceStatus read(DeviceState& state) override;
+    DeviceStatus read(DeviceState& state) noexcept override;
     /// The force (N, device frame) acting on the hand from the next read() on, clamped to the
     /// max force; a non-finite force is refused with BadData and zero force is applied. [servo]
-    DeviceStatus write(const Vec3& forceN) override;
+    DeviceStatus write(const Vec3& forceN) noexcept override;
     /// The last failure. [control]
     std::string errorMessage() const override { return mError; }
 

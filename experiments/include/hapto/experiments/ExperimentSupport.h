@@ -104,9 +104,9 @@ public:
     DeviceStatus open() override;
     void close() override { mSim.close(); }
     /// The hand's reading; the first one after warm-up shows the proxy instead. [servo]
-    DeviceStatus read(DeviceState& state) override;
+    DeviceStatus read(DeviceState& state) noexcept override;
     /// Forwards the force. [servo]
-    DeviceStatus write(const Vec3& forceN) override { return mSim.write(forceN); }
+    DeviceStatus write(const Vec3& forceN) noexcept override { return mSim.write(forceN); }
     std::string errorMessage() const override { return mSim.errorMessage(); }
 
 private:
