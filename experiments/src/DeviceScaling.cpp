@@ -4,12 +4,11 @@
 #include "hapto/experiments/Experiments.h"
 
 #include "hapto/experiments/ExperimentSupport.h"
+#include "hapto/experiments/HandWalk.h"
 #include "hapto/experiments/Plot.h"
 #include "hapto/experiments/Progress.h"
 #include "hapto/experiments/Sweep.h"
 #include "hapto/experiments/Table.h"
-
-#include "HandWalk.h"
 
 #include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
@@ -183,7 +182,7 @@ std::vector<CursorRow> cursorWalk(std::size_t n, const IndexSpec& spec, std::siz
                        std::log(8.0);
         r.strategy = strategyName(strategies[s]);
     }
-    bench::HandWalk walk(scene.bounds(), 1);
+    HandWalk walk(scene.bounds(), 1);
     constexpr std::size_t kBlock = 4096;
     std::vector<Vec3> block(kBlock);
     std::vector<std::uint32_t> leaves(kBlock);
@@ -455,26 +454,49 @@ int runDevices(const DevicesArgs& args) {
         p.name = "devices-load";
         p.title = "Haptic load against devices over one world (" + spec.toString() + ", " +
                   std::to_string(scene.size()) + " objects, script " + args.script + ")";
-        PlotPanel total{
-            "total: sum of mean loads", "devices", "load (% of one core)", true, false, {}, {}, {}};
-        PlotPanel worst{"worst device: p99.9 load",
+        // Two quantities (% of one core, % of the period), so each panel keeps its own scale.
+        p.unstableTitle =
+            "unstable (" + std::string(tailName(servo.tail)) + " load >= 100 % or > 0.1 % missed)";
+        PlotPanel total{"total: sum of mean loads",
                         "devices",
-                        "p99.9 load (% of the period)",
+                        "load (% of one core)",
+                        true,
+                        false,
+                        {},
+                        {},
+                        {},
+                        {}};
+        PlotPanel worst{"worst device: p99.9 solid, p50 dashed",
+                        "devices",
+                        "load (% of the period)",
                         true,
                         true,
                         {},
                         100.0,
-                        "100 % (one period)"};
+                        "100 % (one period)",
+                        {}};
+        for (const int d : counts) {
+            total.xTics.push_back(d);
+            worst.xTics.push_back(d);
+        }
+        int style = 1;
         for (const double rate : args.ratesHz) {
-            PlotSeries a{rateText(rate), {}}, b{rateText(rate), {}};
+            PlotSeries a{rateText(rate), {}, {}, false, style};
+            PlotSeries b{rateText(rate) + " p99.9", {}, {}, false, style};
+            PlotSeries c{rateText(rate) + " p50", {}, {}, true, style};
             for (const ScalingRow& r : rows) {
                 if (r.rateHz == rate) {
                     a.points.emplace_back(r.devices, r.loadSumPct);
+                    a.unstable.push_back(!r.stable());
                     b.points.emplace_back(r.devices, r.worstP999Pct);
+                    b.unstable.push_back(!r.stable());
+                    c.points.emplace_back(r.devices, r.worstP50Pct);
                 }
             }
             total.series.push_back(a);
             worst.series.push_back(b);
+            worst.series.push_back(c);
+            ++style;
         }
         p.panels = {total, worst};
         const PlotResult pr = drawPlot(out, p);
@@ -488,12 +510,30 @@ int runDevices(const DevicesArgs& args) {
         p.name = "cursor-steps";
         p.title =
             "Cursor steps against N (" + cursorSpec.toString() + ", K^3 lattices, hand-speed walk)";
-        PlotPanel perLocate{
-            "per locate (log scale)", "objects N", "mean steps per locate", true, true, {}, {}, {}};
-        PlotPanel perChange{
-            "per leaf change", "objects N", "mean steps per leaf change", true, false, {}, {}, {}};
+        PlotPanel perLocate{"per locate (log scale)",
+                            "objects N",
+                            "mean steps per locate",
+                            true,
+                            true,
+                            {},
+                            {},
+                            {},
+                            {}};
+        PlotPanel perChange{"per leaf change",
+                            "objects N",
+                            "mean steps per leaf change",
+                            true,
+                            false,
+                            {},
+                            {},
+                            {},
+                            {}};
+        for (const std::size_t n : args.cursorObjects) {
+            perLocate.xTics.push_back(static_cast<double>(n));
+            perChange.xTics.push_back(static_cast<double>(n));
+        }
         for (const char* s : {"root", "climb", "links"}) {
-            PlotSeries a{s, {}}, b{s, {}};
+            PlotSeries a{s, {}, {}, false, -1}, b{s, {}, {}, false, -1};
             for (const CursorRow& r : cursorRows) {
                 if (r.strategy == s) {
                     a.points.emplace_back(r.objects, r.stepsPerLocate());
@@ -506,7 +546,7 @@ int runDevices(const DevicesArgs& args) {
             }
             perChange.series.push_back(b);
         }
-        PlotSeries ref{"log8(N/M)", {}};
+        PlotSeries ref{"log8(N/M)", {}, {}, true, -1};
         for (const CursorRow& r : cursorRows) {
             if (r.strategy == std::string("root")) {
                 ref.points.emplace_back(r.objects, r.log8NOverM);
@@ -571,6 +611,7 @@ int runDevices(const DevicesArgs& args) {
     }
     md += "\n";
     writeText(out / "devices.md", md);
+    progress.finish(); // the results never share a line with the bar
     std::cout << md << std::flush;
     return 0;
 }

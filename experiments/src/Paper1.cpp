@@ -134,6 +134,7 @@ int runPaper1(const Paper1Args& args) {
     }
     md += "\n### Max stable objects per renderer\n\n" +
           limitsTable(renderers, args.ratesHz, rows, args.verdict, "K");
+    progress.finish(); // the results never share a line with the bar
     finishSweepReport(out, "paper1", md, plots);
     return 0;
 }

@@ -172,6 +172,7 @@ int runPaper2(const Paper2Args& args) {
     }
     md += "\n### Max stable objects per renderer (every scene stable)\n\n" +
           limitsTable(renderers, args.ratesHz, rows, args.verdict, "count");
+    progress.finish(); // the results never share a line with the bar
     finishSweepReport(out, "paper2", md, plots);
     return 0;
 }

@@ -42,12 +42,56 @@ bool usable(const PlotPanel& p, const std::pair<double, double>& xy) {
            (!p.logY || xy.second > 0);
 }
 
-std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string>>& blocks) {
+/// The y range of the panels' data and limit lines (log panels: positive values only).
+std::optional<std::pair<double, double>> dataRange(const std::vector<const PlotPanel*>& panels) {
+    std::optional<std::pair<double, double>> range;
+    const auto take = [&](double y) {
+        range = range ? std::pair{std::min(range->first, y), std::max(range->second, y)}
+                      : std::pair{y, y};
+    };
+    for (const PlotPanel* p : panels) {
+        for (const PlotSeries& series : p->series) {
+            for (const auto& xy : series.points) {
+                if (usable(*p, xy)) {
+                    take(xy.second);
+                }
+            }
+        }
+        if (p->limitY && (!p->logY || *p->limitY > 0)) {
+            take(*p->limitY);
+        }
+    }
+    return range;
+}
+
+/// `range` widened so that points and lines do not sit on the frame.
+std::pair<double, double> widened(std::pair<double, double> range, bool logY) {
+    if (logY) {
+        return {range.first / 2.0, range.second * 2.0};
+    }
+    const double pad = std::max(1e-9, 0.1 * (range.second - range.first));
+    return {std::min(0.0, range.first - pad), range.second + pad};
+}
+
+std::string number(double v) {
+    char text[48];
+    std::snprintf(text, sizeof text, "%.9g", v);
+    return text;
+}
+
+/// A data block's name: panel i, series k ("$d0_1"), or the unstable marks of panel i ("$u0").
+std::string blockName(std::size_t i, std::size_t k) {
+    return "$d" + std::to_string(i) + "_" + std::to_string(k);
+}
+
+std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string>>& blocks,
+                 const std::vector<std::string>& unstableBlocks) {
     std::ostringstream s;
     const bool multi = spec.panels.size() > 1;
     if (multi) {
         s << "set multiplot layout 1," << spec.panels.size() << " title " << gq(spec.title) << "\n";
     }
+    const std::optional<std::pair<double, double>> shared = sharedYRange(spec);
     for (std::size_t i = 0; i < spec.panels.size(); ++i) {
         const PlotPanel& p = spec.panels[i];
         s << "set title "
@@ -56,32 +100,42 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
         s << (p.logX ? "set logscale x\n" : "unset logscale x\n");
         s << (p.logY ? "set logscale y\n" : "unset logscale y\n");
         s << "set grid\nset key below\n";
-        // Room above a limit line so that it shows (log scale: twice the limit).
-        double top = 0.0;
-        for (const PlotSeries& series : p.series) {
-            for (const auto& xy : series.points) {
-                if (usable(p, xy)) {
-                    top = std::max(top, xy.second);
-                }
+        if (!p.xTics.empty()) {
+            // A labelled tic at every measured x (each device count, each size).
+            s << "set xtics (";
+            for (std::size_t k = 0; k < p.xTics.size(); ++k) {
+                s << (k ? ", " : "") << gq(number(p.xTics[k])) << " " << number(p.xTics[k]);
             }
+            s << ")\n";
+        } else {
+            s << "set xtics autofreq\n";
         }
-        if (p.limitY && top < *p.limitY * 1.5) {
-            s << "set yrange [*:" << (p.logY ? *p.limitY * 2.0 : *p.limitY * 1.2) << "]\n";
+        std::optional<std::pair<double, double>> range = spec.shareY ? shared : dataRange({&p});
+        if (range) {
+            const auto [lo, hi] = widened(*range, p.logY);
+            s << "set yrange [" << number(lo) << ":" << number(hi) << "]\n";
         } else {
             s << "set yrange [*:*]\n";
         }
         std::vector<std::string> plots;
         for (std::size_t k = 0; k < blocks[i].size(); ++k) {
             if (!blocks[i][k].empty()) {
-                // Colour and point type by series index, so a series keeps its look in every
-                // panel even when another series has no points there.
+                // Colour and point type by style (or series position), so a series keeps its
+                // look in every panel even when another series has no points there.
+                const PlotSeries& series = p.series[k];
+                const int style = series.style > 0 ? series.style : static_cast<int>(k) + 1;
                 plots.push_back(blocks[i][k] + " using 1:2 with linespoints lc " +
-                                std::to_string(k + 1) + " pt " + std::to_string(k + 1) + " title " +
-                                gq(p.series[k].title));
+                                std::to_string(style) + " pt " + std::to_string(style) +
+                                (series.dashed ? " dt 2" : " dt 1") + " title " + gq(series.title));
             }
         }
+        if (!unstableBlocks[i].empty()) {
+            plots.push_back(unstableBlocks[i] +
+                            " using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb 'black' title " +
+                            gq(spec.unstableTitle));
+        }
         if (p.limitY) {
-            plots.push_back(std::to_string(*p.limitY) + " with lines dt 2 lc rgb 'red' title " +
+            plots.push_back(number(*p.limitY) + " with lines dt 3 lc rgb 'red' title " +
                             gq(p.limitTitle));
         }
         if (plots.empty() || plots.size() == (p.limitY ? 1u : 0u)) {
@@ -116,38 +170,54 @@ bool gnuplotAvailable() {
     return false;
 }
 
-PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
-    PlotResult r;
+std::optional<std::pair<double, double>> sharedYRange(const PlotSpec& spec) {
+    std::vector<const PlotPanel*> panels;
+    for (const PlotPanel& p : spec.panels) {
+        panels.push_back(&p);
+    }
+    return dataRange(panels);
+}
+
+std::string plotScript(const PlotSpec& spec) {
     std::ostringstream script;
     script << "# " << spec.title << " (generated by hapto experiment; run: gnuplot " << spec.name
            << ".gp)\n";
-    // Data as datablocks, one per series.
+    // Data as datablocks, one per series, and one per panel for its unstable points.
     std::vector<std::vector<std::string>> blocks(spec.panels.size());
+    std::vector<std::string> unstableBlocks(spec.panels.size());
     for (std::size_t i = 0; i < spec.panels.size(); ++i) {
         const PlotPanel& p = spec.panels[i];
+        std::ostringstream marks;
         for (std::size_t k = 0; k < p.series.size(); ++k) {
             std::ostringstream data;
             std::size_t n = 0;
-            for (const auto& xy : p.series[k].points) {
+            for (std::size_t q = 0; q < p.series[k].points.size(); ++q) {
+                const auto& xy = p.series[k].points[q];
                 if (usable(p, xy)) {
-                    char line[96];
-                    std::snprintf(line, sizeof line, "%.9g %.9g\n", xy.first, xy.second);
+                    const std::string line = number(xy.first) + " " + number(xy.second) + "\n";
                     data << line;
                     ++n;
+                    if (q < p.series[k].unstable.size() && p.series[k].unstable[q]) {
+                        marks << line;
+                    }
                 }
             }
             if (n == 0) {
                 blocks[i].emplace_back();
                 continue;
             }
-            const std::string name = "$d" + std::to_string(i) + "_" + std::to_string(k);
+            const std::string name = blockName(i, k);
             script << name << " << EOD\n" << data.str() << "EOD\n";
             blocks[i].push_back(name);
+        }
+        if (!marks.str().empty()) {
+            unstableBlocks[i] = "$u" + std::to_string(i);
+            script << unstableBlocks[i] << " << EOD\n" << marks.str() << "EOD\n";
         }
     }
     const int width =
         spec.panelWidthPx * static_cast<int>(std::max<std::size_t>(1, spec.panels.size()));
-    const std::string plot = body(spec, blocks);
+    const std::string plot = body(spec, blocks, unstableBlocks);
     // `out` names the images without their extension; hapto sets it (gnuplot -e) to a
     // temporary name and renames the finished images into place, so a figure is never half
     // written. Run by hand, the script writes NAME.png and NAME.svg directly.
@@ -158,9 +228,14 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
     script << "set terminal svg size " << width << "," << spec.heightPx
            << " noenhanced font 'sans,10'\nset output out.\".svg\"\n"
            << plot << "set output\n";
+    return script.str();
+}
+
+PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
+    PlotResult r;
     const std::filesystem::path gp = dir / (spec.name + ".gp");
     try {
-        writeFileAtomically(gp, script.str());
+        writeFileAtomically(gp, plotScript(spec));
     } catch (const std::exception& e) {
         r.problem = e.what();
         return r;

@@ -9,8 +9,16 @@
 namespace hapto::experiments {
 
 Progress::Progress(std::string title, std::size_t total)
-    : mTitle(std::move(title)), mTotal(total), mEnabled(isatty(STDERR_FILENO) != 0),
+    : Progress(std::move(title), total, stderr, isatty(STDERR_FILENO) != 0) {}
+
+Progress::Progress(std::string title, std::size_t total, std::FILE* out, bool enabled)
+    : mOut(out), mTitle(std::move(title)), mTotal(total), mEnabled(enabled),
       mStart(std::chrono::steady_clock::now()), mLastDraw(mStart) {}
+
+void Progress::finish() {
+    erase();
+    mEnabled = false;
+}
 
 Progress::~Progress() {
     erase();
@@ -24,14 +32,14 @@ void Progress::advance(std::size_t units, const std::string& label) {
 
 void Progress::note(const std::string& text) {
     erase();
-    std::fprintf(stderr, "%s\n", text.c_str());
+    std::fprintf(mOut, "%s\n", text.c_str());
     draw(true);
 }
 
 void Progress::erase() {
     if (mEnabled && mDrawn) {
-        std::fprintf(stderr, "\r\x1b[2K");
-        std::fflush(stderr);
+        std::fprintf(mOut, "\r\x1b[2K");
+        std::fflush(mOut);
         mDrawn = false;
     }
 }
@@ -51,11 +59,11 @@ void Progress::draw(bool force) {
     const int filled = static_cast<int>(fraction * kWidth);
     const double elapsedS = std::chrono::duration<double>(now - mStart).count();
     std::string label = mLabel.size() > 44 ? mLabel.substr(0, 43) + "~" : mLabel;
-    std::fprintf(stderr, "\r\x1b[2K%s [%s%s] %3.0f%% %5.0fs %s", mTitle.c_str(),
+    std::fprintf(mOut, "\r\x1b[2K%s [%s%s] %3.0f%% %5.0fs %s", mTitle.c_str(),
                  std::string(static_cast<std::size_t>(filled), '#').c_str(),
                  std::string(static_cast<std::size_t>(kWidth - filled), '.').c_str(),
                  100.0 * fraction, elapsedS, label.c_str());
-    std::fflush(stderr);
+    std::fflush(mOut);
     mDrawn = true;
 }
 

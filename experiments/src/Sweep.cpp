@@ -455,46 +455,64 @@ std::string loadCell(const SweepRow& row) {
     return cell;
 }
 
+PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRenderer>& renderers,
+                   double rateHz, const std::vector<SweepRow>& rows, Verdict verdict) {
+    PlotSpec spec;
+    char name[64];
+    std::snprintf(name, sizeof name, "%s-load-%gHz", experiment.c_str(), rateHz);
+    spec.name = name;
+    spec.title = experiment + ": haptic load against objects, " + rateText(rateHz) +
+                 ", p99.9 solid, p50 dashed (median over repeats" +
+                 (experiment == "paper2" ? std::string(" and scenes)") : std::string(")"));
+    spec.shareY = true; // the three conditions side by side on one scale
+    spec.unstableTitle = "unstable (" + std::string(verdictName(verdict)) + " verdict)";
+    for (const Condition c : kConditions) {
+        PlotPanel panel;
+        panel.title = std::string(conditionName(c));
+        panel.xLabel = "objects";
+        panel.yLabel = "load (% of the period)";
+        panel.logX = true;
+        panel.logY = true;
+        panel.limitY = 100.0;
+        panel.limitTitle = "100 % (one period)";
+        std::set<std::size_t> sizes;
+        for (std::size_t k = 0; k < renderers.size(); ++k) {
+            const SweepRenderer& r = renderers[k];
+            // Per size: the loads over its scenes, and whether any of its cells was unstable.
+            std::map<std::size_t, std::vector<double>> p999, p50;
+            std::map<std::size_t, bool> unstable;
+            for (const SweepRow& row : rows) {
+                if (row.renderer == r.name && row.rateHz == rateHz && row.condition == c &&
+                    !row.skipped) {
+                    p999[row.objects].push_back(row.median.p999Pct);
+                    p50[row.objects].push_back(row.median.p50Pct);
+                    unstable[row.objects] = unstable[row.objects] || !row.stable(verdict);
+                    sizes.insert(row.objects);
+                }
+            }
+            PlotSeries tail{r.name + " p99.9", {}, {}, false, static_cast<int>(k) + 1};
+            PlotSeries mid{r.name + " p50", {}, {}, true, static_cast<int>(k) + 1};
+            for (const auto& [n, loads] : p999) {
+                tail.points.emplace_back(static_cast<double>(n), median(loads));
+                tail.unstable.push_back(unstable[n]);
+                mid.points.emplace_back(static_cast<double>(n), median(p50[n]));
+            }
+            panel.series.push_back(std::move(tail));
+            panel.series.push_back(std::move(mid));
+        }
+        panel.xTics.assign(sizes.begin(), sizes.end());
+        spec.panels.push_back(std::move(panel));
+    }
+    return spec;
+}
+
 std::vector<std::filesystem::path>
 plotSweep(const std::filesystem::path& dir, const std::string& experiment,
           const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
-          const std::vector<SweepRow>& rows, Progress& progress) {
+          const std::vector<SweepRow>& rows, Verdict verdict, Progress& progress) {
     std::vector<std::filesystem::path> files;
     for (const double rate : ratesHz) {
-        PlotSpec spec;
-        char name[64];
-        std::snprintf(name, sizeof name, "%s-load-%gHz", experiment.c_str(), rate);
-        spec.name = name;
-        spec.title = experiment + ": p99.9 haptic load against objects, " + rateText(rate) +
-                     " (median over repeats" +
-                     (experiment == "paper2" ? std::string(" and scenes)") : std::string(")"));
-        for (const Condition c : kConditions) {
-            PlotPanel panel;
-            panel.title = std::string(conditionName(c));
-            panel.xLabel = "objects";
-            panel.yLabel = "p99.9 load (% of the period)";
-            panel.logX = true;
-            panel.logY = true;
-            panel.limitY = 100.0;
-            panel.limitTitle = "100 % (one period)";
-            for (const SweepRenderer& r : renderers) {
-                std::map<std::size_t, std::vector<double>> byObjects;
-                for (const SweepRow& row : rows) {
-                    if (row.renderer == r.name && row.rateHz == rate && row.condition == c &&
-                        !row.skipped) {
-                        byObjects[row.objects].push_back(row.median.p999Pct);
-                    }
-                }
-                PlotSeries s;
-                s.title = r.name;
-                for (const auto& [n, loads] : byObjects) {
-                    s.points.emplace_back(static_cast<double>(n), median(loads));
-                }
-                panel.series.push_back(std::move(s));
-            }
-            spec.panels.push_back(std::move(panel));
-        }
-        const PlotResult pr = drawPlot(dir, spec);
+        const PlotResult pr = drawPlot(dir, sweepPlot(experiment, renderers, rate, rows, verdict));
         if (!pr.problem.empty()) {
             progress.note("hapto experiment: plot skipped: " + pr.problem);
         }
@@ -527,7 +545,7 @@ writeSweepFiles(const std::filesystem::path& out, const std::string& name, Json 
         j[key] = body[key];
     }
     writeText(out / (name + ".json"), j.dump(2) + "\n");
-    return plotSweep(out, name, renderers, ratesHz, rows, progress);
+    return plotSweep(out, name, renderers, ratesHz, rows, verdict, progress);
 }
 
 void finishSweepReport(const std::filesystem::path& out, const std::string& name,

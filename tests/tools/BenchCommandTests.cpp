@@ -1,7 +1,5 @@
-// `hapto bench query` and the hand-speed walk it shares with hapto_bench. Behaviour only:
+// `hapto bench query` (its hand walk: tests/experiments/HandWalkTests.cpp). Behaviour only:
 // nothing here depends on how fast anything runs.
-
-#include "../../tools/bench/HandWalk.h"
 
 #include "TestSupport.h"
 
@@ -136,25 +134,4 @@ TEST_CASE("hapto bench query refuses bad index specs and options with exit code 
         const auto r = test::runHapto("bench query --steps 100 --scene /nonexistent/s.json");
         CHECK(r.exitCode == 2);
     }
-}
-
-TEST_CASE("the hand walk stays in its box, moves at hand speed and repeats for a seed") {
-    const Aabb box{Vec3(-0.05, -0.02, 0.0), Vec3(0.05, 0.02, 0.01)};
-    bench::HandWalk a(box, 3), b(box, 3), c(box, 4);
-    Vec3 previous = a.position();
-    CHECK(box.contains(previous));
-    double travelled = 0.0;
-    bool differs = false;
-    for (int i = 0; i < 20000; ++i) {
-        const Vec3 p = a.next();
-        REQUIRE(box.contains(p));
-        const double step = glm::length(p - previous);
-        REQUIRE(step <= 0.5 * 1e-3 * (1.0 + 1e-12)); // 0.5 m/s for 1 ms
-        travelled += step;
-        previous = p;
-        REQUIRE(b.next() == p);
-        differs = differs || c.next() != p;
-    }
-    CHECK(differs);
-    CHECK(travelled > 0.5); // 20 s of motion covers well over half a metre
 }

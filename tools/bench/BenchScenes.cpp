@@ -1,6 +1,6 @@
 #include "BenchScenes.h"
 
-#include "HandWalk.h"
+#include "hapto/experiments/HandWalk.h"
 
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/Random.h"
@@ -67,7 +67,7 @@ std::unique_ptr<SceneCase> makeCase(SceneKind kind, std::size_t count) {
     for (const SceneObject& o : c->scene.objects()) {
         c->boxes.push_back(o.aabb());
     }
-    c->walk = makeHandWalk(c->scene.bounds(), 1, kWalkForwardSteps);
+    c->walk = experiments::makeHandWalk(c->scene.bounds(), 1, kWalkForwardSteps);
     c->walk.insert(c->walk.end(), c->walk.rbegin(), c->walk.rend()); // retrace: a seamless loop
     c->checks = makeChecks(*c);
     c->grid = gridSpecFor(count);

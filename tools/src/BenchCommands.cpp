@@ -3,8 +3,7 @@
 #include "Commands.h"
 #include "Options.h"
 
-#include "../bench/HandWalk.h"
-
+#include "hapto/experiments/HandWalk.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/scenes/InputError.h"
@@ -141,7 +140,7 @@ void runQuery(const QueryArgs& args) {
     // The same walk for every index: generated a block at a time, each block run by every
     // index in turn (starting with a different one each block), each cursor going on from
     // where its previous block left it.
-    bench::HandWalk walk(scene.bounds(), args.seed);
+    experiments::HandWalk walk(scene.bounds(), args.seed);
     std::vector<Vec3> block(kBlockSteps);
     for (std::size_t done = 0, round = 0; done < steps; ++round) {
         const std::size_t length = std::min(kBlockSteps, steps - done);

@@ -1,5 +1,6 @@
 #pragma once
-/// A seeded hand-speed random walk: one pointer position per servo tick, for benchmarks.
+/// A seeded hand-speed random walk: one pointer position per servo tick, for benchmarks and
+/// experiments (hapto_bench, `hapto bench query`, the cursor part of `hapto experiment devices`).
 ///
 /// The idea: drive every index and every baseline with the same motion a hand makes at a
 /// haptic device, so cursor caching is exercised the way a servo thread exercises it. The
@@ -19,7 +20,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace hapto::bench {
+namespace hapto::experiments {
 
 /// How the simulated hand moves.
 struct HandWalkOptions {
@@ -87,4 +88,4 @@ inline std::vector<Vec3> makeHandWalk(const Aabb& box, std::uint64_t seed, std::
     return out;
 }
 
-} // namespace hapto::bench
+} // namespace hapto::experiments

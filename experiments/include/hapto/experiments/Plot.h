@@ -13,6 +13,10 @@ namespace hapto::experiments {
 struct PlotSeries {
     std::string title;                             ///< Legend text.
     std::vector<std::pair<double, double>> points; ///< (x, y) in the panel's units.
+    /// Per point: drawn with the panel's unstable mark as well (empty: none is).
+    std::vector<bool> unstable;
+    bool dashed = false; ///< A dashed line (e.g. p50 beside the solid p99.9).
+    int style = -1;      ///< Colour and point type (1, 2, ...); -1: the series' position + 1.
 };
 
 /// One set of axes.
@@ -23,6 +27,7 @@ struct PlotPanel {
     std::vector<PlotSeries> series;  ///< The lines.
     std::optional<double> limitY;    ///< A dashed horizontal line (e.g. 100 % load).
     std::string limitTitle;          ///< Its legend text.
+    std::vector<double> xTics;       ///< A labelled tic at each of these x (empty: gnuplot's).
 };
 
 /// A figure: panels side by side.
@@ -32,6 +37,8 @@ struct PlotSpec {
     std::vector<PlotPanel> panels;
     int panelWidthPx = 520; ///< Width of one panel (px).
     int heightPx = 420;     ///< Height (px).
+    bool shareY = false;    ///< One y range for every panel (panels of the same quantity).
+    std::string unstableTitle = "unstable"; ///< Key text of the unstable mark.
 };
 
 /// What drawPlot made.
@@ -39,6 +46,13 @@ struct PlotResult {
     std::vector<std::filesystem::path> files; ///< The PNG and SVG written (empty on failure).
     std::string problem; ///< Why nothing was drawn ("gnuplot not found", ...), else empty.
 };
+
+/// The y range every panel of a shared-y figure uses, data and limit lines included (log
+/// panels: positive values only), widened a little; nullopt when there is no data. [any thread]
+std::optional<std::pair<double, double>> sharedYRange(const PlotSpec& spec);
+
+/// The gnuplot script drawPlot runs: data inline, a PNG then an SVG of the panels. [any thread]
+std::string plotScript(const PlotSpec& spec);
 
 /// True when a `gnuplot` executable is on PATH. [control]
 bool gnuplotAvailable();

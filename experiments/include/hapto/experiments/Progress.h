@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdio>
 #include <string>
 
 namespace hapto::experiments {
@@ -12,7 +13,10 @@ namespace hapto::experiments {
 class Progress {
 public:
     /// `title` names the experiment; `total` is the planned number of units (it may grow).
+    /// Draws on stderr when it is a terminal.
     Progress(std::string title, std::size_t total);
+    /// Draws on `out` when `enabled` (tests: a temporary file). Notes go to `out` too.
+    Progress(std::string title, std::size_t total, std::FILE* out, bool enabled);
     /// Erases the bar.
     ~Progress();
     Progress(const Progress&) = delete;
@@ -26,11 +30,15 @@ public:
     void show(const std::string& label) { advance(0, label); }
     /// Prints a line of text above the bar (always, terminal or not). [control]
     void note(const std::string& text);
+    /// Erases the bar for good: call it before printing results, so that they never share a
+    /// line with the bar. Later advances draw nothing; notes still print. [control]
+    void finish();
 
 private:
     void draw(bool force);
     void erase();
 
+    std::FILE* mOut;
     std::string mTitle;
     std::string mLabel;
     std::size_t mTotal;

@@ -13,6 +13,7 @@
 
 #include "hapto/experiments/ExperimentSupport.h"
 #include "hapto/experiments/Experiments.h"
+#include "hapto/experiments/Plot.h"
 #include "hapto/experiments/Progress.h"
 
 #include "hapto/index/IndexSpec.h"
@@ -139,13 +140,17 @@ void finishSweepReport(const std::filesystem::path& out, const std::string& name
 /// A load cell as the tables show it: "p50 / p99.9 / max" in %, or UNSTABLE/skipped marks.
 std::string loadCell(const SweepRow& row);
 
-/// One figure per rate: p99.9 load (%) against objects, a panel per condition, a line per
-/// renderer (median over a size's scenes). Returns the files drawn; notes problems. [control]
-std::vector<std::filesystem::path> plotSweep(const std::filesystem::path& dir,
-                                             const std::string& experiment,
-                                             const std::vector<SweepRenderer>& renderers,
-                                             const std::vector<double>& ratesHz,
-                                             const std::vector<SweepRow>& rows, Progress& progress);
+/// The figure of one rate: load (%) against objects, a panel per condition on one shared y
+/// scale, per renderer a solid p99.9 line and a dashed p50 line of one colour (medians over a
+/// size's scenes), a tic at every size measured, and a ring on each p99.9 point where some
+/// cell of that size was unstable under `verdict`. [any thread]
+PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRenderer>& renderers,
+                   double rateHz, const std::vector<SweepRow>& rows, Verdict verdict);
+/// One sweepPlot() per rate, drawn. Returns the files drawn; notes problems. [control]
+std::vector<std::filesystem::path>
+plotSweep(const std::filesystem::path& dir, const std::string& experiment,
+          const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
+          const std::vector<SweepRow>& rows, Verdict verdict, Progress& progress);
 
 /// A paragraph on how the cells were measured: the verdict driving the sweep, whether
 /// SCHED_FIFO was granted, and the platform's wake-up lateness and misses (medians over the

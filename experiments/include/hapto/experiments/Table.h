@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -26,11 +27,17 @@ enum class ColumnIn : std::uint8_t {
 
 /// One column: declared once, used by all three forms.
 struct Column {
+    /// A column; only the name is required.
+    Column(std::string name, std::string unit = {}, int decimals = -1, std::string heading = {},
+           ColumnIn in = ColumnIn::All)
+        : name(std::move(name)), unit(std::move(unit)), decimals(decimals),
+          heading(std::move(heading)), in(in) {}
+
     std::string name;    ///< CSV header and JSON key, snake_case with its unit (load_p50_pct).
     std::string unit;    ///< Unit ("%", "Hz", "ns", ...), or empty for counts and text.
-    int decimals = -1;   ///< Markdown: fixed places for numbers; -1: as in CSV (%.6g).
+    int decimals;        ///< Markdown: fixed places for numbers; -1: as in CSV (%.6g).
     std::string heading; ///< Markdown heading; empty: the name, then the unit in brackets.
-    ColumnIn in = ColumnIn::All; ///< Which forms show it.
+    ColumnIn in;         ///< Which forms show it.
 };
 
 /// One cell: text, a number, a whole number or a flag.

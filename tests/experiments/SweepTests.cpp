@@ -1,0 +1,102 @@
+// The sweep's arithmetic: medians over repeats, the verdicts (p99.9, or p99 for quick runs),
+// and the limits drawn from them.
+
+#include "hapto/experiments/Sweep.h"
+
+#include <catch2/catch.hpp>
+
+using namespace hapto;
+using namespace hapto::experiments;
+
+namespace {
+
+LoadFigures figures(double p50, double p99, double p999, double missedPct = 0.0) {
+    LoadFigures f;
+    f.p50Pct = p50;
+    f.p99Pct = p99;
+    f.p999Pct = p999;
+    f.maxPct = p999;
+    f.ticks = 1000;
+    f.missedPct = missedPct;
+    return f;
+}
+
+SweepRow row(const std::string& renderer, std::size_t objects, std::uint64_t seed, double p999,
+             double missedPct = 0.0) {
+    SweepRow r;
+    r.renderer = renderer;
+    r.rateHz = 1000;
+    r.size = static_cast<int>(objects);
+    r.objects = objects;
+    r.seed = seed;
+    r.median = figures(1, p999 / 2, p999, missedPct);
+    r.runs = {r.median};
+    return r;
+}
+
+} // namespace
+
+TEST_CASE("median: the middle value, 0 for none, any order") {
+    CHECK(median({}) == 0.0);
+    CHECK(median({3.0}) == 3.0);
+    CHECK(median({5.0, 1.0, 3.0}) == 3.0);
+    const double even = median({4.0, 1.0, 3.0, 2.0});
+    CHECK((even == 2.0 || even == 3.0 || even == 2.5));
+}
+
+TEST_CASE("medianOf takes each figure's median, the first fault, and realtime only if all") {
+    std::vector<LoadFigures> runs = {figures(1, 5, 90), figures(3, 6, 200), figures(2, 7, 95)};
+    runs[0].realtime = runs[1].realtime = true;
+    runs[1].fault = "disconnected";
+    const LoadFigures m = medianOf(runs);
+    CHECK(m.p50Pct == 2);
+    CHECK(m.p999Pct == 95);
+    CHECK(m.p99Pct == 6);
+    CHECK(m.fault == "disconnected");
+    CHECK_FALSE(m.realtime);
+    CHECK_FALSE(m.stable()); // a fault is never stable
+}
+
+TEST_CASE("verdicts: p99.9 < 100 % (and <= 0.1 % missed for DESIGN); quick runs read p99") {
+    LoadFigures f = figures(10, 60, 120);
+    CHECK_FALSE(f.loadStable()); // p99.9 over the period
+    f.tail = Tail::P99;
+    CHECK(f.loadStable()); // a quick run: its p99 is what it can judge
+    CHECK(f.stable());
+    f.missedPct = 0.2;
+    CHECK(f.loadStable());
+    CHECK_FALSE(f.stable()); // DESIGN also counts misses
+    LoadFigures none = figures(10, 20, 30);
+    none.ticks = 0;
+    CHECK_FALSE(none.loadStable()); // no ticks, no verdict
+    CHECK(tailName(Tail::P99) == "p99");
+    CHECK(tailName(Tail::P999) == "p99.9");
+    CHECK(tailFor(true) == Tail::P99);
+    CHECK(tailFor(false) == Tail::P999);
+    CHECK(verdictNote(Tail::P99).find("p99") != std::string::npos);
+    // medianOf keeps the tail the runs were judged on.
+    CHECK(medianOf({f, f}).tail == Tail::P99);
+}
+
+TEST_CASE("sweep limits: largest size with every scene stable, first size with one unstable") {
+    const std::vector<SweepRenderer> renderers = {{"octree", IndexSpec::brute(), ""}};
+    std::vector<SweepRow> rows = {
+        row("octree", 10, 1, 20),  row("octree", 10, 2, 30),
+        row("octree", 20, 1, 40),  row("octree", 20, 2, 150), // one scene of two unstable
+        row("octree", 50, 1, 300),                            // still measured after
+    };
+    rows[2].median.missedPct = 0.5; // stable by load, not by DESIGN
+    const auto load = sweepLimits(renderers, {1000}, rows, Verdict::Load);
+    REQUIRE(load.size() == 1);
+    CHECK(load[0].maxStableObjects == 10u);
+    CHECK(load[0].firstUnstableObjects == 20u);
+    CHECK(load[0].scenesAtFirstUnstable == 2);
+    CHECK(load[0].scenesStableAtFirstUnstable == 1);
+    CHECK(load[0].largestMeasuredObjects == 50u);
+    const auto design = sweepLimits(renderers, {1000}, rows, Verdict::Design);
+    CHECK(design[0].scenesStableAtFirstUnstable == 0); // scene 1 at 20 missed too many
+    // A skipped cell is unstable whatever its figures.
+    rows[0].skipped = true;
+    CHECK_FALSE(rows[0].stable(Verdict::Load));
+    CHECK_FALSE(sweepLimits(renderers, {1000}, rows, Verdict::Load)[0].maxStableObjects);
+}
