@@ -23,26 +23,13 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace hapto {
 
-using Triple = std::array<double, 3>;
-inline Triple triple(const Vec3& v) {
-    return {v.x, v.y, v.z};
-}
-inline Vec3 vec(const Triple& t) {
-    return {t[0], t[1], t[2]};
-}
-
-// ContactReport as plain words for the mailbox (GLM vectors are not trivially copyable).
-struct ContactWire {
-    std::uint64_t tick;
-    Triple devicePoint, proxy, force;
-    std::array<ObjectId, 3> objects;
-    std::array<Triple, 3> normals;
-    std::uint32_t contactCount;
-};
+// What crosses threads through the mailboxes below is plain structs of vectors.
+static_assert(std::is_trivially_copyable_v<ContactReport> && std::is_trivially_copyable_v<Vec3>);
 
 /// The servo's hot state: what a tick reads and writes. [servo] while the servo runs;
 /// [control] (or the supervisor) only while it does not.
@@ -87,7 +74,7 @@ struct ChannelRecord {
     // closes it (down), reopens it and starts its servo again; with reopening off it stays
     // closed (gaveUp). `closed` makes sure one thread, and one only, closes it.
     std::atomic<bool> recovering{false}, down{false}, gaveUp{false}, closed{false};
-    std::thread worker;            ///< The recovery worker (threaded mode).
+    std::thread worker;             ///< The recovery worker (threaded mode).
     std::uint64_t nextReopenNs = 0; ///< Step mode: when to try to open again.
 
     mutable std::mutex mutex;      // guards the fields below: recovery writes, report() reads
@@ -100,11 +87,11 @@ struct ChannelRecord {
 };
 
 struct alignas(64) Runtime::Channel {
-    ServoState servo;               ///< Hot.
-    DeviceMetrics metrics;          ///< Servo -> any thread.
-    Mailbox<ContactWire> contacts;  ///< Servo -> control, every tick.
-    Mailbox<Triple> externalForce;  ///< Control -> servo, world frame (N).
-    ChannelRecord record;           ///< Cold.
+    ServoState servo;                ///< Hot.
+    DeviceMetrics metrics;           ///< Servo -> any thread.
+    Mailbox<ContactReport> contacts; ///< Servo -> control, every tick.
+    Mailbox<Vec3> externalForce;     ///< Control -> servo, world frame (N).
+    ChannelRecord record;            ///< Cold.
 
     Channel(RuntimeDevice d, const RuntimeOptions& o);
 };

@@ -30,8 +30,7 @@ SafetyConfig safetyFor(double maxForceN) {
 
 Runtime::Channel::Channel(RuntimeDevice d, const RuntimeOptions& o)
     : servo(o.renderer, safetyFor(d.config.maxForceN)) {
-    const std::uint64_t period =
-        static_cast<std::uint64_t>(std::llround(1e9 / d.config.rateHz));
+    const std::uint64_t period = static_cast<std::uint64_t>(std::llround(1e9 / d.config.rateHz));
     servo.device = d.device.get();
     servo.recorder = d.recorder;
     servo.transform = d.config.transform;
@@ -237,24 +236,11 @@ Device& Runtime::device(std::size_t i) {
 }
 
 bool Runtime::contact(std::size_t i, ContactReport& report) const {
-    ContactWire w;
-    if (!mChannels.at(i)->contacts.read(w)) {
-        return false;
-    }
-    report.tick = w.tick;
-    report.devicePoint = vec(w.devicePoint);
-    report.proxy = vec(w.proxy);
-    report.force = vec(w.force);
-    report.objects = w.objects;
-    for (std::size_t c = 0; c < 3; ++c) {
-        report.normals[c] = vec(w.normals[c]);
-    }
-    report.contactCount = w.contactCount;
-    return true;
+    return mChannels.at(i)->contacts.read(report);
 }
 
 void Runtime::setExternalForce(std::size_t i, const Vec3& forceN) {
-    mChannels.at(i)->externalForce.publish(triple(forceN));
+    mChannels.at(i)->externalForce.publish(forceN);
 }
 
 } // namespace hapto

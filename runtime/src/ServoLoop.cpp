@@ -80,9 +80,9 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
     const Vec3 v = s.sample.hasVelocity ? s.transform.velocityToWorld(s.sample.velocity)
                                         : (p - s.lastPosition) / s.dtS;
     s.lastPosition = p;
-    Triple external{0.0, 0.0, 0.0};
+    Vec3 external{0.0};
     (void)ch.externalForce.read(external);
-    const TickOutput out = s.haptic.tick(snap, p, v, s.dtS, vec(external));
+    const TickOutput out = s.haptic.tick(snap, p, v, s.dtS, external);
     if (out.newSnapshot) {
         DeviceMetrics::bump(m.snapshotsSeen);
     }
@@ -124,16 +124,15 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
     }
     storeVec(m.forceN, force);
     storeVec(m.positionM, p);
-    ContactWire report{s.tick,
-                       triple(p),
-                       triple(out.render.proxy),
-                       triple(force),
-                       {kNoObject, kNoObject, kNoObject},
-                       {},
-                       out.render.contactCount};
+    ContactReport report;
+    report.tick = s.tick;
+    report.devicePoint = p;
+    report.proxy = out.render.proxy;
+    report.force = force;
+    report.contactCount = out.render.contactCount;
     for (std::uint32_t c = 0; c < out.render.contactCount && c < report.objects.size(); ++c) {
         report.objects[c] = out.render.contacts[c].id;
-        report.normals[c] = triple(out.render.contacts[c].normal);
+        report.normals[c] = out.render.contacts[c].normal;
     }
     ch.contacts.publish(report);
     if (s.recorder) {
@@ -171,13 +170,11 @@ void Runtime::leaveServo(Channel& ch) noexcept {
     (void)s.device->write(Vec3(0.0));
     storeVec(m.forceN, Vec3(0.0));
     // Tell the control thread this hand touches nothing now (a grasp must not hold on to it).
-    ch.contacts.publish(ContactWire{s.tick,
-                                    triple(s.lastPosition),
-                                    triple(s.lastPosition),
-                                    {0.0, 0.0, 0.0},
-                                    {kNoObject, kNoObject, kNoObject},
-                                    {},
-                                    0});
+    ContactReport none;
+    none.tick = s.tick;
+    none.devicePoint = s.lastPosition;
+    none.proxy = s.lastPosition;
+    ch.contacts.publish(none);
     m.running.store(false, std::memory_order_release);
 }
 
