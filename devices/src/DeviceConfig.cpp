@@ -20,9 +20,9 @@ namespace {
 
 using namespace hapto::json;
 
-constexpr std::array<std::string_view, 6> kScripts = {"free", "touch",      "slide",
-                                                      "walk", "grasp-left", "grasp-right"};
-constexpr std::array<std::string_view, 4> kKinds = {"sim", "replay", "falcon", "phantom"};
+/// The kinds a file may name, each also the name of its settings field.
+constexpr std::array<DeviceKind, 4> kFileKinds = {DeviceKind::Sim, DeviceKind::Replay,
+                                                  DeviceKind::Falcon, DeviceKind::Phantom};
 
 WorkspaceTransform parseTransform(const Source& w, const Json& j, const Path& path) {
     object(w, j, path);
@@ -48,12 +48,14 @@ SimConfig parseSim(const Source& w, const Json& j, const Path& path) {
                "resolution_m", "noise_m"});
     SimConfig c;
     if (const Json* v = optional(j, "script")) {
-        c.script = string(w, *v, path / "script");
-        if (std::find(kScripts.begin(), kScripts.end(), c.script) == kScripts.end()) {
-            w.fail(path / "script", "unknown script '" + c.script +
+        const std::string script = string(w, *v, path / "script");
+        const std::optional<HandScript> parsed = parseHandScript(script);
+        if (!parsed) {
+            w.fail(path / "script", "unknown script '" + script +
                                         "' (expected free, touch, slide, walk, grasp-left or "
                                         "grasp-right)");
         }
+        c.script = *parsed;
     }
     if (const Json* v = optional(j, "seed")) {
         if (!v->is_number_integer() || (!v->is_number_unsigned() && v->get<std::int64_t>() < 0)) {
@@ -218,16 +220,19 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
         w.fail(path / "name", "a device name is 1 to 63 letters, digits, '-' or '_' (got \"" +
                                   d.name + "\"); it also names trace files");
     }
-    d.kind = string(w, required(w, j, path, "kind"), path / "kind");
-    if (std::find(kKinds.begin(), kKinds.end(), d.kind) == kKinds.end()) {
+    const std::string kind = string(w, required(w, j, path, "kind"), path / "kind");
+    const std::optional<DeviceKind> parsedKind = parseDeviceKind(kind);
+    if (!parsedKind) {
         w.fail(path / "kind",
-               "unknown kind '" + d.kind + "' (expected sim, replay, falcon or phantom)");
+               "unknown kind '" + kind + "' (expected sim, replay, falcon or phantom)");
     }
-    for (const auto other : kKinds) {
-        if (other != d.kind && j.contains(std::string(other))) {
-            w.fail(path / other.data(),
-                   "settings for kind '" + std::string(other) + "' on a device of kind '" + d.kind +
-                       "' (rename the field to '" + d.kind + "' or change the kind)");
+    d.kind = *parsedKind;
+    for (const DeviceKind otherKind : kFileKinds) {
+        const std::string other(name(otherKind));
+        if (otherKind != d.kind && j.contains(other)) {
+            w.fail(path / other.c_str(), "settings for kind '" + other + "' on a device of kind '" +
+                                             kind + "' (rename the field to '" + kind +
+                                             "' or change the kind)");
         }
     }
     if (const Json* v = optional(j, "rate_hz")) {
@@ -240,19 +245,25 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
     if (const Json* v = optional(j, "transform")) {
         d.transform = parseTransform(w, *v, path / "transform");
     }
-    const Json* params = optional(j, d.kind.c_str());
-    const Path ppath = path / d.kind.c_str();
-    if (d.kind == "sim") {
+    const Json* params = optional(j, kind.c_str());
+    const Path ppath = path / kind.c_str();
+    switch (d.kind) {
+    case DeviceKind::Sim:
         d.params = params ? parseSim(w, *params, ppath) : SimConfig{};
-    } else if (d.kind == "replay") {
+        break;
+    case DeviceKind::Replay:
         if (!params) {
             w.fail(path, "a replay device needs \"replay\": {\"trace\": \"FILE\"}");
         }
         d.params = parseReplay(w, *params, ppath);
-    } else if (d.kind == "falcon") {
+        break;
+    case DeviceKind::Falcon:
         d.params = parseFalcon(w, params ? *params : Json::object(), ppath, d.rateHz);
-    } else {
+        break;
+    case DeviceKind::Phantom:
+    case DeviceKind::Scripted: // parseDeviceKind never gives it
         d.params = parsePhantom(w, params ? *params : Json::object(), ppath, d.rateHz);
+        break;
     }
     return d;
 }
@@ -324,17 +335,17 @@ std::vector<DeviceConfig> loadDeviceConfigFile(const std::filesystem::path& path
 std::vector<DeviceConfig> defaultDeviceConfigs() {
     std::vector<DeviceConfig> out(2);
     out[0].name = "left";
-    out[0].kind = "sim";
+    out[0].kind = DeviceKind::Sim;
     out[0].transform.translation = Vec3(-0.02, 0.0, 0.0);
     SimConfig left;
-    left.script = "slide";
+    left.script = HandScript::Slide;
     left.seed = 1;
     out[0].params = left;
     out[1].name = "right";
-    out[1].kind = "sim";
+    out[1].kind = DeviceKind::Sim;
     out[1].transform.translation = Vec3(0.02, 0.0, 0.0);
     SimConfig right;
-    right.script = "touch";
+    right.script = HandScript::Touch;
     right.seed = 2;
     out[1].params = right;
     return out;

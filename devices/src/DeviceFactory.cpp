@@ -9,25 +9,27 @@
 namespace hapto {
 
 std::unique_ptr<Device> makeDevice(const DeviceConfig& config, const Scene& scene) {
-    if (config.kind == "sim") {
+    switch (config.kind) {
+    case DeviceKind::Sim:
         return std::make_unique<SimDevice>(config, scene);
-    }
-    if (config.kind == "replay") {
+    case DeviceKind::Replay:
         return std::make_unique<ReplayDevice>(config);
-    }
-    if (config.kind == "falcon") {
+    case DeviceKind::Falcon:
         return std::make_unique<FalconDevice>(config.name, std::get<FalconConfig>(config.params),
                                               config.maxForceN);
-    }
-    if (config.kind == "phantom") {
+    case DeviceKind::Phantom: {
         auto device = std::make_unique<PhantomDevice>(
             config.name, std::get<PhantomConfig>(config.params), config.maxForceN);
         // One HD scheduler tick per servo tick keeps the exchange latency at one period.
         device->setSchedulerRateHz(static_cast<unsigned long>(config.rateHz));
         return device;
     }
-    throw InputError("device '" + config.name + "': unknown kind \"" + config.kind +
-                     "\" (expected sim, replay, falcon or phantom)");
+    case DeviceKind::Scripted:
+        break;
+    }
+    throw InputError("device '" + config.name + "': kind \"" + std::string(name(config.kind)) +
+                     "\" is made by the program, not by makeDevice (expected sim, replay, falcon "
+                     "or phantom)");
 }
 
 } // namespace hapto

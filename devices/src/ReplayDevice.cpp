@@ -12,9 +12,10 @@ namespace {
 
 const ReplayConfig& replayOf(const DeviceConfig& config) {
     const auto* r = std::get_if<ReplayConfig>(&config.params);
-    if (config.kind != "replay" || !r) {
+    if (config.kind != DeviceKind::Replay || !r) {
         throw InputError("device '" + config.name +
-                         "': a replay device needs kind \"replay\" (got \"" + config.kind + "\")");
+                         "': a replay device needs kind \"replay\" (got \"" +
+                         std::string(name(config.kind)) + "\")");
     }
     return *r;
 }
@@ -100,7 +101,7 @@ DeviceStatus ReplayDevice::read(DeviceState& state) noexcept {
 
 void useTraceRates(std::span<DeviceConfig> configs) {
     for (DeviceConfig& c : configs) {
-        if (c.kind != "replay") {
+        if (c.kind != DeviceKind::Replay) {
             continue;
         }
         const std::filesystem::path& trace = replayOf(c).trace;

@@ -12,9 +12,10 @@ constexpr std::uint64_t kNoiseStream = 0x5EED0F5E45011AAull; // noise apart from
 
 const SimConfig& simOf(const DeviceConfig& config) {
     const auto* sim = std::get_if<SimConfig>(&config.params);
-    if (config.kind != "sim" || !sim) {
+    if (config.kind != DeviceKind::Sim || !sim) {
         throw InputError("device '" + config.name +
-                         "': a simulated device needs kind \"sim\" (got \"" + config.kind + "\")");
+                         "': a simulated device needs kind \"sim\" (got \"" +
+                         std::string(name(config.kind)) + "\")");
     }
     return *sim;
 }
@@ -38,7 +39,7 @@ SimDevice::SimDevice(const DeviceConfig& config, const Scene& scene)
 
 DeviceCapabilities SimDevice::capabilities() const {
     DeviceCapabilities c;
-    c.model = "simulated hand (" + mSim.script + ")";
+    c.model = "simulated hand (" + std::string(hapto::name(mSim.script)) + ")";
     Aabb box = Aabb::empty();
     const Aabb& b = mScene->bounds();
     for (int i = 0; i < 8; ++i) {

@@ -237,7 +237,7 @@ void approach(Builder& plan, const Scene& scene, const Vec3& to) {
 std::uint32_t chosenSlot(const SimConfig& config, const Scene& scene) {
     const auto slot = scene.slotOf(*config.object);
     if (!slot) {
-        throw InputError("sim script '" + config.script + "': object " +
+        throw InputError("sim script '" + std::string(name(config.script)) + "': object " +
                          std::to_string(*config.object) +
                          " is not in the scene (check \"object\" in the sim settings)");
     }
@@ -342,7 +342,7 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
     const double cap = config.maxSpeedMPerS;
     const double depth = config.pressForceN / config.handStiffness;
 
-    if (config.script == "walk") {
+    if (config.script == HandScript::Walk) {
         // Hops of 1..12 cm in random directions at random peak speeds up to 90 % of the cap
         // (the critically damped hand never outruns its target), now and then a pause.
         const Aabb& b = scene.bounds();
@@ -362,7 +362,7 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
             }
         }
         plan.moveAt(first, 0.5 * cap, ScriptPhase::Move);
-    } else if (config.script == "free") {
+    } else if (config.script == HandScript::Free) {
         // A random waypoint walk near the start, every segment checked against the solids with
         // a margin; played forwards then backwards, so it loops without a new check.
         const Aabb& b = scene.bounds();
@@ -397,7 +397,7 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
             plan.moveTo(i == 0 ? startWorld : legs[i - 1].first, legs[i].second, ScriptPhase::Move);
         }
         loopStart = 0;
-    } else if (config.script == "touch" || config.script == "slide") {
+    } else if (config.script == HandScript::Touch || config.script == HandScript::Slide) {
         const std::optional<std::uint32_t> slot = config.object
                                                       ? std::optional(chosenSlot(config, scene))
                                                       : nearestSurface(scene, startWorld);
@@ -411,7 +411,7 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
             approach(plan, scene, sp.point + sp.normal * kStandOffM);
             const Vec3 pressed = sp.point - sp.normal * depth;
             plan.moveAt(pressed, kPressSpeed, ScriptPhase::Press);
-            if (config.script == "touch") {
+            if (config.script == HandScript::Touch) {
                 plan.hold(0.5, ScriptPhase::Hold);
             } else {
                 const double speed = std::min(kSlideSpeed, cap);
@@ -459,7 +459,7 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
                 }
             }
         }
-    } else if (config.script == "grasp-left" || config.script == "grasp-right") {
+    } else if (config.script == HandScript::GraspLeft || config.script == HandScript::GraspRight) {
         // The object nearest `near` whose both sides a hand can reach (both hands decide the
         // same way, sharing nothing); the nearest one when none can be reached cleanly.
         std::optional<std::uint32_t> slot;
@@ -490,7 +490,7 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
         } else {
             const SceneObject& o = scene.object(*slot);
             object = o.id;
-            const double side = config.script == "grasp-left" ? -1.0 : 1.0;
+            const double side = config.script == HandScript::GraspLeft ? -1.0 : 1.0;
             const Vec3 out(side, 0.0, 0.0);
             const Vec3 surface = o.center + out * surfaceAlong(o, out);
             contactNormal = out;
@@ -527,7 +527,7 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
             plan.hold(0.5, ScriptPhase::Done);
         }
     } else {
-        throw InputError("unknown sim script '" + config.script +
+        throw InputError("unknown sim script '" + std::string(name(config.script)) +
                          "' (expected free, touch, slide, walk, grasp-left or grasp-right)");
     }
 

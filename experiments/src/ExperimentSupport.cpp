@@ -75,11 +75,11 @@ double WarmedSimDevice::warmUp(double settleS, double maxS) {
         throw std::runtime_error("simulated hand '" + mConfig.name +
                                  "' did not open: " + mSim.errorMessage());
     }
-    const std::string& script = mSim.simConfig().script;
+    const HandScript script = mSim.simConfig().script;
     ScriptPhase measured;
-    if (script == "touch") {
+    if (script == HandScript::Touch) {
         measured = ScriptPhase::Hold;
-    } else if (script == "slide") {
+    } else if (script == HandScript::Slide) {
         measured = ScriptPhase::Slide;
     } else {
         return 0.0;
@@ -276,10 +276,10 @@ DeviceConfig simHand(const std::string& name, double rateHz, std::string_view sc
                      std::uint64_t seed, const Vec3& start) {
     DeviceConfig c;
     c.name = name;
-    c.kind = "sim";
+    c.kind = DeviceKind::Sim;
     c.rateHz = rateHz;
     SimConfig sim;
-    sim.script = std::string(script);
+    sim.script = parseHandScript(script).value(); // callers pass a known script
     sim.seed = seed;
     sim.start = start;
     c.params = sim;

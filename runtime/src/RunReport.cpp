@@ -39,7 +39,7 @@ RunReport Runtime::report() const {
         const DeviceMetrics& m = ch.metrics;
         DeviceReport d;
         d.name = c.rd.config.name;
-        d.kind = c.rd.config.kind;
+        d.kind = std::string(name(c.rd.config.kind));
         d.rateHz = c.rd.config.rateHz;
         d.ticks = m.ticks.load();
         HistogramSummary t = m.tickNs.summary();

@@ -52,7 +52,7 @@ TEST_CASE("the README dual-device example loads with its values") {
     CHECK(configs[0].name == "left");
     CHECK(configs[1].name == "right");
     for (const DeviceConfig& c : configs) {
-        CHECK(c.kind == "sim");
+        CHECK(c.kind == DeviceKind::Sim);
         CHECK(c.rateHz == 1000.0);
         CHECK(c.maxForceN == 8.5);
         CHECK(c.transform.scale == 1.0);
@@ -60,8 +60,8 @@ TEST_CASE("the README dual-device example loads with its values") {
     }
     CHECK(configs[0].transform.translation == Vec3(-0.02, 0, 0));
     CHECK(configs[1].transform.translation == Vec3(0.02, 0, 0));
-    CHECK(std::get<SimConfig>(configs[0].params).script == "grasp-left");
-    CHECK(std::get<SimConfig>(configs[1].params).script == "grasp-right");
+    CHECK(std::get<SimConfig>(configs[0].params).script == HandScript::GraspLeft);
+    CHECK(std::get<SimConfig>(configs[1].params).script == HandScript::GraspRight);
     CHECK(std::get<SimConfig>(configs[1].params).seed == 2);
 }
 
@@ -90,7 +90,7 @@ TEST_CASE("defaults apply to a minimal device") {
     CHECK(c.maxForceN == 0.0);
     CHECK(c.transform.translation == Vec3(0.0));
     const SimConfig& s = std::get<SimConfig>(c.params);
-    CHECK(s.script == "walk");
+    CHECK(s.script == HandScript::Walk);
     CHECK(s.seed == 1);
     CHECK(s.handStiffness == 300.0);
     CHECK_FALSE(s.object.has_value());
@@ -106,7 +106,7 @@ TEST_CASE("every sim field parses") {
           "noise_m": 0})"),
         "all.json");
     const SimConfig& s = std::get<SimConfig>(configs[0].params);
-    CHECK(s.script == "slide");
+    CHECK(s.script == HandScript::Slide);
     CHECK(s.seed == 18446744073709551615ull);
     CHECK(s.start == Vec3(0.01, 0, 0));
     CHECK(s.object == 7u);
@@ -293,7 +293,7 @@ TEST_CASE("the default devices are two simulated hands side by side in the clear
     CHECK(configs[1].transform.translation == Vec3(0.02, 0, 0));
     const Scene scene = makeDefaultScene();
     for (const DeviceConfig& c : configs) {
-        CHECK(c.kind == "sim");
+        CHECK(c.kind == DeviceKind::Sim);
         CHECK(c.rateHz == 1000.0);
         const Vec3 start = c.transform.positionToWorld(std::get<SimConfig>(c.params).start);
         for (const SceneObject& o : scene.objects()) {
@@ -309,12 +309,12 @@ TEST_CASE("the factory makes every kind, and hardware kinds fail at open, not be
     const Scene scene = makeDefaultScene();
     DeviceConfig c = defaultDeviceConfigs()[0];
     CHECK(dynamic_cast<SimDevice*>(makeDevice(c, scene).get()) != nullptr);
-    c.kind = "falcon";
+    c.kind = DeviceKind::Falcon;
     c.params = FalconConfig{};
     auto falcon = makeDevice(c, scene);
     CHECK(dynamic_cast<FalconDevice*>(falcon.get()) != nullptr);
-    CHECK(falcon->kind() == "falcon");
-    c.kind = "phantom";
+    CHECK(falcon->kind() == DeviceKind::Falcon);
+    c.kind = DeviceKind::Phantom;
     PhantomConfig phantom;
     phantom.library = "libHD-that-does-not-exist.so";
     c.params = phantom;
@@ -322,11 +322,28 @@ TEST_CASE("the factory makes every kind, and hardware kinds fail at open, not be
     CHECK(dynamic_cast<PhantomDevice*>(ph.get()) != nullptr);
     CHECK(ph->open() != DeviceStatus::Ok); // no OpenHaptics here: a clear error, no throw
     CHECK_THAT(ph->errorMessage(), Catch::Contains("libHD-that-does-not-exist.so"));
-    c.kind = "gamepad";
+    c.kind = DeviceKind::Scripted; // made by the program, never by the factory
     CHECK_THROWS_AS(makeDevice(c, scene), InputError);
-    c.kind = "sim";
+    c.kind = DeviceKind::Sim;
     SimConfig sim;
     sim.object = 123456;
     c.params = sim;
     CHECK_THROWS_WITH(makeDevice(c, scene), Catch::Contains("123456"));
+}
+
+TEST_CASE("device kinds and hand scripts: parsed once, printed back the same") {
+    for (const DeviceKind k :
+         {DeviceKind::Sim, DeviceKind::Replay, DeviceKind::Falcon, DeviceKind::Phantom}) {
+        CHECK(parseDeviceKind(name(k)) == k);
+    }
+    CHECK(name(DeviceKind::Scripted) == "scripted");
+    CHECK_FALSE(parseDeviceKind("scripted").has_value()); // never from a file
+    CHECK_FALSE(parseDeviceKind("Sim").has_value());
+    CHECK_FALSE(parseDeviceKind("").has_value());
+    for (const HandScript s : {HandScript::Free, HandScript::Touch, HandScript::Slide,
+                               HandScript::Walk, HandScript::GraspLeft, HandScript::GraspRight}) {
+        CHECK(parseHandScript(name(s)) == s);
+    }
+    CHECK(name(HandScript::GraspLeft) == "grasp-left");
+    CHECK_FALSE(parseHandScript("dance").has_value());
 }

@@ -133,7 +133,7 @@ TEST_CASE("a phantom opens by name or the default, and a wrong name is an error 
     FakeHd fake;
     {
         PhantomDevice dev("left", fakeConfig(""), 0.0);
-        CHECK(dev.kind() == "phantom");
+        CHECK(dev.kind() == DeviceKind::Phantom);
         CHECK(dev.name() == "left");
         REQUIRE(dev.open() == DeviceStatus::Ok);
         CHECK(fake.isInitialised(kDefault) == 1);

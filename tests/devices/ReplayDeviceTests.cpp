@@ -17,7 +17,7 @@ namespace {
 DeviceConfig replayConfig(const std::filesystem::path& trace, bool loop) {
     DeviceConfig c;
     c.name = "again";
-    c.kind = "replay";
+    c.kind = DeviceKind::Replay;
     ReplayConfig r;
     r.trace = trace;
     r.loop = loop;
@@ -65,7 +65,7 @@ TEST_CASE("replay: plays back the recorded positions tick by tick, then stalls")
     const Scene scene;
     auto device = makeDevice(replayConfig(dir / "left.trace", false), scene);
     auto& replay = dynamic_cast<ReplayDevice&>(*device);
-    CHECK(replay.kind() == "replay");
+    CHECK(replay.kind() == DeviceKind::Replay);
     CHECK(replay.traceHeader().name == "left");
     CHECK(replay.capabilities().nominalRateHz == 1000.0);
     DeviceState s;

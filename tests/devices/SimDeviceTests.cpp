@@ -12,14 +12,13 @@ using namespace hapto;
 
 namespace {
 
-DeviceConfig simConfig(const std::string& script, std::uint64_t seed,
-                       Vec3 translation = Vec3(0.0)) {
+DeviceConfig simConfig(std::string_view script, std::uint64_t seed, Vec3 translation = Vec3(0.0)) {
     DeviceConfig c;
     c.name = "hand";
-    c.kind = "sim";
+    c.kind = DeviceKind::Sim;
     c.transform.translation = translation;
     SimConfig s;
-    s.script = script;
+    s.script = parseHandScript(script).value();
     s.seed = seed;
     c.params = s;
     return c;

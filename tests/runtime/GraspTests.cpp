@@ -77,7 +77,7 @@ struct GraspRig {
         for (int i = 0; i < 2; ++i) {
             DeviceConfig c;
             c.name = names[i];
-            c.kind = "scripted";
+            c.kind = DeviceKind::Scripted;
             c.maxForceN = 8.5;
             rds.push_back({std::make_unique<ScriptedDevice>(names[i], paths[i]), c, nullptr});
         }

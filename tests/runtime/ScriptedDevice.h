@@ -51,7 +51,7 @@ public:
     void setOpenTakes(std::uint64_t ns) { mOpenNs = ns; }
 
     std::string_view name() const override { return mName; }
-    std::string_view kind() const override { return "scripted"; }
+    DeviceKind kind() const override { return DeviceKind::Scripted; }
     DeviceCapabilities capabilities() const override {
         return {"scripted test device", Aabb{Vec3(-1), Vec3(1)}, 10.0, 0.0, 1000.0, 0};
     }

@@ -59,7 +59,7 @@ TEST_CASE("a servo thread starved by a CPU hog gets zero force when it runs agai
         hands.push_back(d.get());
         DeviceConfig c;
         c.name = d->name();
-        c.kind = "scripted";
+        c.kind = DeviceKind::Scripted;
         c.rateHz = 1000.0;
         rds.push_back({std::move(d), c, nullptr});
     }

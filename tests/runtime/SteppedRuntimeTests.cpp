@@ -57,7 +57,7 @@ struct Rig {
             devices.push_back(d.get());
             DeviceConfig c;
             c.name = "d" + std::to_string(i);
-            c.kind = "scripted";
+            c.kind = DeviceKind::Scripted;
             c.rateHz = rateHz;
             c.maxForceN = 5.0;
             rds.push_back({std::move(d), c,

@@ -83,7 +83,7 @@ struct Rig {
             injectors.push_back(wrapped.get());
             DeviceConfig c;
             c.name = "d" + std::to_string(i);
-            c.kind = "scripted";
+            c.kind = DeviceKind::Scripted;
             c.rateHz = 1000.0;
             rds.push_back({std::move(wrapped), c, nullptr});
         }

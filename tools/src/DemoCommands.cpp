@@ -42,11 +42,11 @@ struct DemoArgs {
 std::vector<DeviceConfig> graspHands(ObjectId object) {
     std::vector<DeviceConfig> hands(2);
     const char* names[2] = {"left", "right"};
-    const char* scripts[2] = {"grasp-left", "grasp-right"};
+    const HandScript scripts[2] = {HandScript::GraspLeft, HandScript::GraspRight};
     const Vec3 starts[2] = {Vec3(-0.12, -0.04, 0.0), Vec3(0.04, -0.04, 0.0)};
     for (int i = 0; i < 2; ++i) {
         hands[i].name = names[i];
-        hands[i].kind = "sim";
+        hands[i].kind = DeviceKind::Sim;
         hands[i].transform.translation = starts[i];
         SimConfig sim;
         sim.script = scripts[i];

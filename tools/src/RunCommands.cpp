@@ -106,7 +106,7 @@ int runSession(const RunArgs& a) {
         if (!a.record.empty()) {
             TraceHeader header;
             header.rateHz = c.rateHz;
-            header.kind = c.kind;
+            header.kind = std::string(name(c.kind));
             header.name = c.name;
             header.startUnixNs =
                 static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(

@@ -25,10 +25,10 @@ static std::vector<DeviceConfig> simulatedHands() {
     std::vector<DeviceConfig> hands(2);
     for (int i = 0; i < 2; ++i) {
         hands[i].name = i == 0 ? "left" : "right";
-        hands[i].kind = "sim";
+        hands[i].kind = DeviceKind::Sim;
         hands[i].transform.translation = i == 0 ? Vec3(-0.12, -0.04, 0) : Vec3(0.04, -0.04, 0);
         SimConfig sim;
-        sim.script = i == 0 ? "grasp-left" : "grasp-right";
+        sim.script = i == 0 ? HandScript::GraspLeft : HandScript::GraspRight;
         sim.object = 0;        // the cube
         sim.pressForceN = 2.0; // squeeze (N)
         hands[i].params = sim;

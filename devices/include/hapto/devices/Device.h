@@ -2,6 +2,7 @@
 /// The Device interface: what a servo thread reads from and writes to a force-feedback device.
 
 #include "hapto/core/Geometry.h"
+#include "hapto/devices/DeviceKind.h"
 
 #include <cstdint>
 #include <string>
@@ -50,8 +51,8 @@ public:
 
     /// The name from the configuration ("left", "right"). [any thread]
     virtual std::string_view name() const = 0;
-    /// The configuration kind ("sim", "replay", "falcon", "phantom"). [any thread]
-    virtual std::string_view kind() const = 0;
+    /// The configuration kind; name(kind()) prints it. [any thread]
+    virtual DeviceKind kind() const = 0;
     /// Workspace, limits, rate. [control]
     virtual DeviceCapabilities capabilities() const = 0;
 

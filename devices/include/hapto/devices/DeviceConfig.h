@@ -2,7 +2,9 @@
 /// The device configuration file (`--devices D.json`): which devices, where, how fast, how hard.
 
 #include "hapto/core/Geometry.h"
+#include "hapto/devices/DeviceKind.h"
 #include "hapto/devices/FalconKinematics.h"
+#include "hapto/devices/HandScript.h"
 
 #include <cstdint>
 #include <filesystem>
@@ -39,9 +41,9 @@ struct WorkspaceTransform {
 /// holds the device; see SimDevice. Scripts work in the world frame (m); the hand lives in the
 /// device frame. Every default below is what a missing JSON field gives.
 struct SimConfig {
-    std::string script = "walk"; ///< free, touch, slide, walk, grasp-left, grasp-right.
-    std::uint64_t seed = 1;      ///< Same seed, scene and configuration, same motion, bit for bit.
-    Vec3 start{0.0};             ///< Where the hand starts, device frame (m). JSON `start`.
+    HandScript script = HandScript::Walk; ///< What the hand does. JSON `script`.
+    std::uint64_t seed = 1; ///< Same seed, scene and configuration, same motion, bit for bit.
+    Vec3 start{0.0};        ///< Where the hand starts, device frame (m). JSON `start`.
     std::optional<std::uint32_t> object; ///< Object id to touch, slide on or grasp; none = the
                                          ///< nearest (touch, slide) or the one nearest `near`
                                          ///< (grasp). JSON `object`.
@@ -106,11 +108,11 @@ inline constexpr int kDeviceConfigFormatVersion = 1;
 
 /// One configured device.
 struct DeviceConfig {
-    std::string name;             ///< Unique name: 1..63 of [A-Za-z0-9_-] ("left", "right").
-    std::string kind;             ///< "sim", "replay", "falcon" or "phantom".
-    WorkspaceTransform transform; ///< Device frame into the world.
-    double maxForceN = 0.0;       ///< Force clamp (N); 0 = the device's own maximum.
-    double rateHz = 1000.0;       ///< Servo rate (Hz), 100..100000. A replay uses its trace's.
+    std::string name;                  ///< Unique name: 1..63 of [A-Za-z0-9_-] ("left", "right").
+    DeviceKind kind = DeviceKind::Sim; ///< What drives it. JSON `kind`.
+    WorkspaceTransform transform;      ///< Device frame into the world.
+    double maxForceN = 0.0;            ///< Force clamp (N); 0 = the device's own maximum.
+    double rateHz = 1000.0;            ///< Servo rate (Hz), 100..100000. A replay uses its trace's.
     std::variant<SimConfig, ReplayConfig, FalconConfig, PhantomConfig> params; ///< Per kind.
 };
 

@@ -81,7 +81,7 @@ public:
     /// The configured name. [any thread]
     std::string_view name() const override;
     /// "falcon". [any thread]
-    std::string_view kind() const override { return "falcon"; }
+    DeviceKind kind() const override { return DeviceKind::Falcon; }
     /// Model, workspace (m, centred), max force (N), 1 kHz, 4 buttons. [control]
     DeviceCapabilities capabilities() const override;
 

@@ -44,7 +44,7 @@ public:
     Device& inner() noexcept { return *mInner; }
 
     std::string_view name() const override { return mInner->name(); }
-    std::string_view kind() const override { return mInner->kind(); }
+    DeviceKind kind() const override { return mInner->kind(); }
     DeviceCapabilities capabilities() const override { return mInner->capabilities(); }
     DeviceStatus open() override;
     void close() override { mInner->close(); }

@@ -89,7 +89,7 @@ public:
     /// The configured name. [any thread]
     std::string_view name() const override { return mName; }
     /// "phantom". [any thread]
-    std::string_view kind() const override { return "phantom"; }
+    DeviceKind kind() const override { return DeviceKind::Phantom; }
     /// Model, usable workspace (m), force limit (N), nominal stiffness (N/m), rate (Hz), 2
     /// buttons; the HD values are known after open(). [control]
     DeviceCapabilities capabilities() const override;

@@ -24,7 +24,7 @@ public:
     explicit ReplayDevice(const DeviceConfig& config);
 
     std::string_view name() const override { return mConfig.name; }
-    std::string_view kind() const override { return "replay"; }
+    DeviceKind kind() const override { return DeviceKind::Replay; }
     /// Workspace: the recorded positions' bounds; max force: the configured one, else the
     /// largest recorded; rate: the trace's. [control]
     DeviceCapabilities capabilities() const override;

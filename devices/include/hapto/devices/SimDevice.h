@@ -27,7 +27,7 @@ public:
     SimDevice(const DeviceConfig& config, const Scene& scene);
 
     std::string_view name() const override { return mConfig.name; }
-    std::string_view kind() const override { return "sim"; }
+    DeviceKind kind() const override { return DeviceKind::Sim; }
     /// Workspace: the scene bounds, in the device frame, grown by 5 cm; max force: the
     /// configured one, else 10 N. [control]
     DeviceCapabilities capabilities() const override;

@@ -98,7 +98,7 @@ public:
     bool reachedPhase() const { return mReached; }
 
     std::string_view name() const override { return mSim.name(); }
-    std::string_view kind() const override { return mSim.kind(); }
+    DeviceKind kind() const override { return mSim.kind(); }
     DeviceCapabilities capabilities() const override { return mSim.capabilities(); }
     /// Opens the hand unless warmUp() already did. [control]
     DeviceStatus open() override;
