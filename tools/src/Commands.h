@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <string>
+#include <vector>
 
 namespace hapto::cli {
 
@@ -39,8 +40,16 @@ void addExperimentCommands(CLI::App& app);
 /// [control]
 void addSoakCommands(CLI::App& app);
 
+/// `hapto render`: one device point along a path through the haptic tick, as CSV. [control]
+void addRenderCommands(CLI::App& app);
+
 /// Loads `path`, or the embedded default scene when it is empty. Throws InputError. [control]
 Scene loadSceneOrDefault(const std::string& path);
+
+/// Reads `x,y,z` lines (m), with an optional `x,y,z` header line; blank lines are skipped.
+/// Only a regular file of at most kMaxInputFileBytes is read (InputFile, which names it as
+/// `what`); a bad line is InputError naming path:line. [control]
+std::vector<Vec3> readPoints(const std::string& path, const std::string& what);
 
 /// Parses a non-negative count such as "1000000" or "1e6"; throws InputError naming the option.
 std::size_t parseCount(const std::string& text, const std::string& option);

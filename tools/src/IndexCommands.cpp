@@ -38,10 +38,10 @@ std::string_view trim(std::string_view s) {
     return s;
 }
 
-/// Reads `x,y,z` lines (m), with an optional `x,y,z` header; blank lines are skipped. Only a
-/// regular file of at most kMaxInputFileBytes is read (InputFile).
-std::vector<Vec3> readPoints(const std::string& path) {
-    const std::string all = InputFile(path, "points file").readAll();
+} // namespace
+
+std::vector<Vec3> readPoints(const std::string& path, const std::string& what) {
+    const std::string all = InputFile(path, what).readAll();
     std::vector<Vec3> points;
     std::size_t lineStart = 0;
     for (std::size_t number = 1; lineStart < all.size(); ++number) {
@@ -82,6 +82,8 @@ std::vector<Vec3> readPoints(const std::string& path) {
     return points;
 }
 
+namespace {
+
 void runQuery(const std::string& scenePath, const std::string& specText,
               const std::string& pointsPath, const std::string& outPath, std::uint64_t maxIndexMb) {
     const IndexSpec spec = IndexSpec::parse(specText).withMaxMegabytes(maxIndexMb);
@@ -90,7 +92,7 @@ void runQuery(const std::string& scenePath, const std::string& specText,
         refuseSameFile(outPath, "-o", pointsPath, "--points");
         checkOutputFile(outPath, "-o");
     }
-    const std::vector<Vec3> points = readPoints(pointsPath);
+    const std::vector<Vec3> points = readPoints(pointsPath, "points file");
     const Scene scene = loadSceneOrDefault(scenePath);
     const std::unique_ptr<SpatialIndex> index = buildIndex(scene, spec);
 

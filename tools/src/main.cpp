@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
     hapto::cli::addDemoCommands(app);
     hapto::cli::addBenchCommands(app);
     hapto::cli::addIndexCommands(app);
+    hapto::cli::addRenderCommands(app);
     hapto::cli::addTraceCommands(app);
     hapto::cli::addExperimentCommands(app);
     hapto::cli::addSoakCommands(app);
