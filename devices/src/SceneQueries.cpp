@@ -1,18 +1,16 @@
 #include "SceneQueries.h"
 
+#include "hapto/core/ShapeGeometry.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace hapto::detail {
 
 double signedDistance(const SceneObject& object, const Vec3& p) {
-    if (object.shape == Shape::Sphere) {
-        return glm::length(p - object.center) - object.halfExtents.x;
-    }
-    const Obb box = object.obb();
-    const Vec3 q = glm::abs(box.toLocal(p)) - box.halfExtents;
-    const Vec3 outside = glm::max(q, Vec3(0.0));
-    return glm::length(outside) + std::min(std::max({q.x, q.y, q.z}), 0.0);
+    return object.shape == Shape::Sphere
+               ? sphereSignedDistance(object.center, object.halfExtents.x, p)
+               : boxSignedDistance(object.obb(), p);
 }
 
 SurfacePoint contactPoint(const SceneObject& object, const Vec3& p, double edgeMarginM) {
@@ -25,15 +23,7 @@ SurfacePoint contactPoint(const SceneObject& object, const Vec3& p, double edgeM
     const Obb box = object.obb();
     const Vec3 l = box.toLocal(p);
     // The face whose plane p lies farthest beyond (or, inside, the nearest face).
-    int axis = 0;
-    double best = -1e300;
-    for (int i = 0; i < 3; ++i) {
-        const double sep = std::abs(l[i]) - box.halfExtents[i];
-        if (sep > best) {
-            best = sep;
-            axis = i;
-        }
-    }
+    const int axis = dominantFaceAxis(l, box.halfExtents);
     Vec3 local(0.0);
     for (int i = 0; i < 3; ++i) {
         if (i == axis) {

@@ -38,6 +38,7 @@
 #include "hapto/runtime/GodObjectRenderer.h"
 
 #include "hapto/core/Finite.h"
+#include "hapto/core/ShapeGeometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -153,25 +154,16 @@ Entry sweepSphere(const Vec3& center, double radius, const Vec3& from, const Vec
 
 /// True when p is inside the object's shrunk skin (strictly).
 bool insideSkin(const SceneObject& o, const Vec3& p) {
-    if (o.shape == Shape::Sphere) {
-        const double r = o.halfExtents.x + kSkinM - kShrinkM;
-        return length2(p - o.center) < r * r;
-    }
-    const Obb obb = o.obb();
-    const Vec3 l = glm::abs(obb.toLocal(p));
-    const Vec3 h = obb.halfExtents + Vec3(kSkinM - kShrinkM);
-    return l.x < h.x && l.y < h.y && l.z < h.z;
+    return o.shape == Shape::Sphere
+               ? sphereStrictlyContains(o.center, o.halfExtents.x + kSkinM - kShrinkM, p)
+               : boxStrictlyContains(o.obb(), p, kSkinM - kShrinkM);
 }
 
 /// Distance (m) from p to the object's skin, 0 inside.
 double distanceToSkin(const SceneObject& o, const Vec3& p) {
-    if (o.shape == Shape::Sphere) {
-        return std::max(0.0, glm::length(p - o.center) - (o.halfExtents.x + kSkinM));
-    }
-    const Obb obb = o.obb();
-    const Vec3 l = obb.toLocal(p);
-    const Vec3 h = obb.halfExtents + Vec3(kSkinM);
-    return glm::length(l - glm::clamp(l, -h, h));
+    return o.shape == Shape::Sphere
+               ? std::max(0.0, sphereSignedDistance(o.center, o.halfExtents.x + kSkinM, p))
+               : boxDistanceOutside(o.obb(), p, kSkinM);
 }
 
 /// The nearest point on the object's skin to an inside point p.
@@ -184,15 +176,7 @@ Vec3 pushOut(const SceneObject& o, const Vec3& p) {
     }
     const Obb obb = o.obb();
     Vec3 l = obb.toLocal(p);
-    int best = 0;
-    double bestGap = kInf;
-    for (int i = 0; i < 3; ++i) {
-        const double gap = obb.halfExtents[i] + kSkinM - std::abs(l[i]);
-        if (gap < bestGap) {
-            bestGap = gap;
-            best = i;
-        }
-    }
+    const int best = dominantFaceAxis(l, obb.halfExtents + Vec3(kSkinM)); // the nearest face
     l[best] = (l[best] < 0.0 ? -1.0 : 1.0) * (obb.halfExtents[best] + kSkinM);
     return obb.center + obb.axes * l;
 }

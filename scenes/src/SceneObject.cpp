@@ -1,5 +1,7 @@
 #include "hapto/scenes/SceneObject.h"
 
+#include "hapto/core/ShapeGeometry.h"
+
 #include <glm/gtc/quaternion.hpp>
 
 namespace hapto {
@@ -33,11 +35,7 @@ Aabb SceneObject::aabb() const {
 }
 
 bool SceneObject::contains(const Vec3& p) const {
-    if (shape == Shape::Sphere) {
-        const Vec3 d = p - center;
-        return glm::dot(d, d) <= halfExtents.x * halfExtents.x;
-    }
-    return obb().contains(p);
+    return shape == Shape::Sphere ? sphereContains(center, halfExtents.x, p) : obb().contains(p);
 }
 
 SceneObject makeBox(ObjectId id, Vec3 center, Vec3 halfExtents, Quat rotation, Material material) {

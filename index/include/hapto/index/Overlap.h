@@ -1,5 +1,6 @@
 #pragma once
-/// Conservative overlap tests between object bounds and index cells (separating-axis theorem).
+/// Conservative overlap tests between object bounds and index cells, over the separating-axis
+/// tests of hapto/core/ShapeGeometry.h.
 ///
 /// Every test here may say "overlap" for a pair that is separated by a hair (a tolerance scaled
 /// to the sizes and positions involved), and never says "separated" for a pair that overlaps:
@@ -7,6 +8,7 @@
 /// Touching counts as overlap.
 
 #include "hapto/core/Geometry.h"
+#include "hapto/core/ShapeGeometry.h"
 #include "hapto/scenes/SceneObject.h"
 
 #include <cstdint>
@@ -15,14 +17,6 @@ namespace hapto {
 
 /// Which bounds place objects into cells: the tight oriented box, or the world AABB.
 enum class OverlapMode : std::uint8_t { Obb, Aabb };
-
-/// Relative tolerance of every test: separation must exceed this times the sizes and distances
-/// from the origin involved (m), so rounding never hides an overlap.
-inline constexpr double kOverlapTolerance = 1e-9;
-
-/// Added to every |cos| between box axes, so near-parallel edges (whose cross product is a
-/// nearly null, badly rounded axis) never produce a false separation (Gottschalk et al. 1996).
-inline constexpr double kParallelEpsilon = 1e-9;
 
 /// An object's bounds, prepared once for many cell tests.
 struct OverlapShape {
@@ -45,19 +39,8 @@ struct OverlapCell {
     static OverlapCell of(const Aabb& box) noexcept;
 };
 
-/// Separating-axis test, all 15 axes, between two oriented boxes. Conservative. [any thread]
-bool overlapsObbObb(const Obb& a, const Obb& b) noexcept;
-
-/// Separating-axis test between an oriented box and an axis-aligned cell. Conservative.
-/// [any thread]
-bool overlapsObbAabb(const Obb& box, const Aabb& cell) noexcept;
-
-/// Exact sphere/box test (distance from the centre to the box <= radius), conservative by the
-/// tolerance. [any thread]
-bool overlapsSphereAabb(const Vec3& center, double radius, const Aabb& cell) noexcept;
-
-/// Closed AABB/AABB test widened by the tolerance. [any thread]
-bool overlapsAabbAabb(const Aabb& a, const Aabb& b) noexcept;
+// The separating-axis tests themselves (overlapsObbObb, overlapsObbAabb, overlapsSphereAabb,
+// overlapsAabbAabb) and their tolerances live in hapto/core/ShapeGeometry.h.
 
 /// Whether an object's bounds overlap a cell. Aabb mode: its world AABB. Obb mode: its AABB
 /// and then its OBB (boxes) or exact sphere (spheres), so Obb mode never places an object in
