@@ -104,7 +104,8 @@ int runPaper1(const Paper1Args& args) {
                      " median of " +
                      std::to_string(args.common.repeats) + " run(s) of " +
                      fmt(args.common.durationS, 2) +
-                     " s. UNSTABLE: p99.9 >= 100 % or > 0.1 % deadlines missed.\n";
+                     " s. UNSTABLE: " + std::string(tailName(options.servo.tail)) +
+                     " >= 100 % or > 0.1 % deadlines missed.\n";
     md += "\n" + platformNote(rows, args.verdict);
     for (const double rate : args.ratesHz) {
         for (const SweepRenderer& r : renderers) {

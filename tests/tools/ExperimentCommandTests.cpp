@@ -361,10 +361,10 @@ TEST_CASE("hapto experiment: bad arguments exit 2 with a message") {
     for (const std::string args : {
              "experiment paper1 --quick --rate abc",
              "experiment paper1 --quick --rate 50",
-             "experiment paper1 --quick --rate 1000,",
+             "experiment paper1 --quick --rate 1000,abc",
              "experiment paper1 --quick --max-per-side 1",
              "experiment paper1 --quick --duration 0",
-             "experiment paper2 --quick --counts 10,,20",
+             "experiment paper2 --quick --counts 10,2.5",
              "experiment paper2 --quick --counts 0",
              "experiment paper2 --quick --seeds 0",
              "experiment paper2 --quick --verdict strict",

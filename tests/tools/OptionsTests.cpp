@@ -1,11 +1,14 @@
-// The finite-range check every numeric option goes through (tools/src/Options.h), in process.
+// The checks numeric options go through (finiteRange, wholeNumber) and the realtime flag
+// (tools/src/Options.h), in process.
 
 #include "Options.h"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace hapto::cli;
@@ -49,4 +52,56 @@ TEST_CASE("finiteRange on integer options also catches negatives an unsigned opt
     CHECK_THAT(parse<int>("nan", 1, 32), Catch::Contains("--x"));
     CHECK_THAT(parse<int>("33", 1, 32), Catch::Contains("from 1 to 32"));
     CHECK(parse<int>("32", 1, 32).empty());
+}
+
+namespace {
+
+/// Parses `args` (in order) with a fresh app holding `--n` (a std::size_t read through
+/// wholeNumber) and `--list` (a comma-delimited std::vector<std::size_t>); the error or "".
+std::string parseWhole(std::vector<std::string> args, std::size_t& n,
+                       std::vector<std::size_t>& list) {
+    CLI::App app;
+    app.add_option("--n", n)->transform(wholeNumber(1, 1e8));
+    app.add_option("--list", list)->delimiter(',')->transform(wholeNumber(1, 1e8));
+    std::reverse(args.begin(), args.end()); // CLI11 takes them in reverse
+    try {
+        app.parse(args);
+    } catch (const CLI::ParseError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+} // namespace
+
+TEST_CASE("wholeNumber reads counts as numbers, with or without an exponent") {
+    std::size_t n = 0;
+    std::vector<std::size_t> list;
+    CHECK(parseWhole({"--n", "2e5"}, n, list).empty());
+    CHECK(n == 200000);
+    CHECK(parseWhole({"--n", "1000"}, n, list).empty());
+    CHECK(n == 1000);
+    CHECK(parseWhole({"--list", "10,20,1e3"}, n, list).empty());
+    CHECK(list == std::vector<std::size_t>{10, 20, 1000});
+    CHECK_THAT(parseWhole({"--n", "0"}, n, list), Catch::Contains("out of range"));
+    CHECK_THAT(parseWhole({"--n", "2.5"}, n, list), Catch::Contains("not a whole number"));
+    CHECK_THAT(parseWhole({"--n", "nan"}, n, list), Catch::Contains("--n"));
+    CHECK_THAT(parseWhole({"--n", "1e9"}, n, list), Catch::Contains("from 1 to 100000000"));
+    CHECK_THAT(parseWhole({"--list", "10,0"}, n, list), Catch::Contains("--list"));
+    // CLI11's list syntax skips empty items.
+    CHECK(parseWhole({"--list", "10,,20"}, n, list).empty());
+    CHECK(list == std::vector<std::size_t>{10, 20});
+    CHECK_THAT(parseWhole({"--list", "10,x"}, n, list), Catch::Contains("not a number"));
+}
+
+TEST_CASE("the realtime flag takes --realtime and --no-realtime") {
+    for (const auto& [args, expected] : std::vector<std::pair<std::vector<std::string>, bool>>{
+             {{}, true}, {{"--no-realtime"}, false}, {{"--realtime"}, true}}) {
+        CLI::App app;
+        bool realtime = true;
+        addRealtimeFlag(&app, realtime, "default: ask");
+        std::vector<std::string> reversed(args.rbegin(), args.rend());
+        app.parse(reversed);
+        CHECK(realtime == expected);
+    }
 }

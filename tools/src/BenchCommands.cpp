@@ -105,7 +105,7 @@ double clockOverheadNs() {
 struct QueryArgs {
     std::string scene;
     std::vector<std::string> indices;
-    std::string steps = "100000";
+    std::size_t steps = 100000;
     std::uint64_t seed = 1;
     std::size_t batch = 16;
     bool json = false;
@@ -121,10 +121,7 @@ void runQuery(const QueryArgs& args) {
     for (const std::string& t : texts) {
         targets.push_back(parseTarget(t));
     }
-    const std::size_t steps = parseCount(args.steps, "--steps");
-    if (steps == 0) {
-        throw InputError("--steps: expected at least 1 step, got 0");
-    }
+    const std::size_t steps = args.steps;
     const Scene scene = loadSceneOrDefault(args.scene);
 
     std::vector<std::unique_ptr<Run>> runs;
@@ -252,7 +249,8 @@ void addBenchCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(1, kMaxIndexMbOption));
     cmd->add_option("--steps", args->steps, "Walk steps (queries) per index, e.g. 1e5")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->transform(wholeNumber(1, 4e9));
     cmd->add_option("--seed", args->seed, "Walk seed; same seed, same walk")
         ->capture_default_str()
         ->check(finiteRange(0, kMaxSeed));

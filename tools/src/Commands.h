@@ -51,7 +51,4 @@ Scene loadSceneOrDefault(const std::string& path);
 /// `what`); a bad line is InputError naming path:line. [control]
 std::vector<Vec3> readPoints(const std::string& path, const std::string& what);
 
-/// Parses a non-negative count such as "1000000" or "1e6"; throws InputError naming the option.
-std::size_t parseCount(const std::string& text, const std::string& option);
-
 } // namespace hapto::cli

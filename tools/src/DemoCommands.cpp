@@ -246,7 +246,7 @@ void addDemoCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(1, kMaxIndexMbOption));
     cmd->add_option("--report", a->report, "Write a JSON report here");
-    cmd->add_flag("--realtime", a->realtime, "Ask for SCHED_FIFO for the servo threads");
+    addRealtimeFlag(cmd, a->realtime, "default: do not, the demo shares the machine");
     cmd->callback([a] { runDemo(*a); });
 }
 

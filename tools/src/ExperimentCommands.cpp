@@ -23,7 +23,6 @@ struct CommonOptions {
     CLI::Option* out = nullptr;
     CLI::Option* duration = nullptr;
     CLI::Option* repeats = nullptr;
-    bool noRealtime = false;
 };
 
 void addCommon(CLI::App* cmd, CommonArgs& a, CommonOptions& o, const std::string& name) {
@@ -43,13 +42,10 @@ void addCommon(CLI::App* cmd, CommonArgs& a, CommonOptions& o, const std::string
                                 "--quick: 1")
                     ->capture_default_str()
                     ->check(finiteRange(1, 99));
-    cmd->add_flag("--no-realtime", o.noRealtime,
-                  "Do not ask for SCHED_FIFO and CPU pinning (default: ask; the runtime falls "
-                  "back to normal scheduling when refused and says so)");
+    addRealtimeFlag(cmd, a.realtime, "default: ask");
 }
 
 void applyQuick(CommonArgs& a, const CommonOptions& o) {
-    a.realtime = !o.noRealtime;
     if (a.quick) {
         if (o.duration->count() == 0) {
             a.durationS = 0.15;
@@ -58,6 +54,17 @@ void applyQuick(CommonArgs& a, const CommonOptions& o) {
             a.repeats = 1;
         }
     }
+}
+
+/// `--rates HZ,HZ` (and its deprecated spelling `--rate`): servo rates, 100..100000 Hz each.
+CLI::Option* addRates(CLI::App* cmd, std::vector<double>& ratesHz, const std::string& note) {
+    return cmd
+        ->add_option("--rates,--rate", ratesHz,
+                     "Servo rates (Hz, 100..100000), comma-separated; " + note +
+                         " (--rate: the old spelling)")
+        ->capture_default_str()
+        ->delimiter(',')
+        ->check(finiteRange(100, 100000));
 }
 
 CLI::Option* addVerdict(CLI::App* cmd, std::string& verdict) {
@@ -84,7 +91,6 @@ void addExperimentCommands(CLI::App& app) {
     {
         auto a = std::make_shared<Paper1Args>();
         auto o = std::make_shared<CommonOptions>();
-        auto rates = std::make_shared<std::string>("1000");
         auto* cmd = exp->add_subcommand(
             "paper1",
             "Experiment 1: K x K x K lattices of 5 cm cubes (1 cm gaps) for growing K; renderers "
@@ -95,10 +101,7 @@ void addExperimentCommands(CLI::App& app) {
         addCommon(cmd, a->common, *o, "paper1");
         auto verdict = std::make_shared<std::string>("design");
         addVerdict(cmd, *verdict);
-        cmd->add_option("--rate", *rates,
-                        "Servo rate(s) (Hz, 100..100000), comma-separated for several, e.g. "
-                        "1000,10000")
-            ->capture_default_str();
+        addRates(cmd, a->ratesHz, "e.g. 1000,10000");
         auto* maxK = cmd->add_option("--max-per-side", a->maxPerSide,
                                      "Largest K (cubes per lattice side; K^3 objects); sizes "
                                      "2,3,4,5,6,8,10,13,16,20,25,32,40,50,64,80,100,... up to "
@@ -110,13 +113,12 @@ void addExperimentCommands(CLI::App& app) {
                         "would pass this (MB)")
             ->capture_default_str()
             ->check(finiteRange(1e-3, 1e9));
-        cmd->callback([a, o, rates, maxK, verdict] {
+        cmd->callback([a, o, maxK, verdict] {
             applyQuick(a->common, *o);
             a->verdict = parseVerdict(*verdict, "--verdict");
             if (a->common.quick && maxK->count() == 0) {
                 a->maxPerSide = 4;
             }
-            a->ratesHz = parseRates(*rates, "--rate");
             const int rc = runPaper1(*a);
             if (rc != 0) {
                 std::exit(rc);
@@ -127,8 +129,6 @@ void addExperimentCommands(CLI::App& app) {
     {
         auto a = std::make_shared<Paper2Args>();
         auto o = std::make_shared<CommonOptions>();
-        auto rates = std::make_shared<std::string>("1000");
-        auto counts = std::make_shared<std::string>("10,20,50,100,200,500");
         auto decades = std::make_shared<bool>(false);
         auto* cmd = exp->add_subcommand(
             "paper2",
@@ -139,9 +139,11 @@ void addExperimentCommands(CLI::App& app) {
         addCommon(cmd, a->common, *o, "paper2");
         auto verdict = std::make_shared<std::string>("design");
         addVerdict(cmd, *verdict);
-        auto* countsOpt = cmd->add_option("--counts", *counts,
+        auto* countsOpt = cmd->add_option("--counts", a->counts,
                                           "Objects per scene, comma-separated; --quick: 10,20,50")
-                              ->capture_default_str();
+                              ->capture_default_str()
+                              ->delimiter(',')
+                              ->transform(wholeNumber(1, 1e8));
         cmd->add_flag("--decades", *decades,
                       "Also 1000, 10000, 100000 and 1000000 objects (a renderer still stops "
                       "after its first unstable count)");
@@ -149,9 +151,7 @@ void addExperimentCommands(CLI::App& app) {
             cmd->add_option("--seeds", a->seeds, "Scenes per count (seeds 1..N); --quick: 2")
                 ->capture_default_str()
                 ->check(finiteRange(1, 100));
-        cmd->add_option("--rate", *rates,
-                        "Servo rate(s) (Hz, 100..100000), comma-separated for several")
-            ->capture_default_str();
+        addRates(cmd, a->ratesHz, "e.g. 1000,10000");
         cmd->add_option("--keep-clear", a->keepClearM,
                         "No object within this distance of the centre, where the hand starts (m)")
             ->capture_default_str()
@@ -161,24 +161,22 @@ void addExperimentCommands(CLI::App& app) {
                         "would pass this (MB)")
             ->capture_default_str()
             ->check(finiteRange(1e-3, 1e9));
-        cmd->callback([a, o, rates, counts, decades, countsOpt, seeds, verdict] {
+        cmd->callback([a, o, decades, countsOpt, seeds, verdict] {
             applyQuick(a->common, *o);
             a->verdict = parseVerdict(*verdict, "--verdict");
             if (a->common.quick) {
                 if (countsOpt->count() == 0) {
-                    *counts = "10,20,50";
+                    a->counts = {10, 20, 50};
                 }
                 if (seeds->count() == 0) {
                     a->seeds = 2;
                 }
             }
-            a->counts = parseCounts(*counts, "--counts");
             if (*decades) {
                 for (const std::size_t n : {1000, 10000, 100000, 1000000}) {
                     a->counts.push_back(n);
                 }
             }
-            a->ratesHz = parseRates(*rates, "--rate");
             const int rc = runPaper2(*a);
             if (rc != 0) {
                 std::exit(rc);
@@ -189,9 +187,6 @@ void addExperimentCommands(CLI::App& app) {
     {
         auto a = std::make_shared<DevicesArgs>();
         auto o = std::make_shared<CommonOptions>();
-        auto rates = std::make_shared<std::string>("1000,4000");
-        auto cursorObjects = std::make_shared<std::string>("100,1000,10000,100000,1000000");
-        auto walkSteps = std::make_shared<std::string>("200000");
         auto noCursor = std::make_shared<bool>(false);
         auto* cmd = exp->add_subcommand(
             "devices",
@@ -206,10 +201,7 @@ void addExperimentCommands(CLI::App& app) {
                                            "--quick: 2")
                                ->capture_default_str()
                                ->check(finiteRange(1, 60));
-        auto* ratesOpt = cmd->add_option("--rates", *rates,
-                                         "Servo rates (Hz, 100..100000), comma-separated; "
-                                         "--quick: 1000")
-                             ->capture_default_str();
+        auto* ratesOpt = addRates(cmd, a->ratesHz, "--quick: 1000");
         cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
         cmd->add_option("--index", a->index,
                         "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb; "
@@ -223,38 +215,34 @@ void addExperimentCommands(CLI::App& app) {
                         "Hand script: walk (random hops through the scene) or slide (slide on "
                         "the nearest surface)")
             ->capture_default_str();
-        auto* objectsOpt = cmd->add_option("--cursor-objects", *cursorObjects,
+        auto* objectsOpt = cmd->add_option("--cursor-objects", a->cursorObjects,
                                            "Cursor part: N values (objects; a K^3 lattice with "
                                            "K = round(cbrt N)), comma-separated; --quick: "
                                            "100,1000")
-                               ->capture_default_str();
-        auto* stepsOpt = cmd->add_option("--walk-steps", *walkSteps,
+                               ->capture_default_str()
+                               ->delimiter(',')
+                               ->transform(wholeNumber(1, 1e8));
+        auto* stepsOpt = cmd->add_option("--walk-steps", a->walkSteps,
                                          "Cursor part: walk length (1 ms steps, <= 0.5 mm "
                                          "each), e.g. 2e5; --quick: 20000")
-                             ->capture_default_str();
+                             ->capture_default_str()
+                             ->transform(wholeNumber(1, 4e9));
         cmd->add_flag("--no-cursor", *noCursor, "Skip the cursor part");
-        cmd->callback([a, o, rates, cursorObjects, walkSteps, noCursor, maxDevices, ratesOpt,
-                       objectsOpt, stepsOpt] {
+        cmd->callback([a, o, noCursor, maxDevices, ratesOpt, objectsOpt, stepsOpt] {
             applyQuick(a->common, *o);
             if (a->common.quick) {
                 if (maxDevices->count() == 0) {
                     a->maxDevices = 2;
                 }
                 if (ratesOpt->count() == 0) {
-                    *rates = "1000";
+                    a->ratesHz = {1000.0};
                 }
                 if (objectsOpt->count() == 0) {
-                    *cursorObjects = "100,1000";
+                    a->cursorObjects = {100, 1000};
                 }
                 if (stepsOpt->count() == 0) {
-                    *walkSteps = "20000";
+                    a->walkSteps = 20000;
                 }
-            }
-            a->ratesHz = parseRates(*rates, "--rates");
-            a->cursorObjects = parseCounts(*cursorObjects, "--cursor-objects");
-            a->walkSteps = parseCount(*walkSteps, "--walk-steps");
-            if (a->walkSteps == 0) {
-                throw InputError("--walk-steps: expected at least 1 step, got 0");
             }
             a->cursor = !*noCursor;
             const int rc = runDevices(*a);

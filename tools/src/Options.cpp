@@ -36,4 +36,31 @@ CLI::Validator finiteRange(double lo, double hi) {
         "in [" + number(lo) + ", " + number(hi) + "]", "FINITE_RANGE");
 }
 
+CLI::Validator wholeNumber(double lo, double hi) {
+    const std::string range = "from " + number(lo) + " to " + number(hi);
+    return CLI::Validator(
+        [lo, hi, range](std::string& text) -> std::string {
+            double v = 0.0;
+            if (!CLI::detail::lexical_cast(text, v)) {
+                return "'" + text + "' is not a number; expected a whole number " + range;
+            }
+            if (!std::isfinite(v) || std::floor(v) != v) {
+                return "'" + text + "' is not a whole number; expected a whole number " + range;
+            }
+            if (v < lo || v > hi) {
+                return text + " is out of range; expected a whole number " + range;
+            }
+            text = number(v); // "2e5" -> "200000", which an integer option reads
+            return {};
+        },
+        "whole number in [" + number(lo) + ", " + number(hi) + "]", "WHOLE_NUMBER");
+}
+
+CLI::Option* addRealtimeFlag(CLI::App* cmd, bool& realtime, const std::string& what) {
+    return cmd->add_flag("--realtime,!--no-realtime", realtime,
+                         "Ask for SCHED_FIFO and CPU pinning (" + what +
+                             "); --no-realtime: do not (the runtime falls back to normal "
+                             "scheduling when refused and says so)");
+}
+
 } // namespace hapto::cli

@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <string>
+
 namespace hapto::cli {
 
 /// The largest seed option value: the largest 64-bit unsigned integer, for finiteRange.
@@ -16,5 +18,19 @@ inline constexpr double kMaxIndexMbOption = 1099511627776.0;
 /// every numeric option (integers too: it also catches "-1" given to an unsigned option, which
 /// CLI11 would otherwise wrap round). [control]
 CLI::Validator finiteRange(double lo, double hi);
+
+/// A CLI11 transform (add it with ->transform, not ->check, which cannot rewrite) for a whole
+/// number from `lo` to `hi` (inclusive), written plainly or with an exponent ("200000",
+/// "2e5"); it rewrites the text as plain digits so that CLI11 can read it into an integer
+/// option (or each item of a `,`-delimited list; CLI11 skips empty items). Refuses fractions,
+/// NaN, infinities and values out of range like finiteRange. [control]
+CLI::Validator wholeNumber(double lo, double hi);
+
+/// The option conventions every command follows (README, "Commands"): durations in seconds
+/// (`--duration S`), one servo rate `--rate HZ`, several `--rates HZ,HZ`, lists
+/// comma-separated, numbers read as numbers by CLI11, real-time scheduling asked for with
+/// `--realtime` and declined with `--no-realtime`. Old spellings stay as deprecated aliases.
+/// Adds `--realtime` and `--no-realtime` as one flag setting `realtime`. [control]
+CLI::Option* addRealtimeFlag(CLI::App* cmd, bool& realtime, const std::string& what);
 
 } // namespace hapto::cli

@@ -37,7 +37,7 @@ struct RunArgs {
     double durationS = 5;
     std::string report;
     std::string record;
-    bool noRealtime = false;
+    bool realtime = true;
     double spinUs = 0;
     int missLimit = 3;
     double reopenMs = 1000;
@@ -119,7 +119,7 @@ int runSession(const RunArgs& a) {
         devices.push_back(std::move(rd));
     }
     RuntimeOptions opt;
-    opt.realtime = !a.noRealtime;
+    opt.realtime = a.realtime;
     opt.spinNs = static_cast<std::uint64_t>(a.spinUs * 1000);
     opt.missLimit = a.missLimit;
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
@@ -216,7 +216,7 @@ void addRunCommands(CLI::App& app) {
     cmd->add_option("--report", a->report, "Write the JSON report here");
     cmd->add_option("--record", a->record,
                     "Record every device's ticks into DIR/<name>.trace (see `hapto trace export`)");
-    cmd->add_flag("--no-realtime", a->noRealtime, "Do not ask for SCHED_FIFO and CPU pinning");
+    addRealtimeFlag(cmd, a->realtime, "default: ask");
     cmd->add_option("--spin-us", a->spinUs, "Spin this long before each deadline (us)")
         ->capture_default_str()
         ->check(finiteRange(0, 1000));

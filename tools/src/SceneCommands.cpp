@@ -16,21 +16,6 @@
 
 namespace hapto::cli {
 
-std::size_t parseCount(const std::string& text, const std::string& option) {
-    std::size_t used = 0;
-    double value = 0.0;
-    try {
-        value = std::stod(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != text.size() || !(value >= 0.0) || value > 4.0e9 || std::floor(value) != value) {
-        throw InputError(option + ": expected a whole number >= 0 such as 1000 or 1e6, got '" +
-                         text + "'");
-    }
-    return static_cast<std::size_t>(value);
-}
-
 Scene loadSceneOrDefault(const std::string& path) {
     return path.empty() ? makeDefaultScene() : loadSceneFile(path);
 }
@@ -109,9 +94,10 @@ void addSceneCommands(CLI::App& app) {
             "random", "Experiment 2: N cubes placed uniformly at random in a work cube centred on "
                       "the origin; bounds are the work cube");
         auto opt = std::make_shared<RandomOptions>();
-        auto count = std::make_shared<std::string>();
         auto out = std::make_shared<std::string>();
-        cmd->add_option("--count", *count, "Number of cubes (e.g. 200 or 1e6)")->required();
+        cmd->add_option("--count", opt->count, "Number of cubes (e.g. 200 or 1e6)")
+            ->required()
+            ->transform(wholeNumber(0, 4e9));
         cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
             ->capture_default_str()
             ->check(finiteRange(0, kMaxSeed));
@@ -128,8 +114,7 @@ void addSceneCommands(CLI::App& app) {
             ->check(finiteRange(0, 1e4));
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();
-        cmd->callback([opt, count, out] {
-            opt->count = parseCount(*count, "--count");
+        cmd->callback([opt, out] {
             checkSceneOutput(*out);
             writeScene(makeRandomScene(*opt), *out);
         });
@@ -140,9 +125,10 @@ void addSceneCommands(CLI::App& app) {
             "cluster", "A strongly non-uniform scene: N cubes in C Gaussian clusters (a uniform "
                        "grid does badly here)");
         auto opt = std::make_shared<ClusterOptions>();
-        auto count = std::make_shared<std::string>();
         auto out = std::make_shared<std::string>();
-        cmd->add_option("--count", *count, "Number of cubes (e.g. 1e5)")->required();
+        cmd->add_option("--count", opt->count, "Number of cubes (e.g. 1e5)")
+            ->required()
+            ->transform(wholeNumber(0, 4e9));
         cmd->add_option("--clusters", opt->clusters, "Number of clusters")
             ->capture_default_str()
             ->check(finiteRange(1, 1000000));
@@ -161,8 +147,7 @@ void addSceneCommands(CLI::App& app) {
         cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
         cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
             ->required();
-        cmd->callback([opt, count, out] {
-            opt->count = parseCount(*count, "--count");
+        cmd->callback([opt, out] {
             checkSceneOutput(*out);
             writeScene(makeClusterScene(*opt), *out);
         });

@@ -33,7 +33,8 @@ namespace hapto::cli {
 namespace {
 
 struct SoakArgs {
-    double minutes = 1.0;
+    double durationS = 60.0;                   // --duration (s), or --minutes x 60
+    std::string durationOption = "--duration"; // the spelling given, for messages
     int devices = 2;
     double rateHz = 1000.0;
     std::string scene;
@@ -45,7 +46,7 @@ struct SoakArgs {
     double reopenMs = 200.0;
     double memoryToleranceMiB = 2.0;
     std::string report;
-    bool noRealtime = false;
+    bool realtime = true;
 };
 
 // The faults, injected in turn into device k % D. Stalls shorter than the watchdog only cost
@@ -171,16 +172,16 @@ private:
 
 int runSoak(const SoakArgs& a) {
     StopSignals signals; // before any thread starts; see `hapto run`
-    const double durationS = a.minutes * 60.0;
+    const double durationS = a.durationS;
     const double quietTailS =
         std::min(durationS / 2, 3.0 * a.watchdogMs / 1000 + 1.0 + a.reopenMs / 1000);
     if (a.faultEveryS >= durationS - quietTailS) {
         char text[320];
         std::snprintf(text, sizeof text,
-                      "--minutes %g: the soak would end before its first fault (--fault-every "
+                      "%s: a soak of %g s would end before its first fault (--fault-every "
                       "%g s; faults stop %.1f s before the end so the last can recover), so it "
                       "could test nothing; run longer or inject faults more often",
-                      a.minutes, a.faultEveryS, quietTailS);
+                      a.durationOption.c_str(), durationS, a.faultEveryS, quietTailS);
         throw InputError(text);
     }
     checkSessionFiles({a.scene, "", a.report, ""}, {});
@@ -201,7 +202,7 @@ int runSoak(const SoakArgs& a) {
         rds.push_back({std::move(device), c, nullptr});
     }
     RuntimeOptions opt;
-    opt.realtime = !a.noRealtime;
+    opt.realtime = a.realtime;
     opt.stallTimeoutNs = static_cast<std::uint64_t>(a.watchdogMs * 1e6);
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
     Runtime runtime(world, std::move(rds), opt);
@@ -210,7 +211,7 @@ int runSoak(const SoakArgs& a) {
     std::fprintf(stderr,
                  "hapto soak: %d devices at %.0f Hz, %u objects, index %s, %.1f min; a fault "
                  "every %.1f s, windows of %.0f s\n",
-                 a.devices, a.rateHz, scene.size(), spec.toString().c_str(), a.minutes,
+                 a.devices, a.rateHz, scene.size(), spec.toString().c_str(), a.durationS / 60.0,
                  a.faultEveryS, a.windowS);
     if (runtime.start() != static_cast<std::size_t>(a.devices)) {
         for (const DeviceReport& d : runtime.report().devices) {
@@ -419,7 +420,8 @@ int runSoak(const SoakArgs& a) {
             windowsJson.push_back({{"end_s", w.endS}, {"rss_mib", w.rssMiB}, {"devices", per}});
         }
         const nlohmann::json out{{"settings",
-                                  {{"minutes", a.minutes},
+                                  {{"minutes", a.durationS / 60.0},
+                                   {"duration_s", a.durationS},
                                    {"devices", a.devices},
                                    {"rate_hz", a.rateHz},
                                    {"index", spec.toString()},
@@ -428,7 +430,7 @@ int runSoak(const SoakArgs& a) {
                                    {"window_s", a.windowS},
                                    {"watchdog_ms", a.watchdogMs},
                                    {"reopen_ms", a.reopenMs},
-                                   {"realtime", !a.noRealtime}}},
+                                   {"realtime", a.realtime}}},
                                  {"duration_s", r.durationS},
                                  {"devices", devices},
                                  {"windows", windowsJson},
@@ -470,9 +472,15 @@ void addSoakCommands(CLI::App& app) {
                 "interrupted: no verdict); 2 for bad arguments, such as a soak too short to "
                 "reach its first fault");
     auto a = std::make_shared<SoakArgs>();
-    cmd->add_option("--minutes", a->minutes, "How long to run (min; fractions allowed)")
-        ->capture_default_str()
-        ->check(finiteRange(0.02, 100000));
+    auto* duration = cmd->add_option("--duration", a->durationS, "How long to run (s)")
+                         ->capture_default_str()
+                         ->check(finiteRange(1.2, 6e6));
+    auto minutes = std::make_shared<double>(0.0);
+    auto* minutesOpt =
+        cmd->add_option("--minutes", *minutes,
+                        "Deprecated: how long to run in minutes (use --duration, in seconds)")
+            ->check(finiteRange(0.02, 100000))
+            ->excludes(duration);
     cmd->add_option("--devices", a->devices, "Simulated hands (D)")
         ->capture_default_str()
         ->check(finiteRange(1, 32));
@@ -509,8 +517,16 @@ void addSoakCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(0, 1e6));
     cmd->add_option("--report", a->report, "Write the JSON soak report here");
-    cmd->add_flag("--no-realtime", a->noRealtime, "Do not ask for SCHED_FIFO and CPU pinning");
-    cmd->callback([a] {
+    addRealtimeFlag(cmd, a->realtime, "default: ask");
+    cmd->callback([a, minutes, minutesOpt] {
+        if (minutesOpt->count() > 0) {
+            a->durationS = *minutes * 60.0;
+        }
+        char given[64];
+        std::snprintf(given, sizeof given, "%s %g",
+                      minutesOpt->count() > 0 ? "--minutes" : "--duration",
+                      minutesOpt->count() > 0 ? *minutes : a->durationS);
+        a->durationOption = given;
         const int rc = runSoak(*a);
         if (rc != 0) {
             std::exit(rc);

@@ -2,6 +2,7 @@
 
 #include "Commands.h"
 
+#include "hapto/Version.h"
 #include "hapto/scenes/InputError.h"
 
 #include <CLI/CLI.hpp>
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <string>
 
 int main(int argc, char** argv) {
     CLI::App app{"hapto: a multi-device haptic runtime over one shared spatial index.\n"
@@ -16,6 +18,8 @@ int main(int argc, char** argv) {
                  "hapto"};
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "Print help for every subcommand and exit");
+    app.set_version_flag("--version", std::string("hapto ") + hapto::kVersion,
+                         "Print hapto's version and exit");
 
     hapto::cli::addSceneCommands(app);
     hapto::cli::addRunCommands(app);
@@ -28,6 +32,20 @@ int main(int argc, char** argv) {
     hapto::cli::addExperimentCommands(app);
     hapto::cli::addSoakCommands(app);
 
+    // A first word that is no option and no command is named as an unknown command (CLI11
+    // would only say that an argument was not expected).
+    if (argc > 1 && argv[1][0] != '-') {
+        const std::string word = argv[1];
+        bool known = false;
+        const CLI::App& root = app;
+        for (const CLI::App* sub : root.get_subcommands([](const CLI::App*) { return true; })) {
+            known = known || sub->check_name(word);
+        }
+        if (!known) {
+            std::cerr << "hapto: unknown command '" << word << "'; see hapto --help\n";
+            return 2;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -209,11 +209,6 @@ std::string fmt(double value, int decimals);
 std::string markdownTable(const std::vector<std::string>& header,
                           const std::vector<std::vector<std::string>>& rows);
 
-/// A comma-separated list of rates (Hz), each 100..100000; throws InputError naming `option`.
-std::vector<double> parseRates(const std::string& text, const std::string& option);
-/// A comma-separated list of counts ("10,20,1e3"); throws InputError naming `option`.
-std::vector<std::size_t> parseCounts(const std::string& text, const std::string& option);
-
 /// What a results file says about where it was measured: CPU model, cores, load average,
 /// kernel, and the command line. [control]
 Json machineJson();
