@@ -4,10 +4,8 @@
 
 #include "hapto/scenes/OutputFile.h"
 
-#include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
-#include "hapto/runtime/CandidateSet.h"
-#include "hapto/runtime/ForceSafety.h"
+#include "hapto/runtime/HapticTick.h"
 #include "hapto/scenes/InputError.h"
 
 #include <algorithm>
@@ -100,36 +98,23 @@ double WarmedSimDevice::warmUp(double settleS, double maxS) {
             near.push_back(o);
         }
     }
-    const Scene local(region, std::move(near));
-    const std::unique_ptr<SpatialIndex> index = buildIndex(local, IndexSpec::octree(2, 0.005));
+    auto local = std::make_shared<const Scene>(region, std::move(near));
+    const WorldSnapshot snapshot{1, local, buildIndex(*local, IndexSpec::octree(2, 0.005)), {}};
 
     const WorkspaceTransform& xf = mConfig.transform;
     const double dt = 1.0 / mConfig.rateHz;
-    Cursor deviceCursor(*index), proxyCursor(*index);
-    GodObjectRenderer renderer;
-    ForceSafety safety;
+    HapticTick tick; // the servo's own tick
     DeviceState state;
     double inPhaseS = 0.0, t = 0.0;
-    for (bool first = true; t < maxS; t += dt) {
+    for (; t < maxS; t += dt) {
         if (mSim.read(state) != DeviceStatus::Ok) {
             throw std::runtime_error("simulated hand '" + mConfig.name +
                                      "' failed during warm-up: " + mSim.errorMessage());
         }
         const Vec3 p = xf.positionToWorld(state.position);
         const Vec3 v = xf.velocityToWorld(state.velocity);
-        if (first) {
-            renderer.reset(p);
-            first = false;
-        }
-        const LocateResult atDevice = deviceCursor.locate(p);
-        const LocateResult atProxy = proxyCursor.locate(renderer.proxy());
-        CandidateSet candidates;
-        candidates.add(atDevice.candidates);
-        if (atProxy.leaf != atDevice.leaf || atProxy.outside != atDevice.outside) {
-            candidates.add(atProxy.candidates);
-        }
-        const RenderOutput out = renderer.update(local, candidates, p, v, dt);
-        (void)mSim.write(xf.forceToDevice(safety.filter(out.force)));
+        const TickOutput out = tick.tick(snapshot, p, v, dt, Vec3(0.0));
+        (void)mSim.write(xf.forceToDevice(out.forceN));
         if (mSim.phase() == measured) {
             inPhaseS += dt;
             if (inPhaseS >= settleS) {
@@ -138,7 +123,7 @@ double WarmedSimDevice::warmUp(double settleS, double maxS) {
             }
         }
     }
-    mPrimeDevice = xf.positionToDevice(renderer.proxy());
+    mPrimeDevice = xf.positionToDevice(tick.proxy());
     mPrimePending = true;
     return t;
 }
@@ -315,22 +300,12 @@ SessionResult runSession(World& world, const std::vector<HandPlan>& hands,
 
 double probeTickSeconds(const World& world, const Vec3& point, int runs) {
     const WorldSnapshot& s = world.current();
-    Cursor deviceCursor(*s.index), proxyCursor(*s.index);
-    GodObjectRenderer renderer;
-    renderer.reset(point);
+    HapticTick tick; // the servo's own tick
     std::vector<double> seconds;
     for (int i = 0; i < runs; ++i) {
         const Vec3 p = point + Vec3(1e-5 * (i % 3), 1e-5 * ((i + 1) % 3), 0.0);
         const auto t0 = std::chrono::steady_clock::now();
-        const LocateResult atDevice = deviceCursor.locate(p);
-        const LocateResult atProxy = proxyCursor.locate(renderer.proxy());
-        CandidateSet candidates;
-        candidates.add(atDevice.candidates);
-        if (atProxy.leaf != atDevice.leaf || atProxy.outside != atDevice.outside) {
-            candidates.add(atProxy.candidates);
-        }
-        candidates.add(s.movingSlots());
-        const RenderOutput out = renderer.update(*s.scene, candidates, p, Vec3(0.0), 1e-3);
+        const TickOutput out = tick.tick(s, p, Vec3(0.0), 1e-3, Vec3(0.0));
         const auto t1 = std::chrono::steady_clock::now();
         asm volatile("" : : "g"(&out) : "memory");
         seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
