@@ -483,7 +483,9 @@ bool FalconEmulator::handleIoctl(UMockdevIoctlClient* client) {
             const int n = std::min<int>(room, static_cast<int>(chunk.payload.size()));
             out[0] = kStatus0;
             out[1] = kStatus1;
-            std::memcpy(out + 2, chunk.payload.data(), static_cast<std::size_t>(n));
+            if (n > 0) { // an empty chunk (a short transfer) has no data pointer to copy from
+                std::memcpy(out + 2, chunk.payload.data(), static_cast<std::size_t>(n));
+            }
             done.actualLength = chunk.truncated ? 1 : 2 + n;
             if (static_cast<std::size_t>(n) < chunk.payload.size() && !chunk.truncated) {
                 chunk.payload.erase(chunk.payload.begin(), chunk.payload.begin() + n);
