@@ -1,5 +1,7 @@
 #include "hapto/devices/FalconKinematics.h"
 
+#include "hapto/core/Finite.h"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -154,9 +156,7 @@ std::optional<Vec3> FalconKinematics::forward(const Angles& angles, const Vec3& 
             return std::nullopt;
         }
     }
-    Vec3 p = (std::isfinite(start.x) && std::isfinite(start.y) && std::isfinite(start.z))
-                 ? start
-                 : defaultStart();
+    Vec3 p = finite(start) ? start : defaultStart();
     for (int iter = 0; iter < kMaxNewtonIterations; ++iter) {
         Mat3 dgdp(0.0);
         Vec3 dgdt(0.0);
@@ -230,7 +230,7 @@ std::int16_t FalconKinematics::torqueToMotorWord(double torqueNm) {
 }
 
 MotorWords FalconKinematics::torqueToMotorWords(const Vec3& torqueNm, int wordLimit) {
-    if (!std::isfinite(torqueNm.x) || !std::isfinite(torqueNm.y) || !std::isfinite(torqueNm.z)) {
+    if (!finite(torqueNm)) {
         return {0, 0, 0};
     }
     // Scale the three words together (libnifalcon src/kinematic/FalconKinematicStamper.cpp,

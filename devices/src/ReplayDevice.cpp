@@ -1,5 +1,7 @@
 #include "hapto/devices/ReplayDevice.h"
 
+#include "hapto/core/Finite.h"
+
 #include "hapto/devices/TraceReader.h"
 #include "hapto/scenes/InputError.h"
 
@@ -120,7 +122,7 @@ DeviceStatus ReplayDevice::write(const Vec3& forceN) noexcept {
     if (!mOpen) {
         return DeviceStatus::NotOpen;
     }
-    if (!std::isfinite(forceN.x) || !std::isfinite(forceN.y) || !std::isfinite(forceN.z)) {
+    if (!finite(forceN)) {
         mLastForceN = Vec3(0.0);
         return DeviceStatus::BadData;
     }

@@ -1,5 +1,7 @@
 #include "hapto/devices/SimDevice.h"
 
+#include "hapto/core/Finite.h"
+
 #include "hapto/scenes/InputError.h"
 
 #include <cmath>
@@ -109,7 +111,7 @@ DeviceStatus SimDevice::write(const Vec3& forceN) noexcept {
     if (!mOpen) {
         return DeviceStatus::NotOpen;
     }
-    if (!std::isfinite(forceN.x) || !std::isfinite(forceN.y) || !std::isfinite(forceN.z)) {
+    if (!finite(forceN)) {
         mForceN = Vec3(0.0);
         return DeviceStatus::BadData;
     }

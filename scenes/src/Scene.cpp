@@ -1,5 +1,7 @@
 #include "hapto/scenes/Scene.h"
 
+#include "hapto/core/Finite.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -17,7 +19,7 @@ Scene::Scene(Aabb bounds, std::vector<SceneObject> objects)
         throw std::invalid_argument("scene bounds must have min < max on every axis");
     }
     const Vec3 size = bounds.max - bounds.min;
-    if (!std::isfinite(size.x) || !std::isfinite(size.y) || !std::isfinite(size.z)) {
+    if (!finite(size)) {
         throw std::invalid_argument("scene bounds must have a finite size on every axis");
     }
     if (mObjects.size() >= std::numeric_limits<std::uint32_t>::max()) {
