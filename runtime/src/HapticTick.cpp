@@ -18,8 +18,8 @@ Vec3 HapticTick::effectsForceN(const RenderOutput& /*render*/, const Vec3& /*dev
     return Vec3(0.0);
 }
 
-TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& v,
-                            double dtS, const Vec3& externalForceN) noexcept {
+TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& v, double dtS,
+                            const Vec3& externalForceN) noexcept {
     TickOutput out;
     // A new snapshot (or the first tick): the cursors re-bind to its index and forget their
     // leaves; a snapshot that only moved objects shares the index, but re-binding is cheap
@@ -54,8 +54,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
 
     // 4. Force effects, and the external force. 5. Safety.
-    const Vec3 requested =
-        out.render.force + externalForceN + effectsForceN(out.render, p, v, dtS);
+    const Vec3 requested = out.render.force + externalForceN + effectsForceN(out.render, p, v, dtS);
     out.forceN = mSafety.filter(requested);
     return out;
 }

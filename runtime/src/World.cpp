@@ -167,8 +167,8 @@ void World::maintain() {
         return;
     }
     const std::uint64_t now = nowNs();
-    const bool anyRested = std::any_of(mMovers.begin(), mMovers.end(),
-                                       [&](const Mover& m) { return rested(m, now); });
+    const bool anyRested =
+        std::any_of(mMovers.begin(), mMovers.end(), [&](const Mover& m) { return rested(m, now); });
     if (anyRested || !mPendingRemovals.empty()) {
         startBuild();
         if (mClock) {

@@ -148,11 +148,10 @@ private:
         }
     }
     void recordForce(const Vec3& f) {
-        const std::int64_t now =
-            mClock ? static_cast<std::int64_t>(mClock->nowNs())
-                   : std::chrono::duration_cast<std::chrono::nanoseconds>(
-                         std::chrono::steady_clock::now().time_since_epoch())
-                         .count();
+        const std::int64_t now = mClock ? static_cast<std::int64_t>(mClock->nowNs())
+                                        : std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                              std::chrono::steady_clock::now().time_since_epoch())
+                                              .count();
         if (mClock) {
             std::lock_guard lock(mHistoryMutex);
             mHistory.push_back({mReads.load(), f});

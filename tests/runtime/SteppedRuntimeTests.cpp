@@ -60,8 +60,9 @@ struct Rig {
             c.kind = DeviceKind::Scripted;
             c.rateHz = rateHz;
             c.maxForceN = 5.0;
-            rds.push_back({std::move(d), c,
-                           static_cast<std::size_t>(i) < recorders.size() ? recorders[i] : nullptr});
+            rds.push_back(
+                {std::move(d), c,
+                 static_cast<std::size_t>(i) < recorders.size() ? recorders[i] : nullptr});
         }
         options.realtime = false;
         runtime = std::make_unique<Runtime>(world, std::move(rds), options);
@@ -71,9 +72,7 @@ struct Rig {
         return runtime->startStepped(clock);
     }
     /// Runs every device on its deadlines until t0 + ms.
-    void runTo(double ms) {
-        runtime->runUntil(t0 + static_cast<std::uint64_t>(ms * kMs));
-    }
+    void runTo(double ms) { runtime->runUntil(t0 + static_cast<std::uint64_t>(ms * kMs)); }
     DeviceReport report(std::size_t i) const { return runtime->report().devices.at(i); }
     Vec3 force(std::size_t i) const {
         const DeviceMetrics& m = runtime->metrics(i);
@@ -93,8 +92,7 @@ std::vector<Vec3> forcesAfter(const ScriptedDevice& d, std::uint64_t afterReads)
 }
 
 bool allZero(const std::vector<Vec3>& forces) {
-    return std::all_of(forces.begin(), forces.end(),
-                       [](const Vec3& f) { return f == Vec3(0.0); });
+    return std::all_of(forces.begin(), forces.end(), [](const Vec3& f) { return f == Vec3(0.0); });
 }
 
 } // namespace
@@ -186,11 +184,11 @@ TEST_CASE("step mode: each injected fault zeroes that device in the tick it happ
         FaultKind expected;
         const char* text;
     };
-    const Case c = GENERATE(Case{Inject::ReadError, FaultKind::ReadFailed, "read-failed: error"},
-                            Case{Inject::Disconnect, FaultKind::ReadFailed,
-                                 "read-failed: disconnected"},
-                            Case{Inject::NonFinite, FaultKind::NonFinite, "non-finite: bad-data"},
-                            Case{Inject::Stall, FaultKind::Watchdog, "watchdog: no tick for 50 ms"});
+    const Case c =
+        GENERATE(Case{Inject::ReadError, FaultKind::ReadFailed, "read-failed: error"},
+                 Case{Inject::Disconnect, FaultKind::ReadFailed, "read-failed: disconnected"},
+                 Case{Inject::NonFinite, FaultKind::NonFinite, "non-finite: bad-data"},
+                 Case{Inject::Stall, FaultKind::Watchdog, "watchdog: no tick for 50 ms"});
     INFO(c.text);
     RuntimeOptions never;
     never.reopenAfterNs = 0; // the fault keeps the device down
@@ -306,11 +304,14 @@ TEST_CASE("step mode: a device that is unplugged and comes back is zeroed at onc
 TEST_CASE("step mode: a slow open (homing) delays only its own device's restart") {
     RuntimeOptions opt;
     opt.reopenAfterNs = 100 * kMs;
-    Rig rig(2, 1000.0, [](int i, ScriptedDevice& d) {
-        if (i == 1) {
-            d.inject(Inject::ReadError, 100);
-        }
-    }, opt);
+    Rig rig(
+        2, 1000.0,
+        [](int i, ScriptedDevice& d) {
+            if (i == 1) {
+                d.inject(Inject::ReadError, 100);
+            }
+        },
+        opt);
     rig.start();
     rig.devices[1]->setOpenTakes(2'000 * kMs); // every later open() takes 2 s
     rig.runTo(300.0);
@@ -422,9 +423,8 @@ TEST_CASE("step mode: a device whose thread cannot run is caught by the watchdog
     CHECK(rig.devices[1]->forceAfterGap() == 0.0);
     CHECK(d.faults == 1);
     CHECK(d.reopens == 1);
-    CHECK(d.events == std::vector<std::string>{
-                          "0.600 s: watchdog: no tick for 50 ms; force zeroed",
-                          "0.800 s: reopened; driving again from zero force"});
+    CHECK(d.events == std::vector<std::string>{"0.600 s: watchdog: no tick for 50 ms; force zeroed",
+                                               "0.800 s: reopened; driving again from zero force"});
     CHECK(d.downS == Approx(0.500).margin(1e-12)); // from its last tick at 300 ms
     CHECK(rig.report(0).faults == 0);
     CHECK(rig.report(0).ticks == 1500);
@@ -590,9 +590,9 @@ TEST_CASE("step mode: a recorded trace holds every tick, its wake-up time, the p
         RuntimeOptions opt;
         opt.missLimit = 2;
         // Ticks 300..309 take 2.5 periods: missed deadlines, then zeroed forces.
-        Rig rig(
-            1, 1000.0, [](int, ScriptedDevice& d) { d.inject(Inject::SlowTicks, 300, 2'500'000, 310); },
-            opt, cubeScene(), {&recorder});
+        Rig rig(1, 1000.0,
+                [](int, ScriptedDevice& d) { d.inject(Inject::SlowTicks, 300, 2'500'000, 310); },
+                opt, cubeScene(), {&recorder});
         rig.start();
         for (int ms = 50; ms <= 500; ms += 50) {
             rig.runTo(ms);

@@ -93,8 +93,8 @@ TEST_CASE("hapto render: pressing d into a box face of stiffness k gives k d alo
         depths.push_back(depth);
     }
     writeFile(dir / "path.csv", pathCsv(points));
-    const CommandResult r = runHapto("render --scene " + (dir / "cube.json").string() +
-                                     " --path " + (dir / "path.csv").string());
+    const CommandResult r = runHapto("render --scene " + (dir / "cube.json").string() + " --path " +
+                                     (dir / "path.csv").string());
     INFO(r.output.substr(0, 2000));
     REQUIRE(r.exitCode == 0);
     const std::vector<Row> rows = parse(r.output);
@@ -137,8 +137,8 @@ TEST_CASE("hapto render: the same input gives the same bytes, to a file or stand
     std::vector<std::array<double, 3>> points;
     for (int i = 0; i < 400; ++i) {
         const double u = i / 399.0;
-        points.push_back({-0.03 + 0.07 * u, 0.0245 - 0.002 * std::sin(9.0 * u),
-                          0.01 * std::cos(5.0 * u)});
+        points.push_back(
+            {-0.03 + 0.07 * u, 0.0245 - 0.002 * std::sin(9.0 * u), 0.01 * std::cos(5.0 * u)});
     }
     writeFile(dir / "path.csv", pathCsv(points));
     const std::string args = "render --scene " + (dir / "cube.json").string() + " --path " +
@@ -175,7 +175,8 @@ TEST_CASE("hapto render refuses bad input with exit code 2, says where, and writ
         CHECK_THAT(r.output, Catch::Contains(says));
     };
     SECTION("a bad path line: file and line") {
-        for (const char* bad : {"0,0.02\n", "0,0.02,zero\n", "nan,0,0\n", "0,inf,0\n", "1,2,3,4\n"}) {
+        for (const char* bad :
+             {"0,0.02\n", "0,0.02,zero\n", "nan,0,0\n", "0,inf,0\n", "1,2,3,4\n"}) {
             writeFile(dir / "bad.csv", std::string("x,y,z\n0,0.03,0\n") + bad);
             refused(scene + " --path " + (dir / "bad.csv").string(), "bad.csv:3:");
         }
@@ -189,7 +190,8 @@ TEST_CASE("hapto render refuses bad input with exit code 2, says where, and writ
         refused(" --scene " + (dir / "missing.json").string() + path, "missing.json");
     }
     SECTION("a bad scene, index or rate") {
-        writeFile(dir / "broken.json", R"({"format": "hapto-scene", "version": 1, "objects": [{}]})");
+        writeFile(dir / "broken.json",
+                  R"({"format": "hapto-scene", "version": 1, "objects": [{}]})");
         refused(" --scene " + (dir / "broken.json").string() + path, "objects[0]");
         refused(scene + path + " --index octree:0:0.005", "octree");
         refused(scene + path + " --rate 50", "--rate");

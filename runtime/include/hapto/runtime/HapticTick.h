@@ -84,10 +84,10 @@ private:
     Cursor mProxyCursor;  ///< The proxy's leaf.
     GodObjectRenderer mRenderer;
     ForceSafety mSafety;
-    CandidateSet mCandidates;                    ///< This tick's spans (views into the snapshot).
-    const SpatialIndex* mBoundIndex = nullptr;   ///< The index the cursors are bound to.
-    std::uint64_t mBoundVersion = 0;             ///< The snapshot version they were bound for.
-    bool mFresh = true;                          ///< The next tick starts afresh (reset()).
+    CandidateSet mCandidates;                  ///< This tick's spans (views into the snapshot).
+    const SpatialIndex* mBoundIndex = nullptr; ///< The index the cursors are bound to.
+    std::uint64_t mBoundVersion = 0;           ///< The snapshot version they were bound for.
+    bool mFresh = true;                        ///< The next tick starts afresh (reset()).
 };
 
 } // namespace hapto
