@@ -1,6 +1,6 @@
 # ctest "install: the README's two_hands snippet builds against an installed hapto".
 # Run as: cmake -DBINARY_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DGENERATOR=... -DCXX=...
-#         [-DLAUNCHER=...] -P InstallTest.cmake
+#         [-DLAUNCHER=...] [-DCXX_FLAGS=...] [-DLINKER_FLAGS=...] -P InstallTest.cmake
 # Installs the build into WORK_DIR/prefix, configures and builds tools/examples/two_hands
 # against it with find_package(hapto) (no CMAKE_CXX_STANDARD: C++20 must come from the
 # exported targets), checks the README shows that CMakeLists.txt exactly, and that the
@@ -57,6 +57,14 @@ set(args -S ${example} -B ${WORK_DIR}/two_hands -G ${GENERATOR} -DCMAKE_CXX_COMP
     -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release)
 if(LAUNCHER)
   list(APPEND args -DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER})
+endif()
+# The installed libraries carry the build's flags (a sanitizer preset's instrumentation): the
+# application must be built and linked with them too.
+if(CXX_FLAGS)
+  list(APPEND args "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}")
+endif()
+if(LINKER_FLAGS)
+  list(APPEND args "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}")
 endif()
 run(${CMAKE_COMMAND} ${args})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/two_hands)
