@@ -41,6 +41,8 @@ extern "C" const char* __tsan_default_suppressions() {
         REQUIRE(openStatus == DeviceStatus::Ok);                                                   \
     } while (false)
 
+using hapto::test::eventually;
+
 namespace {
 
 /// Skips (exit 77) unless umockdev's preload is active; under CTest the environment variable
@@ -70,18 +72,6 @@ FalconTimeouts testTimeouts() {
 std::atomic<std::int64_t> gTestNowNs{1'000'000'000};
 std::int64_t testClock() {
     return gTestNowNs.load();
-}
-
-/// Polls `pred` until it holds or a hang guard (not a timing requirement) expires.
-template <class P> bool eventually(P&& pred, std::chrono::milliseconds guard = 10s) {
-    const auto end = std::chrono::steady_clock::now() + guard;
-    while (std::chrono::steady_clock::now() < end) {
-        if (pred()) {
-            return true;
-        }
-        std::this_thread::sleep_for(1ms);
-    }
-    return pred();
 }
 
 /// No homing wait, and the longest command timeout allowed (10 ms), so that the servo threads

@@ -19,6 +19,7 @@
 
 using namespace hapto;
 using namespace hapto::falcon;
+using hapto::test::eventually;
 using hapto::test::FalconEmulator;
 using hapto::test::FalconEmulatorOptions;
 using namespace std::chrono_literals;
@@ -34,18 +35,6 @@ void requireEmulationHere() {
     }
     std::fprintf(stderr, "skipped: the emulated-Falcon tests must run under umockdev-wrapper\n");
     std::exit(77);
-}
-
-/// Polls `pred` until it holds or a hang guard (not a timing requirement) expires.
-template <class P> bool eventuallyHolds(P&& pred, std::chrono::milliseconds guard = 10s) {
-    const auto end = std::chrono::steady_clock::now() + guard;
-    while (std::chrono::steady_clock::now() < end) {
-        if (pred()) {
-            return true;
-        }
-        std::this_thread::sleep_for(1ms);
-    }
-    return pred();
 }
 
 IoSettings testSettings() {
@@ -119,13 +108,13 @@ TEST_CASE("falcon I/O thread: zero motor words while homing or without a command
     io.setHoming(true);
     io.start(usb);
     IoSample s{};
-    REQUIRE(eventuallyHolds([&] { return io.newestSample(s); }));
+    REQUIRE(eventually([&] { return io.newestSample(s); }));
     CHECK(io.state() == IoState::Running);
     io.command(Vec3(1.0, 0.0, 0.0)); // held at zero: homing
     const std::size_t before = emu.commandCount();
-    REQUIRE(eventuallyHolds([&] { return emu.commandCount() > before + 20; }));
+    REQUIRE(eventually([&] { return emu.commandCount() > before + 20; }));
     io.setHoming(false);
-    REQUIRE(eventuallyHolds([&] {
+    REQUIRE(eventually([&] {
         io.command(Vec3(1.0, 0.0, 0.0));
         const auto cmds = emu.commands();
         return !cmds.empty() && cmds.back().motor != MotorWords{0, 0, 0};

@@ -1,6 +1,8 @@
 // PhantomDevice against the stand-in HD library built from fakehd/FakeHD.cpp.
 // Tests wait for conditions with generous bounded timeouts and never assert durations.
 
+#include "TestSupport.h"
+
 #include "hapto/devices/PhantomDevice.h"
 
 #include <catch2/catch.hpp>
@@ -15,6 +17,7 @@
 #include <thread>
 
 using namespace hapto;
+using hapto::test::eventually;
 
 namespace {
 
@@ -89,18 +92,6 @@ private:
     }
     void* mLib = nullptr;
 };
-
-/// Polls `condition` until it holds or 10 s pass; returns whether it held.
-bool waitFor(const std::function<bool()>& condition) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (std::chrono::steady_clock::now() < deadline) {
-        if (condition()) {
-            return true;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    return condition();
-}
 
 PhantomConfig fakeConfig(const std::string& deviceName) {
     PhantomConfig c;
@@ -188,12 +179,12 @@ TEST_CASE("positions arrive in metres from the HD's millimetres, with velocity a
     // Now move along x at 100 mm/s and z at -50 mm/s: velocity in m/s, x grows, y stays.
     fake.setMotion(kDefault, 12.5, -40.0, 7.0, 100.0, 0.0, -50.0);
     fake.setButtons(kDefault, 0b01);
-    REQUIRE(waitFor([&] {
+    REQUIRE(eventually([&] {
         return dev.read(s) == DeviceStatus::Ok && near(s.velocity, Vec3(0.1, 0.0, -0.05));
     }));
     const std::uint64_t firstSequence = s.sequence;
     const double firstX = s.position.x;
-    REQUIRE(waitFor([&] {
+    REQUIRE(eventually([&] {
         DeviceState t;
         return dev.read(t) == DeviceStatus::Ok && t.sequence > firstSequence + 5 &&
                t.position.x > firstX && t.position.z < 0.007 &&
@@ -209,19 +200,19 @@ TEST_CASE("forces arrive in newtons, clamped to the limit, and are zero after cl
     CHECK(near(fake.force(kLeft), Vec3(0.0))); // open applies zero force
 
     REQUIRE(dev.write(Vec3(1.0, -0.5, 0.25)) == DeviceStatus::Ok);
-    CHECK(waitFor([&] { return near(fake.force(kLeft), Vec3(1.0, -0.5, 0.25)); }));
+    CHECK(eventually([&] { return near(fake.force(kLeft), Vec3(1.0, -0.5, 0.25)); }));
 
     // 5 N along y exceeds the 2 N limit: the device gets 2 N along y.
     REQUIRE(dev.write(Vec3(0.0, 5.0, 0.0)) == DeviceStatus::Ok);
-    CHECK(waitFor([&] { return near(fake.force(kLeft), Vec3(0.0, 2.0, 0.0), 1e-9); }));
+    CHECK(eventually([&] { return near(fake.force(kLeft), Vec3(0.0, 2.0, 0.0), 1e-9); }));
     CHECK(fake.maxForceSeen(kLeft) <= 2.0 + 1e-9);
 
     // A non-finite force is refused and zero is applied instead.
     CHECK(dev.write(Vec3(std::nan(""), 0.0, 0.0)) == DeviceStatus::BadData);
-    CHECK(waitFor([&] { return near(fake.force(kLeft), Vec3(0.0)); }));
+    CHECK(eventually([&] { return near(fake.force(kLeft), Vec3(0.0)); }));
 
     REQUIRE(dev.write(Vec3(0.0, 0.0, 1.5)) == DeviceStatus::Ok);
-    REQUIRE(waitFor([&] { return near(fake.force(kLeft), Vec3(0.0, 0.0, 1.5)); }));
+    REQUIRE(eventually([&] { return near(fake.force(kLeft), Vec3(0.0, 0.0, 1.5)); }));
     const unsigned long long framesBeforeClose = fake.forceFrames(kLeft);
     dev.close();
     // The last frame before hdDisableDevice applied zero (the fake keeps it after the release).
@@ -247,17 +238,17 @@ TEST_CASE("two phantoms share one HD scheduler and each gets its own force") {
     CHECK(fake.initWhileRunning() == 0); // the scheduler was paused around hdInitDevice
     CHECK(fake.callbacksScheduled() == 2);
     // Both devices are framed within one tick of the one scheduler thread.
-    CHECK(waitFor([&] { return fake.maxDevicesPerTick() == 2; }));
+    CHECK(eventually([&] { return fake.maxDevicesPerTick() == 2; }));
 
     DeviceState l, r;
-    REQUIRE(waitFor([&] { return left.read(l) == DeviceStatus::Ok; }));
-    REQUIRE(waitFor([&] { return right.read(r) == DeviceStatus::Ok; }));
+    REQUIRE(eventually([&] { return left.read(l) == DeviceStatus::Ok; }));
+    REQUIRE(eventually([&] { return right.read(r) == DeviceStatus::Ok; }));
     CHECK(near(l.position, Vec3(-0.1, 0.0, 0.0)));
     CHECK(near(r.position, Vec3(0.1, 0.0, 0.0)));
 
     REQUIRE(left.write(Vec3(1.0, 0.0, 0.0)) == DeviceStatus::Ok);
     REQUIRE(right.write(Vec3(0.0, -2.0, 0.0)) == DeviceStatus::Ok);
-    CHECK(waitFor([&] {
+    CHECK(eventually([&] {
         return near(fake.force(kLeft), Vec3(1.0, 0.0, 0.0)) &&
                near(fake.force(kRight), Vec3(0.0, -2.0, 0.0));
     }));
@@ -268,8 +259,8 @@ TEST_CASE("two phantoms share one HD scheduler and each gets its own force") {
     CHECK(fake.callbacksScheduled() == 1);
     CHECK(near(fake.force(kLeft), Vec3(0.0)));
     REQUIRE(right.write(Vec3(0.0, 0.0, 0.5)) == DeviceStatus::Ok);
-    CHECK(waitFor([&] { return near(fake.force(kRight), Vec3(0.0, 0.0, 0.5)); }));
-    CHECK(waitFor([&] { return right.read(r) == DeviceStatus::Ok; }));
+    CHECK(eventually([&] { return near(fake.force(kRight), Vec3(0.0, 0.0, 0.5)); }));
+    CHECK(eventually([&] { return right.read(r) == DeviceStatus::Ok; }));
     right.close();
     CHECK(fake.schedulerRunning() == 0);
 }
@@ -280,11 +271,11 @@ TEST_CASE("an HD error in the scheduler becomes a fault with the HD code and tex
     withFrozenClock(dev);
     REQUIRE(dev.open() == DeviceStatus::Ok);
     REQUIRE(dev.write(Vec3(0.5, 0.0, 0.0)) == DeviceStatus::Ok);
-    REQUIRE(waitFor([&] { return near(fake.force(kDefault), Vec3(0.5, 0.0, 0.0)); }));
+    REQUIRE(eventually([&] { return near(fake.force(kDefault), Vec3(0.5, 0.0, 0.0)); }));
 
     fake.injectError(kDefault, 0x0300 /* HD_DEVICE_FAULT */, 42);
     DeviceState s;
-    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Error; }));
+    REQUIRE(eventually([&] { return dev.read(s) == DeviceStatus::Error; }));
     CHECK(dev.write(Vec3(0.5, 0.0, 0.0)) == DeviceStatus::Error);
     const std::string msg = dev.errorMessage();
     CHECK_THAT(msg, Catch::Contains("0x0300"));
@@ -292,7 +283,7 @@ TEST_CASE("an HD error in the scheduler becomes a fault with the HD code and tex
     CHECK_THAT(msg, Catch::Contains("Device fault (fake)")); // hdGetErrorString's text
     CHECK_THAT(msg, Catch::Contains("42"));
     // A faulted device applies zero force.
-    CHECK(waitFor([&] { return near(fake.force(kDefault), Vec3(0.0)); }));
+    CHECK(eventually([&] { return near(fake.force(kDefault), Vec3(0.0)); }));
     dev.close();
     CHECK_THAT(dev.errorMessage(), Catch::Contains("HD_DEVICE_FAULT")); // kept after close
 
@@ -307,7 +298,7 @@ TEST_CASE("an unplugged phantom reads Disconnected") {
     REQUIRE(dev.open() == DeviceStatus::Ok);
     fake.removeDevice(kDefault);
     DeviceState s;
-    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Disconnected; }));
+    REQUIRE(eventually([&] { return dev.read(s) == DeviceStatus::Disconnected; }));
     CHECK_THAT(dev.errorMessage(), Catch::Contains("HD_COMM_ERROR"));
     CHECK_THAT(dev.errorMessage(), Catch::Contains("cable"));
 }
@@ -318,14 +309,14 @@ TEST_CASE("a stalled HD scheduler makes read() report Stalled, and close() still
     dev.setStaleTimeout(std::chrono::milliseconds(20));
     REQUIRE(dev.open() == DeviceStatus::Ok);
     DeviceState s;
-    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Ok; }));
+    REQUIRE(eventually([&] { return dev.read(s) == DeviceStatus::Ok; }));
 
     fake.stall(1);
-    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Stalled; }));
+    REQUIRE(eventually([&] { return dev.read(s) == DeviceStatus::Stalled; }));
     CHECK(dev.read(s) == DeviceStatus::Stalled); // no newer sample: counted as a stale read
     CHECK(dev.staleSampleCount() > 0);
     fake.stall(0);
-    REQUIRE(waitFor([&] { return dev.read(s) == DeviceStatus::Ok; }));
+    REQUIRE(eventually([&] { return dev.read(s) == DeviceStatus::Ok; }));
 
     fake.stall(1);
     dev.close(); // gives up waiting for the zero-force tick, releases the device anyway
@@ -434,7 +425,7 @@ TEST_CASE("a phantom whose servo thread stops feels no force (steady clock)", "[
             std::this_thread::sleep_for(std::chrono::microseconds(200));
         }
     });
-    CHECK(waitFor([&] {
+    CHECK(eventually([&] {
         const bool on = near(fake.force(kDefault), Vec3(0.5, 0.0, 0.0));
         if (on) {
             applied = true;
@@ -444,6 +435,6 @@ TEST_CASE("a phantom whose servo thread stops feels no force (steady clock)", "[
     applied = true;
     servo.join();
     // Only the eventual zero is asserted, within the generous bound of waitFor (10 s).
-    CHECK(waitFor([&] { return near(fake.force(kDefault), Vec3(0.0)); }));
+    CHECK(eventually([&] { return near(fake.force(kDefault), Vec3(0.0)); }));
     dev.close();
 }

@@ -1,6 +1,7 @@
 #pragma once
 /// Helpers shared by the tests: temporary files and running the `hapto` command.
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -8,8 +9,24 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <thread>
 
 namespace hapto::test {
+
+/// Polls `pred` every millisecond until it holds or the hang guard expires (a guard against a
+/// hang, not a timing requirement); returns whether it held. For tests whose subject runs on
+/// threads of its own (a device's I/O thread, an emulator, a servo thread).
+template <class P>
+bool eventually(P&& pred, std::chrono::milliseconds guard = std::chrono::seconds(10)) {
+    const auto end = std::chrono::steady_clock::now() + guard;
+    while (std::chrono::steady_clock::now() < end) {
+        if (pred()) {
+            return true;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return pred();
+}
 
 /// A fresh directory under the system temp dir, removed when the object dies.
 class TempDir {
