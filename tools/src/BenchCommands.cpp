@@ -244,10 +244,7 @@ void addBenchCommands(CLI::App& app) {
                     "optionally with :aabb, then optionally @root, @climb or @links to pick the "
                     "octree cursor's strategy (default links), e.g. octree:2:0.005@climb. "
                     "Default: brute, grid:5 and octree:2:0.005");
-    cmd->add_option("--max-index-mb", args->maxIndexMb,
-                    "Most memory an index build may take (MB); a larger index is refused")
-        ->capture_default_str()
-        ->check(finiteRange(1, kMaxIndexMbOption));
+    addMaxIndexMbOption(cmd, args->maxIndexMb);
     cmd->add_option("--steps", args->steps, "Walk steps (queries) per index, e.g. 1e5")
         ->capture_default_str()
         ->transform(wholeNumber(1, 4e9));

@@ -241,10 +241,7 @@ void addDemoCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(0, kMaxObjectId));
     cmd->add_option("--index", a->index, "Spatial index SPEC")->capture_default_str();
-    cmd->add_option("--max-index-mb", a->maxIndexMb,
-                    "Most memory an index build may take (MB); a larger index is refused")
-        ->capture_default_str()
-        ->check(finiteRange(1, kMaxIndexMbOption));
+    addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--report", a->report, "Write a JSON report here");
     addRealtimeFlag(cmd, a->realtime, "default: do not, the demo shares the machine");
     cmd->callback([a] { runDemo(*a); });

@@ -213,10 +213,7 @@ void addIndexCommands(CLI::App& app) {
             ->required();
         cmd->add_option("-o,--output", *out, "Output CSV file (default: standard output)");
         auto maxIndexMb = std::make_shared<std::uint64_t>(IndexSpec::kDefaultMaxMegabytes);
-        cmd->add_option("--max-index-mb", *maxIndexMb,
-                        "Most memory an index build may take (MB); a larger index is refused")
-            ->capture_default_str()
-            ->check(finiteRange(1, kMaxIndexMbOption));
+        addMaxIndexMbOption(cmd, *maxIndexMb);
         cmd->callback([=] { runQuery(*scene, *spec, *points, *out, *maxIndexMb); });
     }
     // index-stats
@@ -232,10 +229,7 @@ void addIndexCommands(CLI::App& app) {
         cmd->add_option("--index", *spec, specHelp)->required();
         cmd->add_flag("--json", *json, "Print the statistics as one JSON object");
         auto maxIndexMb = std::make_shared<std::uint64_t>(IndexSpec::kDefaultMaxMegabytes);
-        cmd->add_option("--max-index-mb", *maxIndexMb,
-                        "Most memory an index build may take (MB); a larger index is refused")
-            ->capture_default_str()
-            ->check(finiteRange(1, kMaxIndexMbOption));
+        addMaxIndexMbOption(cmd, *maxIndexMb);
         cmd->callback([=] {
             const IndexSpec parsed = IndexSpec::parse(*spec).withMaxMegabytes(*maxIndexMb);
             const Scene s = loadSceneOrDefault(*scene);

@@ -63,4 +63,19 @@ CLI::Option* addRealtimeFlag(CLI::App* cmd, bool& realtime, const std::string& w
                              "scheduling when refused and says so)");
 }
 
+CLI::Option* addIndexOption(CLI::App* cmd, std::string& spec) {
+    return cmd
+        ->add_option("--index", spec,
+                     "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb")
+        ->capture_default_str();
+}
+
+CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes) {
+    return cmd
+        ->add_option("--max-index-mb", megabytes,
+                     "Most memory an index build may take (MB); a larger index is refused")
+        ->capture_default_str()
+        ->check(finiteRange(1, kMaxIndexMbOption));
+}
+
 } // namespace hapto::cli

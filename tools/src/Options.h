@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <string>
 
 namespace hapto::cli {
@@ -32,5 +33,9 @@ CLI::Validator wholeNumber(double lo, double hi);
 /// `--realtime` and declined with `--no-realtime`. Old spellings stay as deprecated aliases.
 /// Adds `--realtime` and `--no-realtime` as one flag setting `realtime`. [control]
 CLI::Option* addRealtimeFlag(CLI::App* cmd, bool& realtime, const std::string& what);
+/// Adds `--index SPEC` (brute, grid:N, octree:M:MIN, optional :aabb), default shown. [control]
+CLI::Option* addIndexOption(CLI::App* cmd, std::string& spec);
+/// Adds `--max-index-mb MB`, the most memory an index build may take. [control]
+CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes);
 
 } // namespace hapto::cli

@@ -116,13 +116,8 @@ void addRenderCommands(CLI::App& app) {
                     "CSV file, one device point x,y,z (m, world frame) per tick, optional header "
                     "x,y,z")
         ->required();
-    cmd->add_option("--index", a->index,
-                    "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb")
-        ->capture_default_str();
-    cmd->add_option("--max-index-mb", a->maxIndexMb,
-                    "Most memory an index build may take (MB); a larger index is refused")
-        ->capture_default_str()
-        ->check(finiteRange(1, kMaxIndexMbOption));
+    addIndexOption(cmd, a->index);
+    addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--rate", a->rateHz,
                     "Tick rate (Hz): dt for the velocity and the renderer's damping and friction")
         ->capture_default_str()

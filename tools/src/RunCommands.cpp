@@ -200,13 +200,8 @@ void addRunCommands(CLI::App& app) {
     cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
     cmd->add_option("--devices", a->devices,
                     "Device configuration file (default: two simulated hands, left and right)");
-    cmd->add_option("--index", a->index,
-                    "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb")
-        ->capture_default_str();
-    cmd->add_option("--max-index-mb", a->maxIndexMb,
-                    "Most memory an index build may take (MB); a larger index is refused")
-        ->capture_default_str()
-        ->check(finiteRange(1, kMaxIndexMbOption));
+    addIndexOption(cmd, a->index);
+    addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--rate", a->rateHz,
                     "Servo rate for every device (Hz; default: each device's own)")
         ->check(finiteRange(100, 100000));

@@ -60,13 +60,8 @@ void addSoakCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(100, 100000));
     cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
-    cmd->add_option("--index", a->index,
-                    "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb")
-        ->capture_default_str();
-    cmd->add_option("--max-index-mb", a->maxIndexMb,
-                    "Most memory an index build may take (MB); a larger index is refused")
-        ->capture_default_str()
-        ->check(finiteRange(1, kMaxIndexMbOption));
+    addIndexOption(cmd, a->index);
+    addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--fault-every", a->faultEveryS,
                     "Inject a fault every this many seconds, into the hands in turn: disconnect "
                     "(0.5 s), stall of 0.4 watchdog timeouts (a miss, not a fault), non-finite "
