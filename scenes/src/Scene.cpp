@@ -25,6 +25,26 @@ Scene::Scene(Aabb bounds, std::vector<SceneObject> objects)
     if (mObjects.size() >= std::numeric_limits<std::uint32_t>::max()) {
         throw std::invalid_argument("a scene holds at most 2^32 - 1 objects");
     }
+    std::uint64_t triangles = 0;
+    for (std::uint32_t i = 0; i < mObjects.size(); ++i) {
+        const SceneObject& o = mObjects[i];
+        if (o.shape != Shape::Mesh) {
+            continue;
+        }
+        if (!o.mesh) {
+            throw std::invalid_argument("mesh object " + std::to_string(o.id) +
+                                        " has no triangles");
+        }
+        mMeshes.push_back({static_cast<std::uint32_t>(triangles), i});
+        triangles += o.mesh->triangleCount();
+        if (triangles > kMaxSceneTriangles) {
+            throw std::invalid_argument("a scene holds at most 2^31 - 1 triangles over all meshes");
+        }
+    }
+    mTriangleCount = static_cast<std::uint32_t>(triangles);
+    if (std::uint64_t(mObjects.size()) + triangles >= std::numeric_limits<std::uint32_t>::max()) {
+        throw std::invalid_argument("a scene holds at most 2^32 - 1 objects and triangles");
+    }
     mSlotById.reserve(mObjects.size());
     for (std::uint32_t i = 0; i < mObjects.size(); ++i) {
         mSlotById.emplace_back(mObjects[i].id, i);
@@ -44,6 +64,23 @@ std::optional<std::uint32_t> Scene::slotOf(ObjectId id) const {
         return std::nullopt;
     }
     return it->second;
+}
+
+TriangleRef Scene::triangle(std::uint32_t item) const noexcept {
+    const std::uint32_t n = item & ~kTriangleItemBit;
+    const auto it =
+        std::upper_bound(mMeshes.begin(), mMeshes.end(), n,
+                         [](std::uint32_t v, const MeshRange& m) { return v < m.firstTriangle; });
+    const MeshRange& m = *(it - 1);
+    return {m.objectSlot, n - m.firstTriangle};
+}
+
+std::array<Vec3, 3> Scene::triangleCorners(std::uint32_t item) const noexcept {
+    const TriangleRef ref = triangle(item);
+    const SceneObject& o = mObjects[ref.objectSlot];
+    const Mat3 r = glm::mat3_cast(o.rotation);
+    const auto [a, b, c] = o.mesh->corners(ref.triangle);
+    return {o.center + r * a, o.center + r * b, o.center + r * c};
 }
 
 void Scene::setPose(std::uint32_t slot, const Vec3& center, const Quat& rotation) {

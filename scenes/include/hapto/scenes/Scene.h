@@ -3,6 +3,7 @@
 
 #include "hapto/scenes/SceneObject.h"
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -11,8 +12,31 @@
 
 namespace hapto {
 
+/// The bit that marks an index item as a mesh triangle rather than an object slot.
+inline constexpr std::uint32_t kTriangleItemBit = 0x80000000u;
+/// The most triangles a scene may hold over all its meshes (item ids have 31 bits).
+inline constexpr std::uint64_t kMaxSceneTriangles = kTriangleItemBit - 1;
+
+/// True when an index item names a mesh triangle (kTriangleItemBit | scene triangle number).
+constexpr bool isTriangleItem(std::uint32_t item) noexcept {
+    return (item & kTriangleItemBit) != 0;
+}
+
+/// A scene triangle: which mesh object it belongs to and which of that mesh's triangles it is.
+struct TriangleRef {
+    std::uint32_t objectSlot = 0; ///< The mesh object's slot.
+    std::uint32_t triangle = 0;   ///< The triangle's number in that object's TriangleMesh.
+};
+
 /// Bounds and objects. Objects are addressed by a dense 32-bit slot (their position in
-/// `objects()`), which indices use internally, and named by their `ObjectId` in every output.
+/// `objects()`) and named by their `ObjectId` in every output.
+///
+/// Items. What a spatial index holds are *items*: every box and sphere by its slot, and every
+/// triangle of every mesh as `kTriangleItemBit | n`, where n numbers the scene's triangles
+/// mesh by mesh in slot order (a mesh object itself is not an item: its triangles are). Items
+/// are enumerated densely by `item(i)` for i < itemCount(): the object slots first, then the
+/// triangles. Appending an object keeps every existing item's id, so an index built before
+/// still names the same objects and triangles.
 class Scene {
 public:
     /// An empty scene over the paper's 25 cm work cube.
@@ -32,6 +56,30 @@ public:
     /// The slot of the object with this id, if any; O(log N). [any thread]
     std::optional<std::uint32_t> slotOf(ObjectId id) const;
 
+    /// Triangles over all mesh objects. [any thread]
+    std::uint32_t triangleCount() const { return mTriangleCount; }
+    /// Number of dense item positions: size() + triangleCount() (mesh objects' own positions
+    /// included; isIndexed() tells them apart). [any thread]
+    std::uint32_t itemCount() const { return size() + mTriangleCount; }
+    /// The item at dense position i < itemCount(). [any thread]
+    std::uint32_t item(std::uint32_t i) const noexcept {
+        return i < size() ? i : kTriangleItemBit | (i - size());
+    }
+    /// False for a mesh object's own slot (its triangles are indexed instead). [any thread]
+    bool isIndexed(std::uint32_t item) const noexcept {
+        return isTriangleItem(item) || mObjects[item].shape != Shape::Mesh;
+    }
+    /// The triangle an item names (the item must be a triangle item of this scene); O(log
+    /// meshes). [any thread]
+    TriangleRef triangle(std::uint32_t item) const noexcept;
+    /// The object an item belongs to: its own slot, or its mesh's slot. [any thread]
+    std::uint32_t objectSlotOf(std::uint32_t item) const noexcept {
+        return isTriangleItem(item) ? triangle(item).objectSlot : item;
+    }
+    /// A triangle item's corners in world coordinates (m), at its mesh's current pose. [any
+    /// thread]
+    std::array<Vec3, 3> triangleCorners(std::uint32_t item) const noexcept;
+
     /// Moves one object (m, unit quaternion); the caller owns this copy of the scene. [control]
     void setPose(std::uint32_t slot, const Vec3& center, const Quat& rotation);
 
@@ -45,8 +93,16 @@ public:
     }
 
 private:
+    /// Where each mesh's triangles start in the scene's triangle numbering.
+    struct MeshRange {
+        std::uint32_t firstTriangle;
+        std::uint32_t objectSlot;
+    };
+
     Aabb mBounds;
     std::vector<SceneObject> mObjects;
+    std::vector<MeshRange> mMeshes; // by firstTriangle, ascending
+    std::uint32_t mTriangleCount = 0;
     std::vector<std::pair<ObjectId, std::uint32_t>> mSlotById; // sorted by id
 };
 

@@ -1,9 +1,12 @@
 #pragma once
-/// One rigid object of a scene: an oriented box or a sphere with an id and a material.
+/// One rigid object of a scene: an oriented box, a sphere or a triangle mesh, with an id and a
+/// material.
 
 #include "hapto/core/Geometry.h"
+#include "hapto/scenes/TriangleMesh.h"
 
 #include <cstdint>
+#include <memory>
 #include <string_view>
 
 namespace hapto {
@@ -15,9 +18,9 @@ using ObjectId = std::uint32_t;
 inline constexpr ObjectId kMaxObjectId = 0xFFFFFFFEu;
 
 /// The shapes hapto renders.
-enum class Shape : std::uint8_t { Box, Sphere };
+enum class Shape : std::uint8_t { Box, Sphere, Mesh };
 
-/// The name of a shape as scene files spell it ("box", "sphere"). [any thread]
+/// The name of a shape as scene files spell it ("box", "sphere", "mesh"). [any thread]
 std::string_view shapeName(Shape shape);
 
 /// How an object feels.
@@ -39,22 +42,32 @@ struct Material {
     bool operator==(const Material&) const = default;
 };
 
-/// An oriented box or a sphere, in world coordinates (m).
+/// An oriented box, a sphere or a triangle mesh, in world coordinates (m).
+///
+/// A mesh is placed like a box: a world point x of the mesh is center + rotation * v for a
+/// local vertex v of `mesh` (scale already applied). Its triangles, not the object, are what an
+/// index holds (see Scene's items); the object itself is what moves and is grasped.
 struct SceneObject {
     ObjectId id = 0;           ///< Unique id within the scene.
-    Shape shape = Shape::Box;  ///< Box or sphere.
-    Vec3 center{0.0};          ///< Centre (m).
+    Shape shape = Shape::Box;  ///< Box, sphere or mesh.
+    Vec3 center{0.0};          ///< Centre (m); a mesh's local origin.
     Vec3 halfExtents{0.0};     ///< Box: half size per own axis (m). Sphere: radius, thrice.
+                               ///< Mesh: half size of its local bounds (m).
     Quat rotation{1, 0, 0, 0}; ///< Orientation, unit quaternion (w, x, y, z).
     Material material{};       ///< Stiffness and friction.
+    std::shared_ptr<const TriangleMesh> mesh; ///< Mesh only: its triangles, local frame.
 
-    /// Sphere radius (m); for a box, the radius of its bounding sphere. [any thread]
+    /// Sphere radius (m); for a box, the radius of its bounding sphere; for a mesh, of its
+    /// bounding sphere about `center`. [any thread]
     double radius() const;
-    /// The object's oriented bounding box (a sphere's is its axis-aligned cube). [any thread]
+    /// The object's oriented bounding box (a sphere's is its axis-aligned cube; a mesh's is its
+    /// local bounds, placed). [any thread]
     Obb obb() const;
-    /// The tightest world AABB (m). [any thread]
+    /// The tightest world AABB of its OBB (m). [any thread]
     Aabb aabb() const;
-    /// True when p lies in the solid (surface included). [any thread]
+    /// True when p lies in the solid (surface included). A mesh has a solid only when it is
+    /// closed (TriangleMesh::closed); the test casts a ray through every triangle, O(triangles):
+    /// for tools and tests, not for the servo path. [any thread]
     bool contains(const Vec3& p) const;
 
     bool operator==(const SceneObject&) const = default;
@@ -65,5 +78,8 @@ SceneObject makeBox(ObjectId id, Vec3 center, Vec3 halfExtents, Quat rotation = 
                     Material material = {});
 /// Makes a sphere. [any thread]
 SceneObject makeSphere(ObjectId id, Vec3 center, double radius, Material material = {});
+/// Places a mesh (which must not be null). [any thread]
+SceneObject makeMesh(ObjectId id, Vec3 center, std::shared_ptr<const TriangleMesh> mesh,
+                     Quat rotation = Quat(1, 0, 0, 0), Material material = {});
 
 } // namespace hapto

@@ -1,0 +1,116 @@
+#include "hapto/scenes/TriangleMesh.h"
+
+#include "hapto/core/Finite.h"
+#include "hapto/scenes/InputError.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace hapto {
+
+namespace {
+
+/// Relative area below which a triangle counts as degenerate: |cross|^2 <= this x (longest
+/// edge)^4, i.e. the triangle is thinner than 1e-12 of its longest edge.
+constexpr double kDegenerateRelative2 = 1e-24;
+
+bool degenerate(const TriangleIndices& t, std::span<const Vec3> v) {
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+        return true;
+    }
+    const Vec3 e0 = v[t[1]] - v[t[0]];
+    const Vec3 e1 = v[t[2]] - v[t[0]];
+    const Vec3 e2 = v[t[2]] - v[t[1]];
+    const double longest2 = std::max({glm::dot(e0, e0), glm::dot(e1, e1), glm::dot(e2, e2)});
+    const Vec3 c = glm::cross(e0, e1);
+    return !(glm::dot(c, c) > kDegenerateRelative2 * longest2 * longest2);
+}
+
+/// True when every undirected edge is used by exactly two triangles.
+bool everyEdgeShared(std::span<const TriangleIndices> triangles) {
+    std::vector<std::uint64_t> edges;
+    edges.reserve(triangles.size() * 3);
+    for (const TriangleIndices& t : triangles) {
+        for (int i = 0; i < 3; ++i) {
+            const std::uint64_t a = t[i];
+            const std::uint64_t b = t[(i + 1) % 3];
+            edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+        }
+    }
+    std::sort(edges.begin(), edges.end());
+    for (std::size_t i = 0; i < edges.size();) {
+        std::size_t j = i;
+        while (j < edges.size() && edges[j] == edges[i]) {
+            ++j;
+        }
+        if (j - i != 2) {
+            return false;
+        }
+        i = j;
+    }
+    return !edges.empty();
+}
+
+} // namespace
+
+std::shared_ptr<const TriangleMesh> TriangleMesh::make(std::vector<Vec3> vertices,
+                                                       std::vector<TriangleIndices> triangles,
+                                                       MeshSource source,
+                                                       const std::string& where) {
+    if (vertices.size() > kMaxVertices) {
+        throw InputError(where + ": " + std::to_string(vertices.size()) +
+                         " vertices; a mesh may have at most " + std::to_string(kMaxVertices));
+    }
+    if (triangles.size() > kMaxTriangles) {
+        throw InputError(where + ": " + std::to_string(triangles.size()) +
+                         " triangles; a mesh may have at most " + std::to_string(kMaxTriangles));
+    }
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        if (!finite(vertices[i])) {
+            throw InputError(where + ": vertices[" + std::to_string(i) +
+                             "] is not finite (after scaling)");
+        }
+    }
+    auto mesh = std::shared_ptr<TriangleMesh>(new TriangleMesh());
+    mesh->mSource = std::move(source);
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        const TriangleIndices t = triangles[i];
+        for (int k = 0; k < 3; ++k) {
+            if (t[k] >= vertices.size()) {
+                throw InputError(where + ": triangles[" + std::to_string(i) + "][" +
+                                 std::to_string(k) + "]: vertex index " + std::to_string(t[k]) +
+                                 " is out of range (the mesh has " +
+                                 std::to_string(vertices.size()) + " vertices)");
+            }
+        }
+        if (degenerate(t, vertices)) {
+            ++mesh->mDropped;
+            continue;
+        }
+        triangles[kept++] = t;
+    }
+    triangles.resize(kept);
+    if (triangles.empty()) {
+        throw InputError(where + ": no triangles" +
+                         (mesh->mDropped > 0
+                              ? " left (all " + std::to_string(mesh->mDropped) + " were degenerate)"
+                              : std::string()));
+    }
+    for (const TriangleIndices& t : triangles) {
+        for (const std::uint32_t i : t) {
+            mesh->mBounds.expand(vertices[i]);
+            mesh->mRadius = std::max(mesh->mRadius, glm::length(vertices[i]));
+        }
+    }
+    mesh->mClosed = everyEdgeShared(triangles);
+    mesh->mVertices = std::move(vertices);
+    mesh->mTriangles = std::move(triangles);
+    mesh->mVertices.shrink_to_fit();
+    mesh->mTriangles.shrink_to_fit();
+    return mesh;
+}
+
+} // namespace hapto
