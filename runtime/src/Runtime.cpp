@@ -47,12 +47,6 @@ Runtime::Channel::Channel(RuntimeDevice d, const RuntimeOptions& o)
 
 Runtime::Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOptions options)
     : mWorld(world), mOptions(options) {
-    if (devices.size() > World::kMaxReaders) {
-        // Refused before anything opens or starts, not at the 65th servo thread.
-        throw std::invalid_argument("runtime: " + std::to_string(devices.size()) +
-                                    " devices; at most " + std::to_string(World::kMaxReaders) +
-                                    " can share one world");
-    }
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     for (std::size_t i = 0; i < devices.size(); ++i) {
         if (!devices[i].device) {
@@ -101,7 +95,7 @@ std::size_t Runtime::openAll() {
         }
         c.opened = true;
         c.closed.store(false);
-        ch.servo.reader = mWorld.registerReader(); // the constructor bounded the count
+        ch.servo.reader = mWorld.registerReader();
         ++opened;
     }
     mStopping.store(false);

@@ -22,21 +22,30 @@ World::~World() {
 }
 
 SnapshotReader* World::registerReader() {
+    const std::lock_guard lock(mReadersMutex);
     for (SnapshotReader& r : mReaders) {
-        bool expected = false;
-        if (r.inUse.compare_exchange_strong(expected, true)) {
+        if (!r.inUse.load()) {
             r.held.store(nullptr);
+            r.inUse.store(true);
             return &r;
         }
     }
-    return nullptr;
+    SnapshotReader& r = mReaders.emplace_back();
+    r.inUse.store(true);
+    return &r;
 }
 
 void World::unregisterReader(SnapshotReader* reader) {
     if (reader) {
+        const std::lock_guard lock(mReadersMutex);
         reader->held.store(nullptr);
         reader->inUse.store(false);
     }
+}
+
+std::size_t World::readerCount() const {
+    const std::lock_guard lock(mReadersMutex);
+    return mReaders.size();
 }
 
 void World::publish(std::shared_ptr<const Scene> scene, std::shared_ptr<const SpatialIndex> index) {
@@ -207,6 +216,7 @@ bool World::rested(const Mover& m, std::uint64_t now) const noexcept {
 }
 
 void World::reclaim() {
+    const std::lock_guard lock(mReadersMutex);
     std::erase_if(mRetired, [&](const std::unique_ptr<WorldSnapshot>& s) {
         for (const SnapshotReader& r : mReaders) {
             if (r.held.load(std::memory_order_seq_cst) == s.get()) {

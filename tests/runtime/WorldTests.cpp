@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <thread>
+#include <vector>
 
 using namespace hapto;
 
@@ -68,6 +69,33 @@ TEST_CASE("added objects are felt at once; removed ones vanish with their rebuil
     CHECK(s.moving.empty());
     CHECK_THROWS(world.removeObject(10));
     CHECK_THROWS(world.moveObject(999, Vec3(0), Quat(1, 0, 0, 0)));
+}
+
+TEST_CASE("a world serves any number of readers, and a reader given back is reused") {
+    World world(twoBoxes(), IndexSpec::parse("brute"));
+    std::vector<SnapshotReader*> readers;
+    for (int i = 0; i < 200; ++i) { // far past the old fixed cap of 64
+        readers.push_back(world.registerReader());
+        REQUIRE(readers.back() != nullptr);
+    }
+    std::vector<SnapshotReader*> sorted = readers;
+    std::sort(sorted.begin(), sorted.end());
+    CHECK(std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()); // all distinct
+    CHECK(world.readerCount() == 200);
+    // Every one of them holds back reclamation while it holds a snapshot.
+    const WorldSnapshot& held = world.acquire(*readers[150]);
+    world.moveObject(20, Vec3(0.06, 0, 0), Quat(1, 0, 0, 0));
+    world.maintain();
+    CHECK(world.retiredCount() == 1);
+    CHECK(world.acquire(*readers[150]).version > held.version);
+    world.maintain();
+    CHECK(world.retiredCount() == 0);
+    world.unregisterReader(readers[7]);
+    CHECK(world.registerReader() == readers[7]); // reused, no growth
+    CHECK(world.readerCount() == 200);
+    for (SnapshotReader* r : readers) {
+        world.unregisterReader(r);
+    }
 }
 
 TEST_CASE("a snapshot a reader holds is not freed until the reader moves on") {

@@ -88,9 +88,9 @@ TEST_CASE("hapto run refuses what cannot work before any device starts, and writ
     CHECK(r.exitCode == 2);
     CHECK_THAT(r.output, Catch::Contains("--spin-us") && Catch::Contains("500 us"));
     CHECK_THAT(r.output, !Catch::Contains("hapto run: 2 devices")); // nothing started
-    // More devices than one World serves.
+    // More devices than one session drives.
     std::string many = R"({"format": "hapto-devices", "version": 1, "devices": [)";
-    for (int i = 0; i < 65; ++i) {
+    for (int i = 0; i < 1025; ++i) {
         many += (i ? "," : "") + std::string(R"({"name": "h)") + std::to_string(i) +
                 R"(", "kind": "sim"})";
     }
@@ -98,7 +98,7 @@ TEST_CASE("hapto run refuses what cannot work before any device starts, and writ
     r = runHapto("run --no-realtime --quiet --devices " + (dir / "many.json").string() +
                  " --report " + (dir / "r.json").string());
     CHECK(r.exitCode == 2);
-    CHECK_THAT(r.output, Catch::Contains("65 devices") && Catch::Contains("64"));
+    CHECK_THAT(r.output, Catch::Contains("1025 devices") && Catch::Contains("1024"));
     CHECK(readFile(dir / "r.json") == "an older report\n");
     CHECK(std::distance(std::filesystem::directory_iterator(dir.path()),
                         std::filesystem::directory_iterator()) == 2);

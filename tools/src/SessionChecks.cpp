@@ -16,12 +16,11 @@ namespace hapto::cli {
 namespace fs = std::filesystem;
 
 void checkDeviceCount(std::size_t devices, const std::string& source) {
-    if (devices > World::kMaxReaders) {
+    if (devices > kMaxSessionDevices) {
         throw InputError((source.empty() ? std::string("the session") : "--devices " + source) +
                          ": " + std::to_string(devices) + " devices, but one session drives at " +
-                         "most " + std::to_string(World::kMaxReaders) +
-                         " (World::kMaxReaders, one snapshot reader per servo thread); split " +
-                         "them over several sessions");
+                         "most " + std::to_string(kMaxSessionDevices) +
+                         " (one servo thread each); split them over several sessions");
     }
 }
 

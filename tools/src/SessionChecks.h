@@ -18,8 +18,14 @@ struct SessionPaths {
     std::string record;  ///< --record: the folder the traces go to (<folder>/<name>.trace).
 };
 
-/// Refuses more devices than one World serves (World::kMaxReaders), naming the limit and
-/// `source` (the device file). [control]
+/// The most devices one `hapto run` drives: 1024. The World has no cap on readers; this one
+/// guards against a generated device file gone wrong. Every device is a servo thread, and at
+/// 1 kHz a device-tick costs about 8 us of CPU with the kernel's sleep and wake-up, so 1024
+/// devices already need about eight cores.
+inline constexpr std::size_t kMaxSessionDevices = 1024;
+
+/// Refuses more devices than kMaxSessionDevices, naming the limit and `source` (the device
+/// file). [control]
 void checkDeviceCount(std::size_t devices, const std::string& source);
 
 /// Refuses a spin (us, before each deadline) that is not shorter than the servo period of

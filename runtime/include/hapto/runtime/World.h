@@ -10,8 +10,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <future>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <vector>
 
@@ -48,19 +50,21 @@ struct alignas(64) SnapshotReader {
 /// or a ManualClock given to useClock(), which also makes builds run inline: deterministic.
 class World {
 public:
-    /// Readers a world can serve (servo threads plus tools).
-    static constexpr std::size_t kMaxReaders = 64;
-
     /// Builds the index over the scene and publishes version 1. [control]
     World(Scene scene, IndexSpec spec);
     ~World();
     World(const World&) = delete;
     World& operator=(const World&) = delete;
 
-    /// Registers a reader (one per servo thread); nullptr when all are taken. [control]
+    /// Registers a reader (one per servo thread). There is no fixed cap: a reader given back
+    /// is reused, otherwise a new one is made (allocates; its address stays valid for the
+    /// world's life). Takes a mutex that only register, unregister and reclamation use: the
+    /// servo path (acquire) never touches it. [control]
     SnapshotReader* registerReader();
     /// Gives a reader back; it must not be inside a tick. [control]
     void unregisterReader(SnapshotReader* reader);
+    /// Readers made so far (in use or free). [control]
+    std::size_t readerCount() const;
 
     /// Claims the current snapshot for `reader` until its next acquire. Lock-free, never
     /// allocates. [servo]
@@ -137,7 +141,8 @@ private:
     std::atomic<const WorldSnapshot*> mCurrent{nullptr};
     std::unique_ptr<WorldSnapshot> mOwned; // the current snapshot's owner
     std::vector<std::unique_ptr<WorldSnapshot>> mRetired;
-    std::array<SnapshotReader, kMaxReaders> mReaders{};
+    mutable std::mutex mReadersMutex;    // register, unregister, reclaim; never the servo path
+    std::deque<SnapshotReader> mReaders; // grows at the back only: addresses stay valid
     std::vector<Mover> mMovers;
     std::unique_ptr<PendingBuild> mBuild;
     std::vector<ObjectId> mPendingRemovals; // removals wait for a build
