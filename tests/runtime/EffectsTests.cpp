@@ -3,6 +3,7 @@
 // before the safety filter, clamped and sanitised by it.
 
 #include "ScriptedDevice.h"
+#include "TestSupport.h"
 
 #include "hapto/core/Finite.h"
 #include "hapto/runtime/Effects.h"
@@ -424,4 +425,37 @@ TEST_CASE("runtime: effects and the hook pass through the safety filter") {
         rig.runTo(100); // held still: the damper adds nothing
         CHECK(near(rig.force(), probe.renderForce + Vec3(0.3, 0, -0.2), 1e-12));
     }
+}
+
+TEST_CASE("servo threads: effects set while they run reach them, and the control thread never "
+          "waits for a tick",
+          "[realtime]") {
+    World world(cubeScene(), IndexSpec::parse("octree:2:0.005"));
+    std::vector<RuntimeDevice> rds;
+    auto d = std::make_unique<ScriptedDevice>("d", still(Vec3(0.08, 0.06, 0.0))); // free space
+    DeviceConfig c;
+    c.name = std::string(d->name());
+    c.kind = DeviceKind::Scripted;
+    c.maxForceN = 5.0;
+    rds.push_back({std::move(d), c, nullptr});
+    RuntimeOptions options;
+    options.realtime = false;               // tests share a noisy machine
+    options.stallTimeoutNs = 5'000'000'000; // a sanitizer build may stall a thread a while
+    Runtime runtime(world, std::move(rds), options);
+    REQUIRE(runtime.start() == 1);
+    const auto force = [&runtime] {
+        const DeviceMetrics& m = runtime.metrics(0);
+        return Vec3(m.forceN[0].load(), m.forceN[1].load(), m.forceN[2].load());
+    };
+    for (int i = 1; i <= 20; ++i) {
+        const Vec3 f(0.01 * i, 0.0, -0.02 * (i % 3));
+        const std::vector<ForceEffect> effects = {ForceEffect::constant(f)};
+        runtime.setEffects(0, effects);
+        INFO("set " << i);
+        CHECK(test::eventually([&] { return force() == f; }));
+    }
+    runtime.setEffectEnabled(0, 0, false);
+    CHECK(test::eventually([&] { return force() == Vec3(0.0); }));
+    runtime.stop();
+    CHECK(runtime.report().devices[0].fault.empty());
 }
