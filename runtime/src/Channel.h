@@ -4,11 +4,14 @@
 ///
 /// Design note. A Channel is laid out in four parts, by who touches them how often:
 ///   ServoState      hot: everything one tick reads or writes and nothing else (the device
-///                   pointer, the frames, the deadline, the sample, the haptic tick). Only the
-///                   servo thread (or the stepping thread) touches it while the servo runs;
-///                   1984 bytes, asserted below: 256 of tick state, 1728 of HapticTick.
+///                   pointer, the frames, the deadline, the sample, the haptic tick with its
+///                   effects and hook). Only the servo thread (or the stepping thread) touches
+///                   it while the servo runs; 3328 bytes, asserted below: 256 of tick state,
+///                   3072 of HapticTick.
 ///   DeviceMetrics   written every tick by the servo, read by any thread (its own lines).
-///   two Mailboxes   contacts out, external force in, every tick (their own lines).
+///   three Mailboxes contacts out, external force in, every tick; effects in, when the control
+///                   thread changes them, with a count the servo checks every tick (their own
+///                   lines).
 ///   ChannelRecord   cold: the configuration and its strings, the threads, recovery flags,
 ///                   the fault record and event list under a mutex. Never touched by a tick.
 /// Strings, vectors and mutexes live only in the record, so a tick's cache lines hold tick data.
@@ -47,10 +50,11 @@ struct alignas(64) ServoState {
     int missLimit = 3;           ///< K.
 
     // Per tick.
-    std::uint64_t deadlineNs = 0; ///< The next wake-up.
-    std::uint64_t tick = 0;       ///< Ticks completed, over every start of the servo.
-    int consecutiveMisses = 0;    ///< Saturates at missLimit.
-    bool first = true;            ///< The next tick is the first since the servo started.
+    std::uint64_t deadlineNs = 0;     ///< The next wake-up.
+    std::uint64_t tick = 0;           ///< Ticks completed, over every start of the servo.
+    std::uint64_t effectsApplied = 0; ///< Effect sets published that the haptic tick holds.
+    int consecutiveMisses = 0;        ///< Saturates at missLimit.
+    bool first = true;                ///< The next tick is the first since the servo started.
     std::atomic<bool> stop{false};
     Vec3 lastPosition{0.0}; ///< The last device point (m, world).
     DeviceState sample;     ///< The last reading.
@@ -59,12 +63,13 @@ struct alignas(64) ServoState {
     ServoState(const RendererConfig& renderer, const SafetyConfig& safety)
         : haptic(renderer, safety) {}
 };
-static_assert(sizeof(ServoState) == 1984, "update the size in the note above");
+static_assert(sizeof(ServoState) == 3328, "update the size in the note above");
 
 /// The cold record of a channel.
 struct ChannelRecord {
-    RuntimeDevice rd; ///< The device (owned), its configuration, its recorder.
-    int cpu = -1;     ///< The core its servo thread is pinned to, or -1.
+    RuntimeDevice rd;  ///< The device (owned), its configuration, its recorder.
+    EffectSet effects; ///< The effects as the control thread last set them.
+    int cpu = -1;      ///< The core its servo thread is pinned to, or -1.
     std::thread thread;
     bool opened = false; ///< open() succeeded at start(); control thread only.
     std::string openError;
@@ -91,7 +96,9 @@ struct alignas(64) Runtime::Channel {
     DeviceMetrics metrics;           ///< Servo -> any thread.
     Mailbox<ContactReport> contacts; ///< Servo -> control, every tick.
     Mailbox<Vec3> externalForce;     ///< Control -> servo, world frame (N).
-    ChannelRecord record;            ///< Cold.
+    Mailbox<EffectSet> effects;      ///< Control -> servo, a new effect set when changed.
+    std::atomic<std::uint64_t> effectsPublished{0}; ///< Sets published to `effects` so far.
+    ChannelRecord record;                           ///< Cold.
 
     Channel(RuntimeDevice d, const RuntimeOptions& o);
 };

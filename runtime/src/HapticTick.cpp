@@ -1,8 +1,10 @@
 #include "hapto/runtime/HapticTick.h"
 
+#include "hapto/core/Finite.h"
+
 namespace hapto {
 
-static_assert(sizeof(HapticTick) == 1728, "update the size in HapticTick.h");
+static_assert(sizeof(HapticTick) == 3072, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
 
 HapticTick::HapticTick(const RendererConfig& renderer, const SafetyConfig& safety)
@@ -13,13 +15,14 @@ void HapticTick::reset() noexcept {
     mSafety.reset();
 }
 
-Vec3 HapticTick::effectsForceN(const RenderOutput& /*render*/, const Vec3& /*devicePointWorld*/,
-                               const Vec3& /*velocityWorld*/, double /*dtS*/) const noexcept {
-    return Vec3(0.0);
+TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& v, double dtS,
+                            const Vec3& externalForceN) noexcept {
+    static constexpr DeviceState kNoSample{};
+    return tick(snapshot, p, v, dtS, externalForceN, kNoSample);
 }
 
 TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& v, double dtS,
-                            const Vec3& externalForceN) noexcept {
+                            const Vec3& externalForceN, const DeviceState& sample) noexcept {
     TickOutput out;
     // A new snapshot (or the first tick): the cursors re-bind to its index and forget their
     // leaves; a snapshot that only moved objects shares the index, but re-binding is cheap
@@ -53,8 +56,26 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     // 3. Render.
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
 
-    // 4. Force effects, and the external force. 5. Safety.
-    const Vec3 requested = out.render.force + externalForceN + effectsForceN(out.render, p, v, dtS);
+    // 4. Force effects at the device point, then the hook, and the external force. A hook
+    // that returns NaN or infinity adds nothing (counted), like a renderer's non-finite output.
+    out.effectsN = mEffects.forceN(p, v);
+    if (mHook.fn) {
+        const TickHookArgs args{
+            sample,
+            p,
+            v,
+            out.render.proxy,
+            std::span<const Contact>(out.render.contacts.data(), out.render.contactCount),
+            out.render.force,
+            dtS};
+        out.hookN = mHook.fn(mHook.context, args);
+        if (!finite(out.hookN)) {
+            out.hookN = Vec3(0.0);
+            out.hookNonFinite = true;
+        }
+    }
+    // 5. Safety.
+    const Vec3 requested = out.render.force + externalForceN + out.effectsN + out.hookN;
     out.forceN = mSafety.filter(requested);
     return out;
 }

@@ -58,6 +58,7 @@ RunReport Runtime::report() const {
         d.contactTicks = m.contactTicks.load();
         d.snapshotsSeen = m.snapshotsSeen.load();
         d.safety = ch.servo.haptic.safety().counters();
+        d.hookNonFinite = m.hookNonFinite.load();
         d.realtime = m.realtime.load(std::memory_order_relaxed);
         std::lock_guard lock(c.mutex);
         const FaultKind f = m.fault.load();
@@ -145,6 +146,7 @@ std::string reportToJson(const RunReport& r) {
               {"rate_limited", d.safety.rateLimited},
               {"non_finite", d.safety.nonFinite},
               {"overflowed", d.safety.overflowed}}},
+            {"hook_non_finite", d.hookNonFinite},
             {"faults", d.faults},
             {"fault", d.fault},
             {"reopens", d.reopens},

@@ -26,10 +26,30 @@ SafetyConfig safetyFor(double maxForceN) {
     return c;
 }
 
+/// The runtime's renderer settings with the device's own contact damping, if it has one.
+RendererConfig rendererFor(const RendererConfig& runtime, const DeviceConfig& device) {
+    RendererConfig c = runtime;
+    if (device.contactDampingNsPerM) {
+        c.damping = *device.contactDampingNsPerM;
+    }
+    return c;
+}
+
+/// The device's configured effects, checked; a message names the device.
+EffectSet effectsFor(const DeviceConfig& device) {
+    try {
+        return EffectSet(device.effects);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("runtime: device '" + device.name + "': " + e.what());
+    }
+}
+
 } // namespace
 
 Runtime::Channel::Channel(RuntimeDevice d, const RuntimeOptions& o)
-    : servo(o.renderer, safetyFor(d.config.maxForceN)) {
+    : servo(rendererFor(o.renderer, d.config), safetyFor(d.config.maxForceN)) {
+    record.effects = effectsFor(d.config);
+    servo.haptic.setEffects(record.effects); // before any thread: no publish needed
     const std::uint64_t period = static_cast<std::uint64_t>(std::llround(1e9 / d.config.rateHz));
     servo.device = d.device.get();
     servo.recorder = d.recorder;
@@ -78,6 +98,7 @@ void Runtime::requireStepped(const char* what) const {
 }
 
 std::size_t Runtime::openAll() {
+    mStarted = true;
     mStartNs = now();
     // Every device is opened before any servo starts (the PHANToM's HD scheduler must not run
     // while another device is being initialised; a Falcon homes with zero force).
@@ -235,6 +256,52 @@ bool Runtime::contact(std::size_t i, ContactReport& report) const {
 
 void Runtime::setExternalForce(std::size_t i, const Vec3& forceN) {
     mChannels.at(i)->externalForce.publish(forceN);
+}
+
+namespace {
+
+/// Hands `effects` to the servo: publish, then count, so a servo that sees the count finds
+/// that set (or a newer one) in the mailbox. [control]
+void publishEffects(Mailbox<EffectSet>& mailbox, std::atomic<std::uint64_t>& published,
+                    const EffectSet& effects) {
+    mailbox.publish(effects);
+    published.store(published.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+}
+
+} // namespace
+
+void Runtime::setEffects(std::size_t i, std::span<const ForceEffect> effects) {
+    Channel& ch = *mChannels.at(i);
+    try {
+        ch.record.effects = EffectSet(effects);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("Runtime::setEffects: device '" + ch.record.rd.config.name +
+                                    "': " + e.what());
+    }
+    publishEffects(ch.effects, ch.effectsPublished, ch.record.effects);
+}
+
+void Runtime::setEffectEnabled(std::size_t i, std::size_t k, bool enabled) {
+    Channel& ch = *mChannels.at(i);
+    if (!ch.record.effects.setEnabled(k, enabled)) {
+        throw std::out_of_range("Runtime::setEffectEnabled: device '" + ch.record.rd.config.name +
+                                "' has no effect " + std::to_string(k) + " (it has " +
+                                std::to_string(ch.record.effects.size()) + ")");
+    }
+    publishEffects(ch.effects, ch.effectsPublished, ch.record.effects);
+}
+
+const EffectSet& Runtime::effects(std::size_t i) const {
+    return mChannels.at(i)->record.effects;
+}
+
+void Runtime::setTickHook(std::size_t i, const TickHook& hook) {
+    Channel& ch = *mChannels.at(i);
+    if (mStarted) {
+        throw std::logic_error("Runtime::setTickHook: register hooks before start() or "
+                               "startStepped()");
+    }
+    ch.servo.haptic.setHook(hook);
 }
 
 } // namespace hapto

@@ -1,10 +1,11 @@
 // The servo: one tick of one device, and the loop that runs it. Design note: a tick is read,
-// claim the snapshot, the haptic tick (HapticTick: locate both cursors, candidates, render,
-// effects, safety), the fault rules, write, record. Faults become zero force and a recorded
-// FaultKind, never an exception. The tick is written once, as servoTick(): a servo thread
-// sleeps to each absolute deadline and calls it (servoMain); the step mode calls it from the
-// caller's thread at the times the caller gives (step). Nothing below servoTick's entry
-// allocates, locks, throws or makes a syscall beyond the device's own I/O and the clock.
+// claim the snapshot, pick up changed force effects, the haptic tick (HapticTick: locate both
+// cursors, candidates, render, effects and the hook, safety), the fault rules, write, record.
+// Faults become zero force and a recorded FaultKind, never an exception. The tick is written once,
+// as servoTick(): a servo thread sleeps to each absolute deadline and calls it (servoMain); the
+// step mode calls it from the caller's thread at the times the caller gives (step). Nothing below
+// servoTick's entry allocates, locks, throws or makes a syscall beyond the device's own I/O and the
+// clock.
 //
 // The fault rules, per tick:
 //   - read() or write() fails: fault, zero, the servo ends (supervision closes and reopens);
@@ -82,9 +83,22 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
     s.lastPosition = p;
     Vec3 external{0.0};
     (void)ch.externalForce.read(external);
-    const TickOutput out = s.haptic.tick(snap, p, v, s.dtS, external);
+    // Effects the control thread changed since the last tick: copied in now. A read that races
+    // a newer publish fails and is tried again next tick; the servo never waits for it.
+    if (ch.effectsPublished.load(std::memory_order_acquire) != s.effectsApplied) {
+        EffectSet fresh;
+        std::uint64_t writes = 0;
+        if (ch.effects.read(fresh, writes)) {
+            s.haptic.setEffects(fresh);
+            s.effectsApplied = writes;
+        }
+    }
+    const TickOutput out = s.haptic.tick(snap, p, v, s.dtS, external, s.sample);
     if (out.newSnapshot) {
         DeviceMetrics::bump(m.snapshotsSeen);
+    }
+    if (out.hookNonFinite) {
+        DeviceMetrics::bump(m.hookNonFinite);
     }
     if (s.stop.load(std::memory_order_acquire)) {
         return false; // stopped while rendering: leaving writes zero, not this force

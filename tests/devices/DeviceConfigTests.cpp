@@ -82,6 +82,70 @@ TEST_CASE("the README hardware example loads; relative traces resolve against th
     CHECK(configs[2].rateHz == 1000.0);
 }
 
+TEST_CASE("the README effects example loads: springs to a plane and a line, a damper in a "
+          "sphere, a constant force that is off, and the contact damping") {
+    const auto configs = parseDeviceConfig(readmeExample(2), "effects.json");
+    REQUIRE(configs.size() == 1);
+    const DeviceConfig& c = configs[0];
+    REQUIRE(c.contactDampingNsPerM.has_value());
+    CHECK(*c.contactDampingNsPerM == 2.0);
+    REQUIRE(c.effects.size() == 4);
+    const ForceEffect& plane = c.effects[0];
+    CHECK(plane.type == EffectType::Spring);
+    CHECK(plane.target == SpringTarget::Plane);
+    CHECK(plane.anchorM == Vec3(0, 0.05, 0));
+    CHECK(plane.axis == Vec3(0, 1, 0));
+    CHECK(plane.stiffnessNPerM == 200.0);
+    CHECK(plane.enabled);
+    CHECK(plane.region.shape == RegionShape::Everywhere);
+    const ForceEffect& line = c.effects[1];
+    CHECK(line.target == SpringTarget::Line);
+    CHECK(line.axis == Vec3(1, 0, 0));
+    CHECK(line.stiffnessNPerM == 50.0);
+    const ForceEffect& damper = c.effects[2];
+    CHECK(damper.type == EffectType::Damper);
+    CHECK(damper.dampingNsPerM == 5.0);
+    CHECK(damper.region.shape == RegionShape::Sphere);
+    CHECK(damper.region.centerM == Vec3(0, 0, 0));
+    CHECK(damper.region.radiusM == 0.02);
+    const ForceEffect& constant = c.effects[3];
+    CHECK(constant.type == EffectType::Constant);
+    CHECK(constant.forceN == Vec3(0, -0.5, 0));
+    CHECK_FALSE(constant.enabled);
+}
+
+TEST_CASE("effects: a spring to a point, a box region, a normalised axis, and none by default") {
+    const auto configs = parseDeviceConfig(withDevice(R"("effects": [
+        {"type": "spring", "anchor": [0.1, 0.2, 0.3], "stiffness_n_per_m": 0},
+        {"type": "spring", "anchor": [0, 0, 0], "stiffness_n_per_m": 10000, "direction": [0, 3, 4]},
+        {"type": "damper", "damping_n_s_per_m": 100, "enabled": true,
+         "region": {"box": {"center": [1, 2, 3], "half_extents": [0.1, 0.2, 0.3]}}},
+        {"type": "constant", "force_n": [0, 0, 100], "region": {"sphere": {"center": [0, 0, 0],
+         "radius_m": 1e6}}}])"),
+                                           "e.json");
+    const std::vector<ForceEffect>& e = configs.at(0).effects;
+    REQUIRE(e.size() == 4);
+    CHECK(e[0].target == SpringTarget::Point);
+    CHECK(e[0].anchorM == Vec3(0.1, 0.2, 0.3));
+    CHECK(e[0].stiffnessNPerM == 0.0); // the limits are inclusive
+    CHECK(e[1].axis == Vec3(0, 0.6, 0.8));
+    CHECK(e[1].stiffnessNPerM == kMaxEffectStiffnessNPerM);
+    CHECK(e[2].region.shape == RegionShape::Box);
+    CHECK(e[2].region.centerM == Vec3(1, 2, 3));
+    CHECK(e[2].region.halfExtentsM == Vec3(0.1, 0.2, 0.3));
+    CHECK(e[2].dampingNsPerM == kMaxDampingNsPerM);
+    CHECK(e[3].forceN == Vec3(0, 0, kMaxEffectForceN));
+    CHECK(e[3].region.radiusM == kMaxEffectLengthM);
+    for (const ForceEffect& effect : e) {
+        CHECK_FALSE(checkForceEffect(effect).has_value());
+    }
+
+    const DeviceConfig plain = parseDeviceConfig(withDevice(""), "p.json").at(0);
+    CHECK(plain.effects.empty());
+    CHECK_FALSE(plain.contactDampingNsPerM.has_value());
+    CHECK(parseDeviceConfig(withDevice(R"("effects": [])"), "p.json").at(0).effects.empty());
+}
+
 TEST_CASE("defaults apply to a minimal device") {
     const auto configs = parseDeviceConfig(withDevice(""), "min.json");
     REQUIRE(configs.size() == 1);
@@ -163,6 +227,10 @@ TEST_CASE("every bad input names the file and its JSON path") {
     };
     const std::string two =
         R"({"format": "hapto-devices", "version": 1, "devices": [{"name": "a", "kind": "sim"}, )";
+    std::string nineEffects = R"({"type": "constant", "force_n": [0, 0, 1]})";
+    for (int i = 1; i < 9; ++i) {
+        nineEffects += R"(, {"type": "constant", "force_n": [0, 0, 1]})";
+    }
     const std::vector<Case> cases = {
         {"[1, 2]", "bad.json: (top level): expected a JSON object"},
         {"{\"format\": \"hapto-devices\",", "bad.json:1:"},
@@ -255,6 +323,82 @@ TEST_CASE("every bad input names the file and its JSON path") {
          "than one servo period (5 ms at rate_hz 200)"},
         {two + R"({"name": "b", "kind": "sim", "sim": {"command_timeout_ms": 2}}]})",
          "bad.json: devices[1].sim: unknown field 'command_timeout_ms'"},
+        // Force effects and the renderer.
+        {two + R"({"name": "b", "kind": "sim", "effects": {"type": "spring"}}]})",
+         "bad.json: devices[1].effects: expected an array of effects, got an object"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [3]}]})",
+         "bad.json: devices[1].effects[0]: expected an object"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [{"anchor": [0, 0, 0]}]}]})",
+         "bad.json: devices[1].effects[0]: missing required field 'type'"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [{"type": "magnet"}]}]})",
+         "bad.json: devices[1].effects[0].type: unknown effect type 'magnet' (expected spring, "
+         "damper or constant)"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "constant", "force_n": [0, 1, 0]},
+            {"type": "spring", "anchor": [0, 0, 0], "stiffness_n_per_m": 1e9}]}]})",
+         "bad.json: devices[1].effects[1].stiffness_n_per_m: the stiffness (N/m) must be in "
+         "0..10000 (got 1e+09); a stiffer spring only oscillates"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "spring", "anchor": [0, 0, 0], "stiffness_n_per_m": -5}]}]})",
+         "bad.json: devices[1].effects[0].stiffness_n_per_m: the stiffness (N/m) must be in "
+         "0..10000 (got -5)"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "spring", "stiffness_n_per_m": 100}]}]})",
+         "bad.json: devices[1].effects[0]: missing required field 'anchor'"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "spring", "anchor": [0, 0, 0], "stiffness_n_per_m": "stiff"}]}]})",
+         "bad.json: devices[1].effects[0].stiffness_n_per_m: expected a number, got a string"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "spring", "anchor": [0, 2e6, 0], "stiffness_n_per_m": 100}]}]})",
+         "bad.json: devices[1].effects[0].anchor: the anchor (m) must have each coordinate"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "spring", "anchor": [0, 0, 0], "stiffness_n_per_m": 100,
+             "direction": [0, 0, 0]}]}]})",
+         "bad.json: devices[1].effects[0].direction: the direction must not be zero"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "spring", "anchor": [0, 0, 0], "stiffness_n_per_m": 100,
+             "direction": [0, 0, 1], "normal": [0, 1, 0]}]}]})",
+         "bad.json: devices[1].effects[0].normal: a spring pulls to a line"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "damper", "damping_n_s_per_m": 2, "stiffness_n_per_m": 100}]}]})",
+         "bad.json: devices[1].effects[0]: unknown field 'stiffness_n_per_m'"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "damper", "damping_n_s_per_m": 500}]}]})",
+         "bad.json: devices[1].effects[0].damping_n_s_per_m: the damping (N·s/m) must be in "
+         "0..100 (got 500)"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "damper", "damping_n_s_per_m": 2, "region": {}}]}]})",
+         "bad.json: devices[1].effects[0].region: a region is one of"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "damper", "damping_n_s_per_m": 2,
+             "region": {"sphere": {"center": [0, 0, 0], "radius_m": 0}}}]}]})",
+         "bad.json: devices[1].effects[0].region.sphere.radius_m: the radius (m) must be > 0"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "damper", "damping_n_s_per_m": 2,
+             "region": {"box": {"center": [0, 0, 0], "half_extents": [0.1, -0.1, 0.1]}}}]}]})",
+         "bad.json: devices[1].effects[0].region.box.half_extents: each half extent (m) must be "
+         "> 0"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "damper", "damping_n_s_per_m": 2,
+             "region": {"box": {"center": [0, 0, 0]}}}]}]})",
+         "bad.json: devices[1].effects[0].region.box: missing required field 'half_extents'"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "constant", "force_n": [0, 0, 1000]}]}]})",
+         "bad.json: devices[1].effects[0].force_n: the force's magnitude (N) must be in 0..100 "
+         "(got 1000)"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [
+            {"type": "constant", "force_n": [0, 0, 1], "enabled": "yes"}]}]})",
+         "bad.json: devices[1].effects[0].enabled: expected true or false"},
+        {two + R"({"name": "b", "kind": "sim", "effects": [)" + nineEffects + "]}]}",
+         "bad.json: devices[1].effects: at most 8 effects per device (got 9)"},
+        {two + R"({"name": "b", "kind": "sim", "renderer": {"damping_n_s_per_m": -1}}]})",
+         "bad.json: devices[1].renderer.damping_n_s_per_m: the contact damping (N·s/m) must be "
+         ">= 0 (got -1)"},
+        {two + R"({"name": "b", "kind": "sim", "renderer": {"damping_n_s_per_m": 1000}}]})",
+         "bad.json: devices[1].renderer.damping_n_s_per_m: the contact damping (N·s/m) must be "
+         "<= 100 (got 1000)"},
+        {two + R"({"name": "b", "kind": "sim", "renderer": {"damping": 1}}]})",
+         "bad.json: devices[1].renderer: unknown field 'damping'"},
     };
     for (const Case& c : cases) {
         INFO(c.text);

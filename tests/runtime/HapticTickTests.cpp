@@ -5,6 +5,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <limits>
+#include <vector>
+
 using namespace hapto;
 
 namespace {
@@ -137,4 +140,63 @@ TEST_CASE("a new snapshot re-binds the cursors and is reported once; moving obje
     CHECK(out.render.contactCount == 1);
     CHECK(out.render.contacts[0].id == 8);
     CHECK(out.render.force.y == Approx(800.0 * (0.001 + GodObjectRenderer::kSkinM)));
+}
+
+namespace {
+
+/// Counts its calls, checks it got no device reading, and returns `force`.
+struct NoSampleHook {
+    Vec3 force{0.0};
+    int calls = 0;
+    bool sawDefaultSample = true;
+};
+
+Vec3 noSampleHook(void* context, const TickHookArgs& a) noexcept {
+    auto& h = *static_cast<NoSampleHook*>(context);
+    ++h.calls;
+    h.sawDefaultSample = h.sawDefaultSample && a.sample.position == Vec3(0.0) &&
+                         a.sample.sequence == 0 && a.sample.buttons == 0;
+    return h.force;
+}
+
+} // namespace
+
+TEST_CASE("the tick adds its effects and its hook to the render force, each reported apart, "
+          "before the safety filter") {
+    World world(boxScene(500.0), IndexSpec::parse("octree:2:0.005"));
+    HapticTick tick;
+    const std::vector<ForceEffect> effects = {ForceEffect::constant(Vec3(0.2, 0, 0)),
+                                              ForceEffect::damper(3.0)};
+    tick.setEffects(EffectSet(effects));
+    NoSampleHook hook;
+    hook.force = Vec3(0, 0, -0.1);
+    tick.setHook({&noSampleHook, &hook});
+    const TickOutput out = pressTo(tick, world.current(), 0.002); // held still: damper adds 0
+    CHECK(hook.calls == 101);
+    CHECK(hook.sawDefaultSample); // the tick without a device reading hands over a default one
+    CHECK(out.effectsN == Vec3(0.2, 0, 0));
+    CHECK(out.hookN == Vec3(0, 0, -0.1));
+    CHECK_FALSE(out.hookNonFinite);
+    CHECK(out.forceN.x == Approx(out.render.force.x + 0.2).epsilon(1e-12));
+    CHECK(out.forceN.y == Approx(out.render.force.y).epsilon(1e-12));
+    CHECK(out.forceN.z == Approx(out.render.force.z - 0.1).epsilon(1e-12));
+    CHECK(tick.effects().size() == 2);
+
+    // In free space, a moving point feels the damper: -b v, with the velocity given.
+    HapticTick free;
+    free.setEffects(EffectSet(effects));
+    free.setHook({&noSampleHook, &hook});
+    const TickOutput moving =
+        free.tick(world.current(), Vec3(0.08, 0, 0), Vec3(0.1, 0, 0), 1e-3, Vec3(0.0));
+    CHECK(moving.render.force == Vec3(0.0));
+    CHECK(moving.effectsN.x == Approx(0.2 - 0.3).epsilon(1e-12));
+    CHECK(moving.forceN.x == Approx(0.2 - 0.3).epsilon(1e-12));
+    CHECK(moving.forceN.z == Approx(-0.1).epsilon(1e-12));
+
+    // A NaN from the hook adds nothing and is flagged; the effects still apply.
+    hook.force = Vec3(std::numeric_limits<double>::quiet_NaN());
+    const TickOutput bad = free.tick(world.current(), Vec3(0.08, 0, 0), Vec3(0.0), 1e-3, Vec3(0.0));
+    CHECK(bad.hookNonFinite);
+    CHECK(bad.hookN == Vec3(0.0));
+    CHECK(bad.forceN == Vec3(0.2, 0, 0));
 }

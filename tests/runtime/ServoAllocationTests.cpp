@@ -104,6 +104,35 @@ void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcep
 
 using namespace hapto;
 
+namespace {
+
+/// A hook that does what a hook may: reads atomics and computes (a pull towards the other
+/// device's point).
+struct PullToOther {
+    const DeviceMetrics* other = nullptr;
+    std::atomic<std::uint64_t> calls{0};
+};
+
+Vec3 pullToOther(void* context, const TickHookArgs& tick) noexcept {
+    auto& pull = *static_cast<PullToOther*>(context);
+    pull.calls.fetch_add(1, std::memory_order_relaxed);
+    const Vec3 there(pull.other->positionM[0].load(), pull.other->positionM[1].load(),
+                     pull.other->positionM[2].load());
+    return 10.0 * (there - tick.devicePointM) + 0.001 * static_cast<double>(tick.contacts.size());
+}
+
+/// Every kind of effect, and a hook on every device.
+std::vector<ForceEffect> everyEffect(double k) {
+    return {ForceEffect::springToPoint(Vec3(0, 0.01, 0), k),
+            ForceEffect::springToLine(Vec3(0), Vec3(1, 0, 0), k),
+            ForceEffect::springToPlane(Vec3(0), Vec3(0, 1, 0), k),
+            ForceEffect::damper(1.0, EffectRegion::box(Vec3(0), Vec3(0.05))),
+            ForceEffect::damper(0.5, EffectRegion::sphere(Vec3(0), 0.03)),
+            ForceEffect::constant(Vec3(0, -0.1, 0))};
+}
+
+} // namespace
+
 TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (step mode)") {
     const Scene scene = makeDefaultScene();
     const std::string spec =
@@ -116,11 +145,18 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
     std::vector<RuntimeDevice> devices;
     for (DeviceConfig c : defaultDeviceConfigs()) {
         c.rateHz = 2000;
+        c.effects = everyEffect(20.0);
+        c.contactDampingNsPerM = 1.0;
         devices.push_back({makeDevice(c, scene), c, nullptr});
     }
     RuntimeOptions opt;
     opt.realtime = false;
     Runtime runtime(world, std::move(devices), opt);
+    PullToOther hooks[2];
+    for (std::size_t i = 0; i < 2; ++i) {
+        hooks[i].other = &runtime.metrics(1 - i);
+        runtime.setTickHook(i, {&pullToOther, &hooks[i]});
+    }
     const std::uint64_t before = gAllAllocations.load();
     const std::uint64_t servoBefore = gServoAllocations.load();
     const std::uint64_t t0 = clock.nowNs();
@@ -129,6 +165,10 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
         if (i % 20 == 0) { // a move every 20 ms; re-indexed once it rests
             world.moveObject(scene.object(0).id, scene.object(0).center + Vec3(0, 0.0001 * i, 0),
                              Quat(1, 0, 0, 0));
+        }
+        if (i % 7 == 0) { // new effects from the control side, picked up by the next tick
+            runtime.setEffects(i % 2, everyEffect(10.0 + i % 30));
+            runtime.setEffectEnabled(1 - i % 2, i % 6, i % 3 != 0);
         }
         runtime.runUntil(t0 + static_cast<std::uint64_t>(i) * 1'000'000);
         runtime.maintain();
@@ -141,6 +181,8 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
         CHECK(d.snapshotsSeen >= 20);
     }
     CHECK(world.buildsPublished() > 1);
+    CHECK(hooks[0].calls.load() == 800);
+    CHECK(hooks[1].calls.load() == 800);
     CHECK(gAllAllocations.load() > before); // the counter is live: the control side allocates
     CHECK(gServoAllocations.load() == servoBefore);
 }
@@ -153,11 +195,17 @@ TEST_CASE("servo threads make no heap allocation while running, across snapshot 
     std::vector<RuntimeDevice> devices;
     for (DeviceConfig c : defaultDeviceConfigs()) {
         c.rateHz = 2000;
+        c.effects = everyEffect(20.0);
         devices.push_back({makeDevice(c, scene), c, nullptr});
     }
     RuntimeOptions opt;
     opt.realtime = false;
     Runtime runtime(world, std::move(devices), opt);
+    PullToOther hooks[2];
+    for (std::size_t i = 0; i < 2; ++i) {
+        hooks[i].other = &runtime.metrics(1 - i);
+        runtime.setTickHook(i, {&pullToOther, &hooks[i]});
+    }
     const std::uint64_t before = gAllAllocations.load();
     const std::uint64_t servoBefore = gServoAllocations.load();
     runtime.start();
@@ -173,6 +221,7 @@ TEST_CASE("servo threads make no heap allocation while running, across snapshot 
             world.moveObject(scene.object(0).id, scene.object(0).center + Vec3(0, 0.0001 * i, 0),
                              Quat(1, 0, 0, 0));
         }
+        runtime.setEffects(i % 2, everyEffect(10.0 + i % 30)); // while the servos run
         runtime.maintain();
     }
     runtime.stop();
@@ -182,6 +231,8 @@ TEST_CASE("servo threads make no heap allocation while running, across snapshot 
         CHECK(d.fault.empty());
         CHECK(d.snapshotsSeen >= 5);
     }
+    CHECK(hooks[0].calls.load() > 0);
+    CHECK(hooks[1].calls.load() > 0);
     CHECK(gAllAllocations.load() > before); // the counter is live: the control thread allocates
     CHECK(gServoAllocations.load() == servoBefore);
 }

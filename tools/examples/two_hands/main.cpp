@@ -1,6 +1,7 @@
 // two_hands: the smallest complete hapto application. Two devices (simulated hands here; a
 // device file can name Falcons or PHANToMs instead) grasp a cube, lift it, carry it 10 cm and
-// put it down, while hapto measures every servo tick.
+// put it down, while hapto measures every servo tick. Each hand also feels the other through a
+// virtual spring: a per-tick hook, called on each hand's servo thread.
 //
 //   two_hands [DEVICES.json]
 
@@ -19,6 +20,32 @@
 #include <thread>
 
 using namespace hapto;
+
+// The virtual spring between the hands (a 10 cm bar of 5 N/m): each hand's hook reads the other
+// hand's newest point from its live metrics (atomics) and pulls or pushes along the line
+// between them. It runs on the servo thread every tick, so it only reads and computes: no
+// allocation, lock, print or wait.
+struct Coupling {
+    const DeviceMetrics* other = nullptr; // the other hand
+    double stiffnessNPerM = 5.0;
+    double restLengthM = 0.10;
+};
+
+static Vec3 feelTheOtherHand(void* context, const TickHookArgs& tick) noexcept {
+    const Coupling& c = *static_cast<const Coupling*>(context);
+    if (c.other->ticks.load(std::memory_order_relaxed) == 0) {
+        return Vec3(0.0); // the other hand has no point yet
+    }
+    const Vec3 there(c.other->positionM[0].load(std::memory_order_relaxed),
+                     c.other->positionM[1].load(std::memory_order_relaxed),
+                     c.other->positionM[2].load(std::memory_order_relaxed));
+    const Vec3 d = there - tick.devicePointM;
+    const double length = glm::length(d);
+    if (length < 1e-9) {
+        return Vec3(0.0);
+    }
+    return c.stiffnessNPerM * (length - c.restLengthM) * (d / length); // N, world
+}
 
 // Two simulated hands, left and right of the cube, running the grasp scripts.
 static std::vector<DeviceConfig> simulatedHands() {
@@ -44,6 +71,9 @@ int main(int argc, char** argv) try {
     // 2. The devices, from a file or in code.
     const std::vector<DeviceConfig> configs =
         argc > 1 ? loadDeviceConfigFile(argv[1]) : simulatedHands();
+    if (configs.size() != 2) {
+        throw InputError(std::string(argv[1]) + ": two devices, please (left and right hands)");
+    }
     std::vector<RuntimeDevice> devices;
     for (const DeviceConfig& config : configs) {
         devices.push_back({makeDevice(config, scene), config, nullptr});
@@ -57,6 +87,10 @@ int main(int argc, char** argv) try {
         std::fprintf(stderr, "two_hands: %s\n", grant.note.c_str());
     }
     Runtime runtime(world, std::move(devices));
+    // The hooks are registered before start(); their contexts outlive the runtime's threads.
+    Coupling leftFeelsRight{&runtime.metrics(1)}, rightFeelsLeft{&runtime.metrics(0)};
+    runtime.setTickHook(0, {&feelTheOtherHand, &leftFeelsRight});
+    runtime.setTickHook(1, {&feelTheOtherHand, &rightFeelsLeft});
     GraspController grasp(world, runtime, 0, 1);
     if (runtime.start() != configs.size()) {
         std::fprintf(stderr, "two_hands: a device did not open\n");

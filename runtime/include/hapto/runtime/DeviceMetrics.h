@@ -40,6 +40,7 @@ struct alignas(64) DeviceMetrics {
     std::atomic<std::uint64_t> outsideTicks{0}; ///< Ticks with the pointer outside the bounds.
     std::atomic<std::uint64_t> contactTicks{0}; ///< Ticks in contact with some object.
     std::atomic<std::uint64_t> snapshotsSeen{0};   ///< Distinct world versions picked up.
+    std::atomic<std::uint64_t> hookNonFinite{0};   ///< Ticks whose hook force was not finite.
     std::atomic<std::uint64_t> heartbeatNs{0};     ///< Monotonic time of the last completed tick.
     std::atomic<FaultKind> fault{FaultKind::None}; ///< Set once when the thread faults.
     std::atomic<std::uint8_t> faultStatus{0};      ///< The DeviceStatus behind a read/write fault.

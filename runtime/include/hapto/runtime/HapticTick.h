@@ -2,10 +2,13 @@
 /// The haptic tick, once: locate (device and proxy cursors) -> candidates -> render -> force
 /// effects -> safety filter, for one device, real-time safe.
 
+#include "hapto/devices/Device.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/runtime/CandidateSet.h"
+#include "hapto/runtime/Effects.h"
 #include "hapto/runtime/ForceSafety.h"
 #include "hapto/runtime/GodObjectRenderer.h"
+#include "hapto/runtime/TickHook.h"
 #include "hapto/runtime/World.h"
 
 #include <cstdint>
@@ -17,9 +20,12 @@ struct TickOutput {
     /// The renderer's result: proxy, contacts, objects tested, status, and its force (N)
     /// before effects, the external force and the safety filter.
     RenderOutput render;
-    /// The force to send (N): render force + external force + effects, through the safety
-    /// filter.
+    /// The force to send (N): render force + external force + effects + hook, through the
+    /// safety filter.
     Vec3 forceN{0.0};
+    Vec3 effectsN{0.0};         ///< The force effects' sum this tick (N), before the safety filter.
+    Vec3 hookN{0.0};            ///< The hook's force this tick (N; zero when it was not finite).
+    bool hookNonFinite = false; ///< The hook returned a non-finite force (replaced by zero).
     std::uint32_t locateSteps = 0; ///< Cursor steps, both cursors.
     bool outside = false;          ///< The device point is outside the index's bounds.
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
@@ -33,16 +39,17 @@ struct TickOutput {
 ///   2. candidates: the two leaves' object slots (the proxy's only when its leaf differs) and
 ///      the snapshot's moving objects, as spans (no copy);
 ///   3. render: the god-object renderer moves the proxy and computes k (proxy - device);
-///   4. force effects: the extension point where effects add force (empty today; see
-///      effectsForceN);
+///   4. force effects and the hook: the device's EffectSet (springs, dampers, constant forces)
+///      at the device point, then the application's per-tick hook, if any, are added to the
+///      render force and the external force;
 ///   5. safety: ForceSafety clamps, rate-limits and sanitises the sum.
 /// It holds the two cursors, the renderer, the safety filter and the candidate set, sized at
 /// construction: tick() never allocates, locks, makes a syscall or throws. One instance per
 /// device, used by one thread at a time. The caller owns the snapshot (it stays valid for the
 /// tick) and the device side: reading, the frames, and what to do with the force.
 ///
-/// Size: 1728 bytes, 64-byte aligned (checked by a static_assert in the source file), of
-/// which 1408 are the renderer.
+/// Size: 3072 bytes, 64-byte aligned (checked by a static_assert in the source file), of
+/// which 1408 are the renderer and 1288 the effect set (8 effects of 160 bytes).
 class alignas(64) HapticTick {
 public:
     /// Checks both configurations; throws std::invalid_argument when one is invalid. [control]
@@ -55,10 +62,26 @@ public:
 
     /// One tick for the device point `devicePointWorld` (m) moving at `velocityWorld` (m/s;
     /// not finite: estimated from the last point over dtS) against `snapshot`, `dtS` seconds
-    /// after the last tick, with `externalForceN` (N, e.g. a carried object's weight) added
-    /// before the safety filter. [servo]
+    /// after the last tick, with `externalForceN` (N, e.g. a carried object's weight), the
+    /// effects' force and the hook's added before the safety filter. `sample` is the device's
+    /// reading, handed to the hook. [servo]
+    TickOutput tick(const WorldSnapshot& snapshot, const Vec3& devicePointWorld,
+                    const Vec3& velocityWorld, double dtS, const Vec3& externalForceN,
+                    const DeviceState& sample) noexcept;
+    /// The same without a device reading (`hapto render`, the experiments): the hook, if any,
+    /// sees a default DeviceState. [servo]
     TickOutput tick(const WorldSnapshot& snapshot, const Vec3& devicePointWorld,
                     const Vec3& velocityWorld, double dtS, const Vec3& externalForceN) noexcept;
+
+    /// Replaces the force effects from the next tick on (a copy, no allocation). [servo] (the
+    /// thread that ticks; the Runtime's control side goes through Runtime::setEffects)
+    void setEffects(const EffectSet& effects) noexcept { mEffects = effects; }
+    /// The force effects. [servo]
+    const EffectSet& effects() const noexcept { return mEffects; }
+    /// Registers the per-tick hook (null fn: none), called from the next tick on; see
+    /// TickHook.h for its rules. [control] before the first tick, or from the thread that
+    /// ticks: it is a plain field, not synchronised.
+    void setHook(const TickHook& hook) noexcept { mHook = hook; }
 
     /// The force of the last tick is not sent (a fault rule commanded zero): the next force
     /// grows from zero at the safety filter's rate. [servo]
@@ -72,19 +95,13 @@ public:
     const ForceSafety& safety() const noexcept { return mSafety; }
 
 private:
-    /// Force effects (N, world frame), added after rendering and before the safety filter,
-    /// so an effect is clamped and rate-limited like contact. The extension point for a set
-    /// of effects (a vibration, a viscous field, a spring to a point, a button click): each
-    /// sees this tick's render result and device motion, must be real-time safe like the
-    /// rest of the tick, and adds its force here. None today: zero. [servo]
-    Vec3 effectsForceN(const RenderOutput& render, const Vec3& devicePointWorld,
-                       const Vec3& velocityWorld, double dtS) const noexcept;
-
     Cursor mDeviceCursor; ///< The device point's leaf.
     Cursor mProxyCursor;  ///< The proxy's leaf.
     GodObjectRenderer mRenderer;
     ForceSafety mSafety;
     CandidateSet mCandidates;                  ///< This tick's spans (views into the snapshot).
+    EffectSet mEffects;                        ///< Springs, dampers, constant forces.
+    TickHook mHook;                            ///< The application's per-tick hook, or none.
     const SpatialIndex* mBoundIndex = nullptr; ///< The index the cursors are bound to.
     std::uint64_t mBoundVersion = 0;           ///< The snapshot version they were bound for.
     bool mFresh = true;                        ///< The next tick starts afresh (reset()).

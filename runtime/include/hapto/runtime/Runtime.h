@@ -6,9 +6,11 @@
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/runtime/DeviceMetrics.h"
+#include "hapto/runtime/Effects.h"
 #include "hapto/runtime/ForceSafety.h"
 #include "hapto/runtime/GodObjectRenderer.h"
 #include "hapto/runtime/ManualClock.h"
+#include "hapto/runtime/TickHook.h"
 #include "hapto/runtime/World.h"
 
 #include <array>
@@ -18,6 +20,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -53,13 +56,14 @@ struct RuntimeOptions {
     std::uint64_t reopenAfterNs =
         1'000'000'000;         ///< After a fault, close the device and try to open it again every
                                ///< this long (ns), then drive it again from zero force; 0 = never.
-    RendererConfig renderer{}; ///< Proxy settings for every device.
+    RendererConfig renderer{}; ///< Proxy settings for every device (a device's
+                               ///< DeviceConfig::contactDampingNsPerM overrides the damping).
 };
 
 /// One device as the runtime drives it.
 struct RuntimeDevice {
     std::unique_ptr<Device> device;    ///< The backend, not yet opened.
-    DeviceConfig config;               ///< Name, transform, rate, max force.
+    DeviceConfig config;               ///< Name, transform, rate, max force, effects.
     TraceRecorder* recorder = nullptr; ///< Optional per-tick recording (owned by the caller).
 };
 
@@ -74,10 +78,11 @@ struct DeviceReport {
     std::uint64_t lateWakeups = 0, missedDeadlines = 0, zeroedForMisses = 0;
     double locateStepsMean = 0, candidatesMean = 0;
     std::uint64_t outsideTicks = 0, contactTicks = 0, snapshotsSeen = 0;
-    SafetyCounters safety{};   ///< Clamps, rate limits, non-finite forces.
-    std::string fault;         ///< Empty, or what faulted the device and keeps it down now.
-    std::uint64_t faults = 0;  ///< Faults while running (each zeroed the device at once).
-    std::uint64_t reopens = 0; ///< Times the device was opened again after a fault.
+    SafetyCounters safety{};         ///< Clamps, rate limits, non-finite forces.
+    std::uint64_t hookNonFinite = 0; ///< Ticks whose hook returned a non-finite force (zeroed).
+    std::string fault;               ///< Empty, or what faulted the device and keeps it down now.
+    std::uint64_t faults = 0;        ///< Faults while running (each zeroed the device at once).
+    std::uint64_t reopens = 0;       ///< Times the device was opened again after a fault.
     /// Time from each fault to its reopen, summed, the current outage included (s).
     double downS = 0;
     std::vector<std::string> events; ///< "12.345 s: read-failed: disconnected", oldest first
@@ -189,6 +194,26 @@ public:
     /// before the safety filter (e.g. the weight of a carried object). [control]
     void setExternalForce(std::size_t i, const Vec3& forceN);
 
+    /// Replaces device i's force effects (springs, dampers, constant forces; Effects.h) from
+    /// its next tick on, running or not. Never waits for the servo thread: the whole set goes
+    /// through a lock-free mailbox and the servo copies it in at its next tick. Throws
+    /// std::invalid_argument naming the effect and its field when there are more than
+    /// EffectSet::kCapacity or one fails checkForceEffect(), std::out_of_range for a bad i.
+    /// [control]
+    void setEffects(std::size_t i, std::span<const ForceEffect> effects);
+    /// Turns effect k of device i on or off from its next tick on, as setEffects(). Throws
+    /// std::out_of_range when there is no such device or effect. [control]
+    void setEffectEnabled(std::size_t i, std::size_t k, bool enabled);
+    /// Device i's effects as last set (its DeviceConfig's, then setEffects() and
+    /// setEffectEnabled()). [control]
+    const EffectSet& effects(std::size_t i) const;
+    /// Registers device i's per-tick hook (see TickHook.h for what it may do), called on its
+    /// servo thread every tick from the first on; `hook.context` must stay valid until stop().
+    /// Only before start() or startStepped(): afterwards it throws std::logic_error (the hook
+    /// is a plain field of the servo's state; starting the thread publishes it, so the servo
+    /// reads it without any synchronisation). [control]
+    void setTickHook(std::size_t i, const TickHook& hook);
+
 private:
     struct Channel;
     // Runtime.cpp: set-up and shutdown.
@@ -216,6 +241,7 @@ private:
     RuntimeOptions mOptions;
     std::vector<std::unique_ptr<Channel>> mChannels;
     ManualClock* mClock = nullptr; // step mode's clock; nullptr: threaded, CLOCK_MONOTONIC
+    bool mStarted = false;         // start() or startStepped() was called (hooks are fixed)
     std::uint64_t mStartNs = 0;
     std::atomic<std::uint64_t> mStopNs{0};
     std::string mRealtimeNote;
