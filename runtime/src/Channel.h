@@ -6,7 +6,7 @@
 ///   ServoState      hot: everything one tick reads or writes and nothing else (the device
 ///                   pointer, the frames, the deadline, the sample, the haptic tick). Only the
 ///                   servo thread (or the stepping thread) touches it while the servo runs;
-///                   1984 bytes, asserted below: 256 of tick state, 1728 of HapticTick.
+///                   2112 bytes, asserted below: 384 of tick state, 1728 of HapticTick.
 ///   DeviceMetrics   written every tick by the servo, read by any thread (its own lines).
 ///   two Mailboxes   contacts out, external force in, every tick (their own lines).
 ///   ChannelRecord   cold: the configuration and its strings, the threads, recovery flags,
@@ -39,6 +39,7 @@ struct alignas(64) ServoState {
     TraceRecorder* recorder = nullptr;
     SnapshotReader* reader = nullptr;
     WorkspaceTransform transform;
+    Vec3 toolTip{0.0}; ///< The contact point in the stylus frame (m); 0 = the gimbal centre.
     std::uint64_t periodNs = 1'000'000;
     std::uint64_t lateNs = 0;    ///< A wake-up later than this is counted late.
     std::uint64_t starvedNs = 0; ///< One this late (K periods) commands zero.
@@ -59,7 +60,7 @@ struct alignas(64) ServoState {
     ServoState(const RendererConfig& renderer, const SafetyConfig& safety)
         : haptic(renderer, safety) {}
 };
-static_assert(sizeof(ServoState) == 1984, "update the size in the note above");
+static_assert(sizeof(ServoState) == 2112, "update the size in the note above");
 
 /// The cold record of a channel.
 struct ChannelRecord {
