@@ -116,6 +116,9 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
     std::vector<RuntimeDevice> devices;
     for (DeviceConfig c : defaultDeviceConfigs()) {
         c.rateHz = 2000;
+        // A turning stylus with a tool tip: the tip's point and velocity are servo work too.
+        c.toolTipM = Vec3(0.0, 0.0, 0.01);
+        std::get<SimConfig>(c.params).spinRadPerS = Vec3(0.0, 1.0, 0.0);
         devices.push_back({makeDevice(c, scene), c, nullptr});
     }
     RuntimeOptions opt;

@@ -61,6 +61,8 @@ TEST_CASE("hapto trace info describes a trace") {
     REQUIRE(r.exitCode == 0);
     CHECK_THAT(r.output, Catch::Contains("left (sim)"));
     CHECK_THAT(r.output, Catch::Contains("samples:  3"));
+    CHECK_THAT(r.output, Catch::Contains("format:   version 2"));
+    CHECK_THAT(r.output, Catch::Contains("tool tip: [0, 0, 0] m"));
 }
 
 TEST_CASE("hapto trace export refuses a bad trace with exit code 2") {

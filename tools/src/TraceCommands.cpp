@@ -99,6 +99,15 @@ void printInfo(const std::string& tracePath) {
     std::printf("trace:    %s\n", tracePath.c_str());
     std::printf("device:   %s (%s)\n", h.name.c_str(), h.kind.c_str());
     std::printf("rate:     %g Hz\n", h.rateHz);
+    std::printf("format:   version %u\n", h.version);
+    if (h.hasConfiguration()) {
+        const WorkspaceTransform& t = h.transform;
+        std::printf("transform: translation [%g, %g, %g] m, rotation [%g, %g, %g, %g], scale %g\n",
+                    t.translation.x, t.translation.y, t.translation.z, t.rotation.w, t.rotation.x,
+                    t.rotation.y, t.rotation.z, t.scale);
+        std::printf("tool tip: [%g, %g, %g] m\n", h.toolTipM.x, h.toolTipM.y, h.toolTipM.z);
+        std::printf("clamp:    %g N%s\n", h.maxForceN, h.maxForceN > 0 ? "" : " (the default)");
+    }
     std::printf("samples:  %llu%s\n", static_cast<unsigned long long>(n),
                 h.finished ? "" : " (recording was not closed)");
     if (n > 0) {
