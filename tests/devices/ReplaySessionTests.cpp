@@ -107,6 +107,10 @@ TEST_CASE("replay: a recorded run replayed against the same scene and index writ
         c.maxForceN = 2.0;
     }
     configs[1].transform.rotation = glm::angleAxis(0.3, glm::normalize(Vec3(0, 0, 1)));
+    // The left hand holds a turning stylus touching with a 1 mm tool tip: the replay must play
+    // the orientation and angular velocity back and take the recorded tip.
+    configs[0].toolTipM = Vec3(0.0, 0.0, 0.001);
+    std::get<SimConfig>(configs[0].params).spinRadPerS = Vec3(0.0, 0.8, 0.0);
     const auto recorded = runAndRecord(scene, configs, dir / "run");
 
     std::vector<DeviceConfig> replays = replaysOf(configs, dir / "run");
@@ -116,6 +120,7 @@ TEST_CASE("replay: a recorded run replayed against the same scene and index writ
         CHECK(replays[i].maxForceN == 2.0);
         CHECK(replays[i].transform.translation == configs[i].transform.translation);
         CHECK(replays[i].transform.rotation == configs[i].transform.rotation);
+        CHECK(replays[i].toolTipM == configs[i].toolTipM);
     }
     const auto replayed = runAndRecord(scene, replays, dir / "replay");
 
@@ -138,6 +143,9 @@ TEST_CASE("replay: a recorded run replayed against the same scene and index writ
             REQUIRE(b.contactCount == a.contactCount);
             REQUIRE(b.positionM == a.positionM);
             REQUIRE(b.velocityMps == a.velocityMps);
+            REQUIRE(b.orientation == a.orientation);
+            REQUIRE(b.angularVelocity == a.angularVelocity);
+            REQUIRE(b.hasOrientation == (d == 0));
         }
     }
 }
