@@ -45,7 +45,7 @@ SimConfig parseSim(const Source& w, const Json& j, const Path& path) {
     checkKeys(w, j, path,
               {"script", "seed", "start", "object", "near", "press_n", "max_speed_m_per_s", "lift",
                "carry", "hand_mass_kg", "hand_stiffness_n_per_m", "hand_damping_ratio",
-               "resolution_m", "noise_m"});
+               "resolution_m", "noise_m", "orientation", "spin_rad_per_s"});
     SimConfig c;
     if (const Json* v = optional(j, "script")) {
         const std::string script = string(w, *v, path / "script");
@@ -103,6 +103,16 @@ SimConfig parseSim(const Source& w, const Json& j, const Path& path) {
     }
     if (const Json* v = optional(j, "noise_m")) {
         c.noiseM = ranged(w, *v, path / "noise_m", 0.0, 0.01, false, "the noise (m)");
+    }
+    if (const Json* v = optional(j, "orientation")) {
+        c.orientation = quaternion(w, *v, path / "orientation");
+    }
+    if (const Json* v = optional(j, "spin_rad_per_s")) {
+        c.spinRadPerS = vec3(w, *v, path / "spin_rad_per_s");
+        for (int i = 0; i < 3; ++i) {
+            checkRange(w, c.spinRadPerS[i], (path / "spin_rad_per_s")[static_cast<std::size_t>(i)],
+                       -100.0, 100.0, false, "a spin component (rad/s)");
+        }
     }
     return c;
 }
@@ -333,8 +343,8 @@ bool validName(const std::string& name) {
 DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
     object(w, j, path);
     checkKeys(w, j, path,
-              {"name", "kind", "rate_hz", "max_force_n", "transform", "effects", "renderer", "sim",
-               "replay", "falcon", "phantom"});
+              {"name", "kind", "rate_hz", "max_force_n", "transform", "tool_tip", "effects",
+               "renderer", "sim", "replay", "falcon", "phantom"});
     DeviceConfig d;
     d.name = string(w, required(w, j, path, "name"), path / "name");
     if (!validName(d.name)) {
@@ -372,6 +382,16 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
     if (const Json* v = optional(j, "renderer")) {
         d.contactDampingNsPerM = parseRenderer(w, *v, path / "renderer");
     }
+    if (const Json* v = optional(j, "tool_tip")) {
+        d.toolTipM = vec3(w, *v, path / "tool_tip");
+        for (int i = 0; i < 3; ++i) {
+            if (std::abs(d.toolTipM[i]) > kMaxToolTipM) {
+                w.fail((path / "tool_tip")[static_cast<std::size_t>(i)],
+                       "a tool tip component is at most " + show(kMaxToolTipM) + " m (got " +
+                           show(d.toolTipM[i]) + ")");
+            }
+        }
+    }
     const Json* params = optional(j, kind.c_str());
     const Path ppath = path / kind.c_str();
     switch (d.kind) {
@@ -382,7 +402,14 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
         if (!params) {
             w.fail(path, "a replay device needs \"replay\": {\"trace\": \"FILE\"}");
         }
-        d.params = parseReplay(w, *params, ppath);
+        {
+            ReplayConfig r = parseReplay(w, *params, ppath);
+            r.ownRate = j.contains("rate_hz");
+            r.ownTransform = j.contains("transform");
+            r.ownToolTip = j.contains("tool_tip");
+            r.ownMaxForce = j.contains("max_force_n");
+            d.params = std::move(r);
+        }
         break;
     case DeviceKind::Falcon:
         d.params = parseFalcon(w, params ? *params : Json::object(), ppath, d.rateHz);

@@ -146,6 +146,12 @@ DeviceStatus FalconDevice::read(DeviceState& state) noexcept {
     if (have) {
         state.position = s.positionM;
         state.hasVelocity = false;
+        // The Falcon senses its three arm encoders only: no stylus orientation, gimbal or
+        // gripper (../shared/devices/, libnifalcon's FalconKinematic).
+        state.hasOrientation = false;
+        state.hasAngularVelocity = false;
+        state.hasGimbalAngles = false;
+        state.hasGripper = false;
         state.buttons = s.buttons;
         state.sequence = s.sequence;
     }

@@ -4,7 +4,8 @@
 // The idea: two real-time threads that never wait for each other. The HD scheduler thread owns
 // the device I/O (hdBeginFrame/hdEndFrame must run there); the hapto servo thread owns the force
 // computation. Between them sit two single-writer seqlock mailboxes per device:
-//   sample  HD thread -> servo   {position m, velocity m/s, buttons, time since open (ns)}
+//   sample  HD thread -> servo   {position m, velocity m/s, stylus orientation, gimbal angles
+//                                 rad, buttons, time since open (ns)}
 //   force   servo -> HD thread   {force N, time of the write on the command clock (ns)}
 // plus atomics for faults (HD thread -> everyone), the zero-force request at close (control ->
 // HD thread) and its acknowledgement (HD thread -> control).
@@ -21,7 +22,7 @@
 //     hdUnschedule returned (and PhantomDevice cannot move).
 //   - HD calls from control threads (init, enable, probe, schedule, start/stop) are serialised
 //     by one process-wide mutex; neither the servo nor the HD thread ever takes it.
-// The cost per tick: HD thread, 3 HD gets + 1 set + ~12 atomic stores + one clock read;
+// The cost per tick: HD thread, 5 HD gets + 1 set + ~12 atomic stores + one clock read;
 // servo thread, ~12 atomic loads + one clock read. Latency: see PhantomDevice.h.
 
 #include "hapto/devices/PhantomDevice.h"
@@ -50,10 +51,12 @@ static_assert(std::is_trivially_copyable_v<PhantomForce>);
 
 /// One HD tick's reading as the HD callback left it.
 struct PhantomSample {
-    Vec3 positionM{0.0};       ///< Device frame (m).
-    Vec3 velocityMps{0.0};     ///< Device frame (m/s).
-    std::uint32_t buttons = 0; ///< HD_CURRENT_BUTTONS.
-    std::int64_t ageNs = 0;    ///< When it was taken, counted from the link's origin (ns).
+    Vec3 positionM{0.0};          ///< Device frame (m).
+    Vec3 velocityMps{0.0};        ///< Device frame (m/s).
+    Quat orientation{1, 0, 0, 0}; ///< Stylus in the device frame (HD_CURRENT_TRANSFORM).
+    Vec3 gimbalAnglesRad{0.0};    ///< HD_CURRENT_GIMBAL_ANGLES (rad).
+    std::uint32_t buttons = 0;    ///< HD_CURRENT_BUTTONS.
+    std::int64_t ageNs = 0;       ///< When it was taken, counted from the link's origin (ns).
 };
 static_assert(std::is_trivially_copyable_v<PhantomSample>);
 
@@ -117,6 +120,21 @@ constexpr double kMmToM = 1.0e-3;
 constexpr std::chrono::seconds kFirstSampleTimeout{2};
 constexpr std::chrono::milliseconds kZeroForceTimeout{200};
 
+/// The stylus rotation of an HD_CURRENT_TRANSFORM (PhantomHdApi.h: m[4 i + j] = R(j, i), a
+/// column-major 4x4 of the column-vector transform) as a unit quaternion; a matrix that is no
+/// rotation gives non-finite numbers, refused by read(). [HD thread]
+Quat stylusOrientation(const hd::HDdouble m[16]) noexcept {
+    glm::dmat3 r;
+    for (int c = 0; c < 3; ++c) {
+        for (int row = 0; row < 3; ++row) {
+            r[c][row] = m[4 * c + row]; // glm: r[column][row]
+        }
+    }
+    const Quat q = glm::quat_cast(r);
+    const double n = glm::length(q);
+    return n > 0.5 && n < 1.5 ? q / n : Quat{std::nan(""), 0, 0, 0};
+}
+
 /// The HD scheduler callback of one device. Runs on OpenHaptics' scheduler thread every tick.
 hd::HDCallbackCode phantomServoCallback(void* userData) {
     PhantomLink& link = *static_cast<PhantomLink*>(userData);
@@ -129,6 +147,10 @@ hd::HDCallbackCode phantomServoCallback(void* userData) {
     hd::HDint buttons = 0;
     api.getDoublev(hd::kCurrentPosition, position);
     api.getDoublev(hd::kCurrentVelocity, velocity);
+    hd::HDdouble transform[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    hd::HDdouble gimbal[3] = {0.0, 0.0, 0.0};
+    api.getDoublev(hd::kCurrentTransform, transform);
+    api.getDoublev(hd::kCurrentGimbalAngles, gimbal);
     api.getIntegerv(hd::kCurrentButtons, &buttons);
 
     const bool zero = link.zeroForce.load(std::memory_order_acquire) ||
@@ -158,11 +180,11 @@ hd::HDCallbackCode phantomServoCallback(void* userData) {
         }
     } else {
         const auto age = std::chrono::steady_clock::now() - link.origin;
-        link.sample.publish(
-            PhantomSample{Vec3(position[0], position[1], position[2]) * kMmToM,
-                          Vec3(velocity[0], velocity[1], velocity[2]) * kMmToM,
-                          static_cast<std::uint32_t>(buttons),
-                          std::chrono::duration_cast<std::chrono::nanoseconds>(age).count()});
+        link.sample.publish(PhantomSample{
+            Vec3(position[0], position[1], position[2]) * kMmToM,
+            Vec3(velocity[0], velocity[1], velocity[2]) * kMmToM, stylusOrientation(transform),
+            Vec3(gimbal[0], gimbal[1], gimbal[2]), static_cast<std::uint32_t>(buttons),
+            std::chrono::duration_cast<std::chrono::nanoseconds>(age).count()});
     }
     if (zero) {
         link.zeroForceApplied.store(true, std::memory_order_release);
@@ -421,12 +443,18 @@ DeviceStatus PhantomDevice::read(DeviceState& state) noexcept {
     if (writes == 0 || ageNs > mStaleTimeout.count()) {
         return DeviceStatus::Stalled;
     }
-    if (!finite(s.positionM) || !finite(s.velocityMps)) {
+    const Quat& q = s.orientation;
+    if (!finite(s.positionM) || !finite(s.velocityMps) || !finite(s.gimbalAnglesRad) ||
+        !finite(Vec3(q.x, q.y, q.z)) || !std::isfinite(q.w)) {
         return DeviceStatus::BadData;
     }
     state.position = s.positionM;
     state.velocity = s.velocityMps;
     state.hasVelocity = true;
+    state.orientation = q;
+    state.hasOrientation = true;
+    state.gimbalAnglesRad = s.gimbalAnglesRad;
+    state.hasGimbalAngles = true;
     state.buttons = s.buttons;
     state.sequence = writes;
     return DeviceStatus::Ok;

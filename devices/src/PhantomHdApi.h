@@ -11,7 +11,8 @@
 ///     HD_CURRENT_POSITION 0x2050, HD_CURRENT_VELOCITY 0x2051, HD_DEVICE_MODEL_TYPE 0x2501,
 ///     HD_DEVICE_VENDOR 0x2503, HD_DEVICE_SERIAL_NUMBER 0x2504, HD_USABLE_WORKSPACE_DIMENSIONS
 ///     0x2551, HD_NOMINAL_MAX_STIFFNESS 0x2602, HD_NOMINAL_MAX_FORCE 0x2603, HD_CURRENT_FORCE
-///     0x2700), HD_FORCE_OUTPUT 0x4000, HD_INVALID_HANDLE 0xFFFFFFFF, HD_DEFAULT_DEVICE = NULL,
+///     0x2700, HD_CURRENT_TRANSFORM 0x2052, HD_CURRENT_GIMBAL_ANGLES 0x2150), HD_FORCE_OUTPUT
+///     0x4000, HD_INVALID_HANDLE 0xFFFFFFFF, HD_DEFAULT_DEVICE = NULL,
 ///     scheduler priorities (HD_MAX_SCHEDULER_PRIORITY = USHRT_MAX): hdDefines.h.
 ///   - HD_CALLBACK_DONE 0 / HD_CALLBACK_CONTINUE 1, HDCallbackCode = unsigned int,
 ///     HDSchedulerHandle = unsigned long, the callback type HDCallbackCode (*)(void*):
@@ -22,6 +23,13 @@
 ///   - Units (OpenHaptics Programmer's Guide and every vendor example): positions and workspace
 ///     in millimetres, velocity in mm/s, force in newtons, nominal max stiffness in N/mm.
 ///     Workspace dimensions are six doubles {minX, minY, minZ, maxX, maxY, maxZ}.
+///   - HD_CURRENT_TRANSFORM is 16 doubles, the stylus frame as an hduMatrix stores it
+///     (HDU/hduMatrix.h: "Constructor from array of 16 values stored by row", translations "set
+///     along the last row" {.., x y z 1}, points multiplied as row vectors): element 4 i + j is
+///     row i, column j of that row-vector matrix, so m[4 i + j] = R(j, i) for the
+///     column-vector rotation R (read as a column-major 4x4, it is the column-vector transform,
+///     OpenGL's layout), m[12..14] the position (mm). HD_CURRENT_GIMBAL_ANGLES is 3 doubles,
+///     the gimbal joint angles (rad), like HD_CURRENT_JOINT_ANGLES.
 /// Consulted: the OpenHaptics 3.x Linux headers as redistributed in a public mirror of the SDK
 /// (github.com/danepowell/openhaptics, usr/include/HD/), the SDK's console examples (units,
 /// call order: init, enable force output, schedule, start; stop, unschedule, disable), and
@@ -79,6 +87,8 @@ inline constexpr HDerror kInvalidLicense = 0x0600;
 inline constexpr HDenum kCurrentButtons = 0x2000;
 inline constexpr HDenum kCurrentPosition = 0x2050;
 inline constexpr HDenum kCurrentVelocity = 0x2051;
+inline constexpr HDenum kCurrentTransform = 0x2052;
+inline constexpr HDenum kCurrentGimbalAngles = 0x2150;
 inline constexpr HDenum kDeviceModelType = 0x2501;
 inline constexpr HDenum kDeviceVendor = 0x2503;
 inline constexpr HDenum kDeviceSerialNumber = 0x2504;

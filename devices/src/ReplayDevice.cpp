@@ -80,6 +80,7 @@ DeviceStatus ReplayDevice::read(DeviceState& state) noexcept {
         if (!mReplay.loop) {
             state.position = mSamples.back().positionM;
             state.hasVelocity = false;
+            state.hasAngularVelocity = false;
             return DeviceStatus::Stalled;
         }
         mPlayed = 0;
@@ -94,20 +95,40 @@ DeviceStatus ReplayDevice::read(DeviceState& state) noexcept {
     ++mReads;
     const TraceSample& s = mSamples[mCursor];
     state.position = s.positionM;
-    state.velocity = Vec3(0.0);
-    state.hasVelocity = false;
+    state.velocity = s.velocityMps;
+    state.hasVelocity = s.hasVelocity;
+    state.orientation = s.orientation;
+    state.hasOrientation = s.hasOrientation;
+    state.angularVelocity = s.angularVelocity;
+    state.hasAngularVelocity = s.hasAngularVelocity;
     state.buttons = s.buttons;
     state.sequence = mReads;
     return s.status;
 }
 
-void useTraceRates(std::span<DeviceConfig> configs) {
+void useTraceSettings(std::span<DeviceConfig> configs, bool rates) {
     for (DeviceConfig& c : configs) {
         if (c.kind != DeviceKind::Replay) {
             continue;
         }
-        const std::filesystem::path& trace = replayOf(c).trace;
-        const double rateHz = TraceReader(trace).header().rateHz;
+        const ReplayConfig& replay = replayOf(c);
+        const std::filesystem::path& trace = replay.trace;
+        const TraceHeader header = TraceReader(trace).header();
+        if (header.hasConfiguration()) {
+            if (!replay.ownTransform) {
+                c.transform = header.transform;
+            }
+            if (!replay.ownToolTip) {
+                c.toolTipM = header.toolTipM;
+            }
+            if (!replay.ownMaxForce) {
+                c.maxForceN = header.maxForceN;
+            }
+        }
+        if (!rates || replay.ownRate) {
+            continue;
+        }
+        const double rateHz = header.rateHz;
         if (!(rateHz >= 100.0 && rateHz <= 100000.0)) {
             throw InputError(trace.string() + ": device '" + c.name + "' would replay at " +
                              std::to_string(rateHz) +

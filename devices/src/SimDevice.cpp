@@ -100,6 +100,15 @@ DeviceStatus SimDevice::read(DeviceState& state) noexcept {
     }
     state.velocity = mHand.velocity();
     state.hasVelocity = true;
+    // A scripted stylus, when the configuration gives one: a constant or turning orientation.
+    const bool stylus = mSim.orientation.has_value() || mSim.spinRadPerS != Vec3(0.0);
+    state.hasOrientation = stylus;
+    state.hasAngularVelocity = stylus;
+    if (stylus) {
+        state.orientation = scriptedOrientation(mSim.orientation.value_or(Quat{1, 0, 0, 0}),
+                                                mSim.spinRadPerS, timeS());
+        state.angularVelocity = mSim.spinRadPerS;
+    }
     const bool holding = mPhase == ScriptPhase::Squeeze || mPhase == ScriptPhase::Lift ||
                          mPhase == ScriptPhase::Carry || mPhase == ScriptPhase::PutDown;
     state.buttons = holding ? 1u : 0u;

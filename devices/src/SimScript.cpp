@@ -537,4 +537,12 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
     return script;
 }
 
+Quat scriptedOrientation(const Quat& start, const Vec3& spinRadPerS, double timeS) noexcept {
+    const double rate = glm::length(spinRadPerS);
+    if (!(rate > 0.0)) {
+        return start;
+    }
+    return glm::normalize(glm::angleAxis(rate * timeS, spinRadPerS / rate) * start);
+}
+
 } // namespace hapto

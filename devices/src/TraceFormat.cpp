@@ -38,6 +38,21 @@ double getF64(const unsigned char* in) {
     return std::bit_cast<double>(getU64(in));
 }
 
+void putVec(unsigned char* out, const Vec3& v) {
+    for (int i = 0; i < 3; ++i) {
+        putF64(out + 8 * i, v[i]);
+    }
+}
+Vec3 getVec(const unsigned char* in) {
+    return Vec3(getF64(in), getF64(in + 8), getF64(in + 16));
+}
+void putQuat(unsigned char* out, const Quat& q) {
+    putF64(out, q.w);
+    putF64(out + 8, q.x);
+    putF64(out + 16, q.y);
+    putF64(out + 24, q.z);
+}
+
 void putText(unsigned char* out, const std::string& text, std::size_t field) {
     std::memset(out, 0, field);
     std::memcpy(out, text.data(), std::min(text.size(), field - 1));
@@ -48,7 +63,7 @@ void putText(unsigned char* out, const std::string& text, std::size_t field) {
 void encodeTraceHeader(const TraceHeader& header, std::uint64_t sampleCount, unsigned char* out) {
     std::memset(out, 0, kTraceHeaderBytes);
     std::memcpy(out, kTraceMagic.data(), kTraceMagic.size());
-    putU32(out + 8, header.version);
+    putU32(out + 8, kTraceVersion);
     putU32(out + 12, static_cast<std::uint32_t>(kTraceHeaderBytes));
     putU32(out + 16, static_cast<std::uint32_t>(kTraceSampleBytes));
     putU32(out + 20, 0);
@@ -57,9 +72,14 @@ void encodeTraceHeader(const TraceHeader& header, std::uint64_t sampleCount, uns
     putU64(out + 40, header.startUnixNs);
     putText(out + 48, header.kind, kTraceMaxKindBytes + 1);
     putText(out + 64, header.name, kTraceMaxNameBytes + 1);
+    putVec(out + 128, header.transform.translation);
+    putQuat(out + 152, header.transform.rotation);
+    putF64(out + 184, header.transform.scale);
+    putVec(out + 192, header.toolTipM);
+    putF64(out + 216, header.maxForceN);
 }
 
-TraceHeaderFields decodeTraceHeader(const unsigned char* in) {
+TraceHeaderFields decodeTraceHeader(const unsigned char* in, bool version2) {
     TraceHeaderFields h;
     std::memcpy(h.magic.data(), in, 8);
     h.version = getU32(in + 8);
@@ -71,6 +91,16 @@ TraceHeaderFields decodeTraceHeader(const unsigned char* in) {
     h.startUnixNs = getU64(in + 40);
     std::memcpy(h.kind.data(), in + 48, 16);
     std::memcpy(h.name.data(), in + 64, 64);
+    if (version2) {
+        h.translation = getVec(in + 128);
+        for (int i = 0; i < 4; ++i) {
+            h.rotation[static_cast<std::size_t>(i)] = getF64(in + 152 + 8 * i);
+        }
+        h.scale = getF64(in + 184);
+        h.toolTipM = getVec(in + 192);
+        h.maxForceN = getF64(in + 216);
+        std::memcpy(h.reserved.data(), in + 224, h.reserved.size());
+    }
     return h;
 }
 
@@ -86,9 +116,17 @@ void encodeTraceSample(const TraceSample& s, unsigned char* out) noexcept {
     out[72] = static_cast<unsigned char>(s.status);
     out[73] = out[74] = out[75] = 0;
     putU32(out + 76, s.buttons);
+    putVec(out + 80, s.proxyM);
+    putVec(out + 104, s.hasVelocity ? s.velocityMps : Vec3(0.0));
+    putQuat(out + 128, s.hasOrientation ? s.orientation : Quat{1, 0, 0, 0});
+    putVec(out + 160, s.hasAngularVelocity ? s.angularVelocity : Vec3(0.0));
+    putU32(out + 184, s.contactCount);
+    putU32(out + 188, (s.hasVelocity ? kTraceSampleHasVelocity : 0u) |
+                          (s.hasOrientation ? kTraceSampleHasOrientation : 0u) |
+                          (s.hasAngularVelocity ? kTraceSampleHasAngularVelocity : 0u));
 }
 
-TraceSample decodeTraceSample(const unsigned char* in) noexcept {
+TraceSample decodeTraceSample(const unsigned char* in, std::uint32_t version) noexcept {
     TraceSample s;
     s.tick = getU64(in);
     s.timeNs = getU64(in + 8);
@@ -100,6 +138,18 @@ TraceSample decodeTraceSample(const unsigned char* in) noexcept {
     s.ioNs = getU32(in + 68);
     s.status = static_cast<DeviceStatus>(in[72]);
     s.buttons = getU32(in + 76);
+    if (version >= 2) {
+        s.proxyM = getVec(in + 80);
+        s.velocityMps = getVec(in + 104);
+        s.orientation =
+            Quat{getF64(in + 128), getF64(in + 136), getF64(in + 144), getF64(in + 152)};
+        s.angularVelocity = getVec(in + 160);
+        s.contactCount = getU32(in + 184);
+        const std::uint32_t flags = getU32(in + 188);
+        s.hasVelocity = (flags & kTraceSampleHasVelocity) != 0;
+        s.hasOrientation = (flags & kTraceSampleHasOrientation) != 0;
+        s.hasAngularVelocity = (flags & kTraceSampleHasAngularVelocity) != 0;
+    }
     return s;
 }
 

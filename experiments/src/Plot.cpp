@@ -2,6 +2,7 @@
 
 #include "hapto/experiments/Plot.h"
 
+#include "hapto/scenes/InputError.h"
 #include "hapto/scenes/OutputFile.h"
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -88,8 +90,14 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
                  const std::vector<std::string>& unstableBlocks) {
     std::ostringstream s;
     const bool multi = spec.panels.size() > 1;
+    const std::size_t columns =
+        spec.columns > 0 ? std::min<std::size_t>(static_cast<std::size_t>(spec.columns),
+                                                 std::max<std::size_t>(1, spec.panels.size()))
+                         : std::max<std::size_t>(1, spec.panels.size());
+    const std::size_t rows = (spec.panels.size() + columns - 1) / columns;
     if (multi) {
-        s << "set multiplot layout 1," << spec.panels.size() << " title " << gq(spec.title) << "\n";
+        s << "set multiplot layout " << rows << "," << columns << " title " << gq(spec.title)
+          << "\n";
     }
     const std::optional<std::pair<double, double>> shared = sharedYRange(spec);
     for (std::size_t i = 0; i < spec.panels.size(); ++i) {
@@ -104,7 +112,9 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
             // A labelled tic at every measured x (each device count, each size).
             s << "set xtics (";
             for (std::size_t k = 0; k < p.xTics.size(); ++k) {
-                s << (k ? ", " : "") << gq(number(p.xTics[k])) << " " << number(p.xTics[k]);
+                const std::string label =
+                    k < p.xTicLabels.size() ? p.xTicLabels[k] : number(p.xTics[k]);
+                s << (k ? ", " : "") << gq(label) << " " << number(p.xTics[k]);
             }
             s << ")\n";
         } else {
@@ -117,15 +127,29 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
         } else {
             s << "set yrange [*:*]\n";
         }
+        s << "unset object\n";
+        for (std::size_t k = 0; k < p.spans.size(); ++k) {
+            s << "set object " << k + 1 << " rect from " << number(p.spans[k].first)
+              << ", graph 0 to " << number(p.spans[k].second)
+              << ", graph 1 behind fillcolor rgb '#dddddd' fillstyle solid 1.0 noborder\n";
+        }
         std::vector<std::string> plots;
+        if (!p.spans.empty() && !p.spanTitle.empty()) {
+            // A key entry for the shading (a box of its colour drawn nowhere).
+            plots.push_back("keyentry with boxes fillcolor rgb '#dddddd' fillstyle solid 1.0 "
+                            "title " +
+                            gq(p.spanTitle));
+        }
         for (std::size_t k = 0; k < blocks[i].size(); ++k) {
             if (!blocks[i][k].empty()) {
                 // Colour and point type by style (or series position), so a series keeps its
                 // look in every panel even when another series has no points there.
                 const PlotSeries& series = p.series[k];
                 const int style = series.style > 0 ? series.style : static_cast<int>(k) + 1;
-                plots.push_back(blocks[i][k] + " using 1:2 with linespoints lc " +
-                                std::to_string(style) + " pt " + std::to_string(style) +
+                plots.push_back(blocks[i][k] + " using 1:2 with " +
+                                (series.linesOnly ? "lines" : "linespoints") + " lc " +
+                                std::to_string(style) +
+                                (series.linesOnly ? "" : " pt " + std::to_string(style)) +
                                 (series.dashed ? " dt 2" : " dt 1") + " title " + gq(series.title));
             }
         }
@@ -138,7 +162,9 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
             plots.push_back(number(*p.limitY) + " with lines dt 3 lc rgb 'red' title " +
                             gq(p.limitTitle));
         }
-        if (plots.empty() || plots.size() == (p.limitY ? 1u : 0u)) {
+        const std::size_t decorations =
+            (p.limitY ? 1u : 0u) + (!p.spans.empty() && !p.spanTitle.empty() ? 1u : 0u);
+        if (plots.empty() || plots.size() == decorations) {
             s << "set label 1 'no data' at graph 0.5, 0.5 center\n";
             plots = {"[1:10] 1/0 notitle"};
         }
@@ -151,6 +177,7 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
     if (multi) {
         s << "unset multiplot\n";
     }
+    s << "unset object\n";
     return s.str();
 }
 
@@ -215,19 +242,26 @@ std::string plotScript(const PlotSpec& spec) {
             script << unstableBlocks[i] << " << EOD\n" << marks.str() << "EOD\n";
         }
     }
-    const int width =
-        spec.panelWidthPx * static_cast<int>(std::max<std::size_t>(1, spec.panels.size()));
+    const std::size_t n = std::max<std::size_t>(1, spec.panels.size());
+    const std::size_t columns =
+        spec.columns > 0 ? std::min<std::size_t>(static_cast<std::size_t>(spec.columns), n) : n;
+    const int width = spec.panelWidthPx * static_cast<int>(columns);
+    const int height = spec.heightPx * static_cast<int>((n + columns - 1) / columns);
     const std::string plot = body(spec, blocks, unstableBlocks);
     // `out` names the images without their extension; hapto sets it (gnuplot -e) to a
     // temporary name and renames the finished images into place, so a figure is never half
     // written. Run by hand, the script writes NAME.png and NAME.svg directly.
     script << "if (!exists(\"out\")) out = " << gq(spec.name) << "\n";
-    script << "set terminal pngcairo size " << width << "," << spec.heightPx
-           << " noenhanced font 'sans,10'\nset output out.\".png\"\n"
-           << plot << "set output\n";
-    script << "set terminal svg size " << width << "," << spec.heightPx
-           << " noenhanced font 'sans,10'\nset output out.\".svg\"\n"
-           << plot << "set output\n";
+    if (spec.png) {
+        script << "set terminal pngcairo size " << width << "," << height
+               << " noenhanced font 'sans,10'\nset output out.\".png\"\n"
+               << plot << "set output\n";
+    }
+    if (spec.svg) {
+        script << "set terminal svg size " << width << "," << height
+               << " noenhanced font 'sans,10'\nset output out.\".svg\"\n"
+               << plot << "set output\n";
+    }
     return script.str();
 }
 
@@ -284,6 +318,69 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
         r.problem = "gnuplot made no file from " + gp.string();
     }
     return r;
+}
+
+void drawPlotFile(const PlotSpec& spec, const std::filesystem::path& out,
+                  const std::filesystem::path& script) {
+    const std::string ext = out.extension().string();
+    if (ext != ".png" && ext != ".svg") {
+        throw InputError(out.string() + ": the plot file's name must end in .png or .svg (got \"" +
+                         ext + "\")");
+    }
+    PlotSpec one = spec;
+    one.png = ext == ".png";
+    one.svg = ext == ".svg";
+    const std::string text = plotScript(one);
+    if (!script.empty()) {
+        writeFileAtomically(script, text);
+    }
+    if (!gnuplotAvailable()) {
+        throw std::runtime_error(
+            "gnuplot not found on PATH (Debian: apt-get install gnuplot-nox); nothing drawn" +
+            (script.empty() ? std::string() : ", wrote " + script.string()));
+    }
+    // Script, log and image all go to temporaries beside `out` (same file system: the final
+    // rename is one step), named after this process.
+    const std::filesystem::path dir =
+        out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
+    const std::string stem =
+        "." + out.filename().string() + ".tmp-plot-" + std::to_string(::getpid());
+    const std::filesystem::path gp = dir / (stem + ".gp");
+    const std::filesystem::path log = dir / (stem + ".log");
+    const std::filesystem::path image = dir / (stem + ext);
+    std::error_code ignored;
+    const auto cleanUp = [&] {
+        std::filesystem::remove(gp, ignored);
+        std::filesystem::remove(log, ignored);
+        std::filesystem::remove(image, ignored);
+    };
+    {
+        std::ofstream f(gp, std::ios::binary | std::ios::trunc);
+        f << text;
+        if (!f.flush()) {
+            cleanUp();
+            throw std::runtime_error(gp.string() + ": cannot write the plot script");
+        }
+    }
+    const std::string cmd = "gnuplot -e " + shq("out=" + gq((dir / stem).string())) + " " +
+                            shq(gp.string()) + " > " + shq(log.string()) + " 2>&1";
+    const int status = std::system(cmd.c_str());
+    if (status != 0 || !std::filesystem::exists(image)) {
+        std::string why;
+        std::ifstream in(log);
+        std::getline(in, why);
+        cleanUp();
+        throw std::runtime_error("gnuplot failed drawing " + out.string() + " (exit " +
+                                 std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
+                                 (why.empty() ? "" : ": " + why) + ")");
+    }
+    std::error_code ec;
+    std::filesystem::rename(image, out, ec); // whole, in one step
+    cleanUp();
+    if (ec) {
+        throw std::runtime_error("cannot rename the plot into " + out.string() + ": " +
+                                 ec.message());
+    }
 }
 
 } // namespace hapto::experiments

@@ -6,8 +6,7 @@
 ///   ServoState      hot: everything one tick reads or writes and nothing else (the device
 ///                   pointer, the frames, the deadline, the sample, the haptic tick with its
 ///                   effects and hook). Only the servo thread (or the stepping thread) touches
-///                   it while the servo runs; 3328 bytes, asserted below: 256 of tick state,
-///                   3072 of HapticTick.
+///                   it while the servo runs; its size is asserted below.
 ///   DeviceMetrics   written every tick by the servo, read by any thread (its own lines).
 ///   three Mailboxes contacts out, external force in, every tick; effects in, when the control
 ///                   thread changes them, with a count the servo checks every tick (their own
@@ -42,6 +41,7 @@ struct alignas(64) ServoState {
     TraceRecorder* recorder = nullptr;
     SnapshotReader* reader = nullptr;
     WorkspaceTransform transform;
+    Vec3 toolTip{0.0}; ///< The contact point in the stylus frame (m); 0 = the gimbal centre.
     std::uint64_t periodNs = 1'000'000;
     std::uint64_t lateNs = 0;    ///< A wake-up later than this is counted late.
     std::uint64_t starvedNs = 0; ///< One this late (K periods) commands zero.
@@ -63,7 +63,7 @@ struct alignas(64) ServoState {
     ServoState(const RendererConfig& renderer, const SafetyConfig& safety)
         : haptic(renderer, safety) {}
 };
-static_assert(sizeof(ServoState) == 3328, "update the size in the note above");
+static_assert(sizeof(ServoState) == 3456, "update the size in the note above");
 
 /// The cold record of a channel.
 struct ChannelRecord {

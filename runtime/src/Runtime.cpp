@@ -54,6 +54,7 @@ Runtime::Channel::Channel(RuntimeDevice d, const RuntimeOptions& o)
     servo.device = d.device.get();
     servo.recorder = d.recorder;
     servo.transform = d.config.transform;
+    servo.toolTip = d.config.toolTipM;
     servo.periodNs = period;
     servo.dtS = static_cast<double>(period) * 1e-9;
     servo.lateNs = static_cast<std::uint64_t>(o.lateWakeupFraction * static_cast<double>(period));

@@ -22,6 +22,7 @@
 #include "hapto/devices/TraceRecorder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <unistd.h>
 
 namespace hapto {
@@ -67,18 +68,27 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
         }
         return false;
     }
-    if (!finite(s.sample.position) || (s.sample.hasVelocity && !finite(s.sample.velocity))) {
+    const Quat& q = s.sample.orientation;
+    if (!finite(s.sample.position) || (s.sample.hasVelocity && !finite(s.sample.velocity)) ||
+        (s.sample.hasOrientation && !(finite(Vec3(q.x, q.y, q.z)) && std::isfinite(q.w))) ||
+        (s.sample.hasAngularVelocity && !finite(s.sample.angularVelocity))) {
         fault(FaultKind::NonFinite, DeviceStatus::BadData, readDone);
         return false;
     }
 
     const WorldSnapshot& snap = mWorld.acquire(*s.reader);
-    const Vec3 p = s.transform.positionToWorld(s.sample.position);
+    // The contact point: the tool tip, position + R * tip (R the stylus orientation, or the
+    // device's axes on a device without one), which is the gimbal centre for a zero tip. Its
+    // velocity adds the stylus's turn, w x (R * tip), where the device measures w.
+    const Vec3 tip = s.sample.hasOrientation ? s.sample.orientation * s.toolTip : s.toolTip;
+    const Vec3 p = s.transform.positionToWorld(s.sample.position + tip);
     if (s.first) {
         s.lastPosition = p;
         s.first = false;
     }
-    const Vec3 v = s.sample.hasVelocity ? s.transform.velocityToWorld(s.sample.velocity)
+    const Vec3 tipTurn =
+        s.sample.hasAngularVelocity ? glm::cross(s.sample.angularVelocity, tip) : Vec3(0.0);
+    const Vec3 v = s.sample.hasVelocity ? s.transform.velocityToWorld(s.sample.velocity + tipTurn)
                                         : (p - s.lastPosition) / s.dtS;
     s.lastPosition = p;
     Vec3 external{0.0};
@@ -159,6 +169,14 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
         sample.ioNs = static_cast<std::uint32_t>(std::min<std::uint64_t>(ioNs, UINT32_MAX));
         sample.status = st;
         sample.buttons = s.sample.buttons;
+        sample.proxyM = s.transform.positionToDevice(out.render.proxy);
+        sample.velocityMps = s.sample.velocity;
+        sample.hasVelocity = s.sample.hasVelocity;
+        sample.orientation = s.sample.orientation;
+        sample.hasOrientation = s.sample.hasOrientation;
+        sample.angularVelocity = s.sample.angularVelocity;
+        sample.hasAngularVelocity = s.sample.hasAngularVelocity;
+        sample.contactCount = out.render.contactCount;
         (void)s.recorder->push(sample);
     }
     ++s.tick;

@@ -491,3 +491,36 @@ TEST_CASE("device kinds and hand scripts: parsed once, printed back the same") {
     CHECK(name(HandScript::GraspLeft) == "grasp-left");
     CHECK_FALSE(parseHandScript("dance").has_value());
 }
+
+TEST_CASE("tool_tip, a sim stylus and the replay's own settings parse; bad ones name their path") {
+    const auto configs = parseDeviceConfig(withDevice(R"("tool_tip": [0, 0, -0.04],
+                      "sim": {"orientation": [0, 1, 0, 0], "spin_rad_per_s": [0, 0.5, 0]})"),
+                                           "tip.json");
+    CHECK(configs[0].toolTipM == Vec3(0.0, 0.0, -0.04));
+    const SimConfig& s = std::get<SimConfig>(configs[0].params);
+    REQUIRE(s.orientation.has_value());
+    CHECK(*s.orientation == Quat{0, 1, 0, 0});
+    CHECK(s.spinRadPerS == Vec3(0.0, 0.5, 0.0));
+    CHECK(parseDeviceConfig(withDevice(""), "min.json")[0].toolTipM == Vec3(0.0));
+
+    const std::string replay = R"({"format": "hapto-devices", "version": 1, "devices": [)";
+    const auto own = parseDeviceConfig(
+        replay + R"({"name": "r", "kind": "replay", "rate_hz": 500, "tool_tip": [0, 0, 0.01],
+                     "replay": {"trace": "r.trace"}}]})",
+        "own.json");
+    const ReplayConfig& r = std::get<ReplayConfig>(own[0].params);
+    CHECK(r.ownRate);
+    CHECK(r.ownToolTip);
+    CHECK_FALSE(r.ownTransform);
+    CHECK_FALSE(r.ownMaxForce);
+
+    CHECK_THAT(errorOf(withDevice(R"("tool_tip": [0, 0.6, 0])")),
+               Catch::Contains("bad.json: devices[0].tool_tip[1]: a tool tip component is at "
+                               "most 0.5 m (got 0.6)"));
+    CHECK_THAT(errorOf(withDevice(R"("tool_tip": [0, 0])")),
+               Catch::Contains("bad.json: devices[0].tool_tip"));
+    CHECK_THAT(errorOf(withDevice(R"("sim": {"orientation": [2, 0, 0, 0]})")),
+               Catch::Contains("bad.json: devices[0].sim.orientation"));
+    CHECK_THAT(errorOf(withDevice(R"("sim": {"spin_rad_per_s": [0, 0, 1000]})")),
+               Catch::Contains("bad.json: devices[0].sim.spin_rad_per_s[2]"));
+}

@@ -32,6 +32,7 @@ struct FakeHd {
     void (*reset)();
     void (*setMotion)(int, double, double, double, double, double, double);
     void (*setButtons)(int, int);
+    void (*setStylus)(int, double, double, double, double, double, double, double);
     void (*lastForce)(int, double*);
     unsigned long long (*forceFrames)(int);
     double (*maxForceSeen)(int);
@@ -55,6 +56,7 @@ struct FakeHd {
         get("fakehd_reset", reset);
         get("fakehd_set_motion", setMotion);
         get("fakehd_set_buttons", setButtons);
+        get("fakehd_set_stylus", setStylus);
         get("fakehd_last_force", lastForce);
         get("fakehd_force_frames", forceFrames);
         get("fakehd_max_force_seen", maxForceSeen);
@@ -190,6 +192,42 @@ TEST_CASE("positions arrive in metres from the HD's millimetres, with velocity a
                t.position.x > firstX && t.position.z < 0.007 &&
                std::abs(t.position.y + 0.040) < 1e-12 && t.buttons == 0b01u;
     }));
+}
+
+TEST_CASE("the stylus orientation arrives from HD_CURRENT_TRANSFORM as a unit quaternion, with "
+          "the gimbal angles") {
+    FakeHd fake;
+    fake.setMotion(kDefault, 10.0, 20.0, 30.0, 0.0, 0.0, 0.0);
+    PhantomDevice dev("left", fakeConfig(""), 0.0);
+    REQUIRE(dev.open() == DeviceStatus::Ok);
+    DeviceState s;
+    REQUIRE(dev.read(s) == DeviceStatus::Ok);
+    CHECK(s.hasOrientation);
+    CHECK(s.hasGimbalAngles);
+    CHECK_FALSE(s.hasAngularVelocity); // not read: its unit is not in the HD headers
+    CHECK_FALSE(s.hasGripper);
+    CHECK(near(s.orientation * Vec3(1, 2, 3), Vec3(1, 2, 3))); // identity at rest
+
+    // A quarter turn about +z: the stylus's x axis points along the device's +y.
+    const double quarter = std::acos(0.0);
+    fake.setStylus(kDefault, 0.0, 0.0, 1.0, quarter, 0.1, -0.2, 0.3);
+    REQUIRE(eventually([&] {
+        return dev.read(s) == DeviceStatus::Ok && near(s.gimbalAnglesRad, Vec3(0.1, -0.2, 0.3));
+    }));
+    CHECK(near(s.orientation * Vec3(1, 0, 0), Vec3(0, 1, 0), 1e-12));
+    CHECK(near(s.orientation * Vec3(0, 0, 1), Vec3(0, 0, 1), 1e-12));
+    CHECK(std::abs(glm::length(s.orientation) - 1.0) < 1e-12);
+    CHECK(near(s.position, Vec3(0.010, 0.020, 0.030)));
+
+    // An arbitrary turn: the quaternion rotates like the matrix the HD library built.
+    const Vec3 axis = glm::normalize(Vec3(1.0, -2.0, 0.5));
+    fake.setStylus(kDefault, axis.x, axis.y, axis.z, 2.0, 0.0, 0.0, 0.0);
+    REQUIRE(eventually(
+        [&] { return dev.read(s) == DeviceStatus::Ok && near(s.gimbalAnglesRad, Vec3(0.0)); }));
+    const Quat expected = glm::angleAxis(2.0, axis);
+    for (const Vec3& v : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.3, -0.4, 2.0)}) {
+        CHECK(near(s.orientation * v, expected * v, 1e-12));
+    }
 }
 
 TEST_CASE("forces arrive in newtons, clamped to the limit, and are zero after close") {

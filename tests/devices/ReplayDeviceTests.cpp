@@ -145,12 +145,12 @@ TEST_CASE("replay: a replay configuration takes its trace's rate; other kinds ke
     std::vector<DeviceConfig> configs{replayConfig(dir / "fast.trace", false),
                                       defaultDeviceConfigs()[0]};
     configs[1].rateHz = 700.0;
-    useTraceRates(configs);
+    useTraceSettings(configs);
     CHECK(configs[0].rateHz == 2500.0);
     CHECK(configs[1].rateHz == 700.0);
 
     configs[0] = replayConfig(dir / "none.trace", false);
-    CHECK_THROWS_WITH(useTraceRates(configs), Catch::Contains("none.trace"));
+    CHECK_THROWS_WITH(useTraceSettings(configs), Catch::Contains("none.trace"));
 }
 
 TEST_CASE("replay: a trace rate the runtime cannot run is refused, naming the device") {
@@ -166,6 +166,6 @@ TEST_CASE("replay: a trace rate the runtime cannot run is refused, naming the de
         rec.close();
     }
     std::vector<DeviceConfig> configs{replayConfig(dir / "odd.trace", false)};
-    CHECK_THROWS_WITH(useTraceRates(configs),
+    CHECK_THROWS_WITH(useTraceSettings(configs),
                       Catch::Contains("'again'") && Catch::Contains("100..100000 Hz"));
 }

@@ -391,3 +391,45 @@ TEST_CASE("sim: any number of devices run side by side without sharing state") {
         }
     }
 }
+
+TEST_CASE("sim: a scripted stylus reports its orientation turning at the given rate; without "
+          "one it reports none") {
+    const Scene scene = makeDefaultScene();
+    DeviceConfig c = simConfig("free", 1);
+    const Quat start = glm::angleAxis(0.4, Vec3(1, 0, 0));
+    sim(c).orientation = start;
+    sim(c).spinRadPerS = Vec3(0.0, 0.0, 2.0); // 2 rad/s about +z
+    SimDevice d(c, scene);
+    REQUIRE(d.open() == DeviceStatus::Ok);
+    DeviceState s;
+    for (int t = 1; t <= 500; ++t) {
+        REQUIRE(d.read(s) == DeviceStatus::Ok);
+    }
+    REQUIRE(s.hasOrientation);
+    REQUIRE(s.hasAngularVelocity);
+    CHECK(s.angularVelocity == Vec3(0.0, 0.0, 2.0));
+    CHECK_FALSE(s.hasGimbalAngles);
+    CHECK_FALSE(s.hasGripper);
+    // 500 ticks of 1 ms: 1 rad about +z after the start orientation.
+    const Quat expected = glm::angleAxis(1.0, Vec3(0, 0, 1)) * start;
+    for (const Vec3& v : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}) {
+        CHECK(glm::length(s.orientation * v - expected * v) < 1e-12);
+    }
+
+    DeviceConfig constant = simConfig("free", 1);
+    sim(constant).orientation = start;
+    SimDevice still(constant, scene);
+    REQUIRE(still.open() == DeviceStatus::Ok);
+    REQUIRE(still.read(s) == DeviceStatus::Ok);
+    CHECK(s.hasOrientation);
+    CHECK(s.orientation == start);
+    CHECK(s.angularVelocity == Vec3(0.0));
+
+    SimDevice plain(simConfig("free", 1), scene);
+    REQUIRE(plain.open() == DeviceStatus::Ok);
+    DeviceState fresh;
+    REQUIRE(plain.read(fresh) == DeviceStatus::Ok);
+    CHECK_FALSE(fresh.hasOrientation);
+    CHECK_FALSE(fresh.hasAngularVelocity);
+    CHECK(fresh.orientation == Quat{1, 0, 0, 0});
+}

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <filesystem>
 #include <thread>
 
@@ -22,6 +23,11 @@ TraceHeader header() {
     h.kind = "sim";
     h.name = "left";
     h.startUnixNs = 1700000000123456789ull;
+    h.transform.translation = Vec3(-0.02, 0.01, 0.3);
+    h.transform.rotation = glm::angleAxis(0.7, glm::normalize(Vec3(1, 2, 3)));
+    h.transform.scale = 1.5;
+    h.toolTipM = Vec3(0.0, 0.0, -0.04);
+    h.maxForceN = 3.3;
     return h;
 }
 
@@ -40,6 +46,21 @@ std::vector<TraceSample> randomSamples(std::size_t n, std::uint64_t seed) {
         s.ioNs = static_cast<std::uint32_t>(rng.below(100000));
         s.status = static_cast<DeviceStatus>(rng.below(6));
         s.buttons = static_cast<std::uint32_t>(rng.below(4));
+        s.proxyM = s.positionM + Vec3(rng.normal(), rng.normal(), rng.normal()) * 0.001;
+        s.hasVelocity = rng.uniform() < 0.5;
+        if (s.hasVelocity) {
+            s.velocityMps = Vec3(rng.normal(), rng.normal(), rng.normal());
+        }
+        s.hasOrientation = rng.uniform() < 0.5;
+        if (s.hasOrientation) {
+            s.orientation =
+                glm::normalize(Quat{rng.normal(), rng.normal(), rng.normal(), rng.normal()});
+        }
+        s.hasAngularVelocity = rng.uniform() < 0.5;
+        if (s.hasAngularVelocity) {
+            s.angularVelocity = Vec3(rng.normal(), rng.normal(), rng.normal());
+        }
+        s.contactCount = static_cast<std::uint32_t>(rng.below(4));
     }
     return out;
 }
@@ -88,6 +109,43 @@ TEST_CASE("trace: write then read gives back every sample exactly") {
     CHECK(h.name == "left");
     CHECK(h.startUnixNs == 1700000000123456789ull);
     CHECK(h.version == kTraceVersion);
+    CHECK(h.hasConfiguration());
+    CHECK(h.transform.translation == header().transform.translation);
+    CHECK(h.transform.rotation == header().transform.rotation);
+    CHECK(h.transform.scale == 1.5);
+    CHECK(h.toolTipM == Vec3(0.0, 0.0, -0.04));
+    CHECK(h.maxForceN == 3.3);
+}
+
+TEST_CASE("trace: a version 1 file still reads, its version 2 fields at their defaults") {
+    // Written by the version 1 recorder (and kept as a fuzz corpus entry): three ticks of
+    // "left" (sim) at 1 kHz.
+    const std::filesystem::path v1 =
+        std::filesystem::path(HAPTO_SOURCE_DIR) / "tools/fuzz/corpus/trace_file/three-ticks.trace";
+    TraceHeader h;
+    const auto samples = TraceReader::load(v1, &h);
+    CHECK(h.version == 1);
+    CHECK_FALSE(h.hasConfiguration());
+    CHECK(h.name == "left");
+    CHECK(h.kind == "sim");
+    CHECK(h.rateHz == 1000.0);
+    CHECK(h.transform.scale == 1.0);
+    CHECK(h.toolTipM == Vec3(0.0));
+    REQUIRE(samples.size() == 3);
+    for (std::size_t k = 0; k < 3; ++k) {
+        const TraceSample& s = samples[k];
+        CHECK(s.tick == k);
+        CHECK(s.timeNs == 1'000'000 * k);
+        CHECK(s.positionM == Vec3(0.01 * static_cast<double>(k), 0.0, -0.02));
+        CHECK(s.forceN == Vec3(0.0, 1.0, 0.0));
+        CHECK(s.computeNs == 3000);
+        CHECK(s.ioNs == 500);
+        CHECK(s.buttons == 1);
+        CHECK(s.proxyM == Vec3(0.0));
+        CHECK_FALSE(s.hasVelocity);
+        CHECK_FALSE(s.hasOrientation);
+        CHECK(s.contactCount == 0);
+    }
 }
 
 TEST_CASE("trace: the header layout is the documented one") {
@@ -95,12 +153,35 @@ TEST_CASE("trace: the header layout is the documented one") {
     writeTrace(dir / "t.trace", randomSamples(3, 2));
     const std::string bytes = test::readFile(dir / "t.trace");
     CHECK(bytes.substr(0, 8) == "HAPTOTRC");
-    CHECK(bytes[8] == 1); // version, little-endian
-    CHECK(bytes[12] == static_cast<char>(128));
-    CHECK(bytes[16] == 80);
+    CHECK(bytes[8] == 2);  // version, little-endian
+    CHECK(bytes[12] == 0); // header size 256
+    CHECK(bytes[13] == 1);
+    CHECK(bytes[16] == static_cast<char>(192));
     CHECK(bytes[32] == 3); // sample count
     CHECK(bytes.substr(48, 3) == "sim");
     CHECK(bytes.substr(64, 4) == "left");
+    const auto f64 = [&](std::size_t at) {
+        std::uint64_t v = 0;
+        for (int i = 0; i < 8; ++i) {
+            v |= static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[at + i])) << (8 * i);
+        }
+        return std::bit_cast<double>(v);
+    };
+    CHECK(f64(128) == -0.02); // translation
+    CHECK(f64(152) == header().transform.rotation.w);
+    CHECK(f64(176) == header().transform.rotation.z);
+    CHECK(f64(184) == 1.5);   // scale
+    CHECK(f64(208) == -0.04); // tool tip z
+    CHECK(f64(216) == 3.3);   // force clamp
+    CHECK(bytes.substr(224, 32) == std::string(32, '\0'));
+    const std::vector<TraceSample> s = randomSamples(3, 2);
+    const std::size_t s0 = kTraceHeaderBytes;
+    CHECK(f64(s0 + 80) == s[0].proxyM.x);
+    CHECK(f64(s0 + 128) == (s[0].hasOrientation ? s[0].orientation.w : 1.0));
+    CHECK(static_cast<unsigned char>(bytes[s0 + 184]) == s[0].contactCount);
+    CHECK(static_cast<unsigned char>(bytes[s0 + 188]) ==
+          ((s[0].hasVelocity ? 1 : 0) | (s[0].hasOrientation ? 2 : 0) |
+           (s[0].hasAngularVelocity ? 4 : 0)));
 }
 
 TEST_CASE("trace: an empty recording is valid") {
@@ -119,11 +200,11 @@ TEST_CASE("trace: truncated and corrupt files are refused with the byte offset")
 
     fresh();
     std::filesystem::resize_file(p, kTraceHeaderBytes + 9 * kTraceSampleBytes + 40);
-    CHECK_THAT(errorReading(p), Catch::Contains("t.trace: byte 888: truncated: the header "
+    CHECK_THAT(errorReading(p), Catch::Contains("t.trace: byte 2024: truncated: the header "
                                                 "announces 10 samples"));
     fresh();
     patch(p, 32, std::string("\xfe") + std::string(7, '\xff')); // 2^64 - 2 samples
-    CHECK_THAT(errorReading(p), Catch::Contains("byte 928: truncated: the header announces "
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 2176: truncated: the header announces "
                                                 "18446744073709551614 samples (more bytes than "
                                                 "a file can hold)"));
     fresh();
@@ -134,8 +215,39 @@ TEST_CASE("trace: truncated and corrupt files are refused with the byte offset")
     test::writeFile(p, "{\"format\": \"hapto-scene\"} and then some more text to fill");
     CHECK_THAT(errorReading(p), Catch::Contains("byte 0: not a hapto trace"));
     fresh();
-    patch(p, 8, std::string("\x02", 1));
-    CHECK_THAT(errorReading(p), Catch::Contains("byte 8: trace format version 2"));
+    patch(p, 8, std::string("\x03", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 8: trace format version 3"));
+    fresh();
+    std::filesystem::resize_file(p, 200);
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 200: truncated: a version 2 header"));
+    fresh();
+    patch(p, 8, std::string("\x01", 1)); // a version 1 header on version 2 sizes
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 12: header size 256, expected 128"));
+    fresh();
+    patch(p, 152, std::string(8, '\0')); // rotation w = 0: not unit
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 152: the transform's rotation"));
+    fresh();
+    patch(p, 184, std::string(8, '\0')); // scale 0
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 184: the transform's scale"));
+    fresh();
+    patch(p, 200, std::string(8, '\xff')); // tool tip NaN
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 192: the tool tip is not finite"));
+    fresh();
+    patch(p, 230, std::string("\x01", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 230: reserved header bytes"));
+    fresh();
+    patch(p, kTraceHeaderBytes + kTraceSampleBytes + 88, std::string(8, '\xff'));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 528: sample 1: proxy is not finite"));
+    fresh();
+    patch(p, kTraceHeaderBytes + kTraceSampleBytes + 128, std::string(8, '\0'));
+    patch(p, kTraceHeaderBytes + kTraceSampleBytes + 136, std::string(24, '\0'));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 576: sample 1: orientation is not a unit"));
+    fresh();
+    patch(p, kTraceHeaderBytes + kTraceSampleBytes + 184, std::string("\x07", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 632: sample 1: contact count 7"));
+    fresh();
+    patch(p, kTraceHeaderBytes + kTraceSampleBytes + 188, std::string("\x08", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 636: sample 1: unknown sample flags 8"));
     fresh();
     patch(p, 16, std::string("\x40", 1));
     CHECK_THAT(errorReading(p), Catch::Contains("byte 16: sample size 64"));
@@ -147,16 +259,16 @@ TEST_CASE("trace: truncated and corrupt files are refused with the byte offset")
     CHECK_THAT(errorReading(p), Catch::Contains("byte 64: the name field"));
     fresh();
     patch(p, kTraceHeaderBytes + 2 * kTraceSampleBytes + 72, std::string("\x09", 1));
-    CHECK_THAT(errorReading(p), Catch::Contains("byte 360: sample 2: unknown device status 9"));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 712: sample 2: unknown device status 9"));
     fresh();
     patch(p, kTraceHeaderBytes + 3 * kTraceSampleBytes + 16, std::string(8, '\xff'));
-    CHECK_THAT(errorReading(p), Catch::Contains("byte 384: sample 3: position is not finite"));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 848: sample 3: position is not finite"));
     fresh();
     patch(p, kTraceHeaderBytes + 4 * kTraceSampleBytes, std::string(8, '\0'));
     CHECK_THAT(errorReading(p), Catch::Contains("sample 4: tick 0 does not follow"));
     fresh();
     test::writeFile(p, test::readFile(p) + "xyz");
-    CHECK_THAT(errorReading(p), Catch::Contains("byte 928: 3 unexpected bytes after the last"));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 2176: 3 unexpected bytes after the last"));
     CHECK_THAT(errorReading(dir / "none.trace"), Catch::Contains("none.trace: cannot read"));
 }
 

@@ -147,6 +147,9 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
         c.rateHz = 2000;
         c.effects = everyEffect(20.0);
         c.contactDampingNsPerM = 1.0;
+        // A turning stylus with a tool tip: the tip's point and velocity are servo work too.
+        c.toolTipM = Vec3(0.0, 0.0, 0.01);
+        std::get<SimConfig>(c.params).spinRadPerS = Vec3(0.0, 1.0, 0.0);
         devices.push_back({makeDevice(c, scene), c, nullptr});
     }
     RuntimeOptions opt;

@@ -61,6 +61,8 @@ TEST_CASE("hapto trace info describes a trace") {
     REQUIRE(r.exitCode == 0);
     CHECK_THAT(r.output, Catch::Contains("left (sim)"));
     CHECK_THAT(r.output, Catch::Contains("samples:  3"));
+    CHECK_THAT(r.output, Catch::Contains("format:   version 2"));
+    CHECK_THAT(r.output, Catch::Contains("tool tip: [0, 0, 0] m"));
 }
 
 TEST_CASE("hapto trace export refuses a bad trace with exit code 2") {
@@ -72,4 +74,129 @@ TEST_CASE("hapto trace export refuses a bad trace with exit code 2") {
     CHECK_THAT(r.output, Catch::Contains("left.trace: byte 200: truncated"));
     const auto missing = test::runHapto("trace export " + (dir / "none.trace").string());
     CHECK(missing.exitCode == 2);
+}
+
+namespace {
+
+// A version 2 trace of `name`: 400 ticks at 1 kHz, in contact from tick 100 to 199 (a force
+// pushing back along +y, the proxy held at y = 0), compute time growing with the tick.
+void writeContactTrace(const std::filesystem::path& p, const std::string& name, double sign) {
+    TraceHeader h;
+    h.name = name;
+    h.kind = "sim";
+    TraceRecorder rec(p, h);
+    for (std::uint64_t t = 0; t < 400; ++t) {
+        TraceSample s;
+        s.tick = t;
+        s.timeNs = 1'000'000 * t;
+        const double y = 0.01 - 0.0001 * static_cast<double>(t);
+        s.positionM = Vec3(sign * 0.02, y, 0.0);
+        const bool contact = t >= 100 && t < 200;
+        s.proxyM = Vec3(sign * 0.02, contact ? 0.0 : y, 0.0);
+        s.contactCount = contact ? 1 : 0;
+        s.forceN = contact ? Vec3(0.0, 300.0 * (0.0 - y), 0.0) : Vec3(0.0);
+        s.computeNs = static_cast<std::uint32_t>(1000 + t);
+        REQUIRE(rec.push(s));
+    }
+    rec.close();
+}
+
+bool startsWith(const std::string& s, const std::string& prefix) {
+    return s.compare(0, prefix.size(), prefix) == 0;
+}
+
+} // namespace
+
+TEST_CASE("hapto trace plot draws traces as PNG and SVG, a line per device, contact shaded") {
+    test::TempDir dir;
+    writeContactTrace(dir / "left.trace", "left", -1.0);
+    writeContactTrace(dir / "right.trace", "right", 1.0);
+    for (const std::string ext : {"png", "svg"}) {
+        INFO(ext);
+        const std::filesystem::path out = dir / ("run." + ext);
+        const auto r = test::runHapto("trace plot " + (dir / "left.trace").string() + " " +
+                                      (dir / "right.trace").string() + " -o " + out.string() +
+                                      " --script " + (dir / "run.gp").string());
+        INFO(r.output);
+        REQUIRE(r.exitCode == 0);
+        const std::string image = test::readFile(out);
+        if (ext == "png") {
+            CHECK(startsWith(image, "\x89PNG\r\n\x1a\n"));
+        } else {
+            CHECK_THAT(image, Catch::Contains("<svg"));
+            CHECK_THAT(image, Catch::Contains("</svg>"));
+        }
+        const std::string gp = test::readFile(dir / "run.gp");
+        // One panel per quantity, with units.
+        for (const char* label :
+             {"position (m)", "proxy (m)", "force (N)", "tick time (us)", "time (s)"}) {
+            CHECK_THAT(gp, Catch::Contains(std::string("\"") + label + "\""));
+        }
+        // A line per device (and per component).
+        for (const char* series : {"left x", "right z", "left |F|", "right |F|", "left Fy"}) {
+            CHECK_THAT(gp, Catch::Contains(std::string("title \"") + series + "\""));
+        }
+        // The contact span: ticks 100..199 of both devices, 0.1 s to 0.199 s.
+        CHECK_THAT(gp, Catch::Contains("set object 1 rect from 0.1, graph 0 to 0.199, graph 1"));
+        CHECK_THAT(gp, Catch::Contains("\"in contact\""));
+        CHECK_THAT(gp, !Catch::Contains("set object 2 rect"));
+        // The data: tick 150 of "left" (y = -0.005 m, |F| = 1.5 N, 1.15 us).
+        CHECK_THAT(gp, Catch::Contains("\n0.15 -0.005\n"));
+        CHECK_THAT(gp, Catch::Contains("\n0.15 1.5\n"));
+        CHECK_THAT(gp, Catch::Contains("\n0.15 1.15\n"));
+        if (ext == "png") {
+            CHECK_THAT(gp, Catch::Contains("set terminal pngcairo"));
+            CHECK_THAT(gp, !Catch::Contains("set terminal svg"));
+        } else {
+            CHECK_THAT(gp, Catch::Contains("set terminal svg"));
+        }
+    }
+    // Nothing but the outputs is left in the folder.
+    std::size_t files = 0;
+    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path())) {
+        ++files;
+    }
+    CHECK(files == 5); // two traces, run.png, run.svg, run.gp
+}
+
+TEST_CASE("hapto trace plot refuses a bad trace or output with exit code 2, writing nothing") {
+    test::TempDir dir;
+    writeContactTrace(dir / "left.trace", "left", -1.0);
+    std::filesystem::copy_file(dir / "left.trace", dir / "bad.trace");
+    std::filesystem::resize_file(dir / "bad.trace", 300);
+    auto r = test::runHapto("trace plot " + (dir / "left.trace").string() + " " +
+                            (dir / "bad.trace").string() + " -o " + (dir / "p.png").string());
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("bad.trace: byte 300"));
+    CHECK_FALSE(std::filesystem::exists(dir / "p.png"));
+    r = test::runHapto("trace plot " + (dir / "left.trace").string() + " -o " +
+                       (dir / "p.jpg").string());
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains(".png or .svg"));
+}
+
+TEST_CASE("hapto report plot draws a run report per device") {
+    test::TempDir dir;
+    const auto run = test::runHapto("run --duration 0.3 --no-realtime --quiet --report " +
+                                    (dir / "report.json").string());
+    INFO(run.output);
+    REQUIRE(run.exitCode == 0);
+    const auto r =
+        test::runHapto("report plot " + (dir / "report.json").string() + " -o " +
+                       (dir / "report.svg").string() + " --script " + (dir / "report.gp").string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK_THAT(test::readFile(dir / "report.svg"), Catch::Contains("<svg"));
+    const std::string gp = test::readFile(dir / "report.gp");
+    CHECK_THAT(gp, Catch::Contains("tick time (% of the period)"));
+    CHECK_THAT(gp, Catch::Contains("lateness (us)"));
+    // The devices by name along x, a line per statistic.
+    CHECK_THAT(gp, Catch::Contains("set xtics (\"left\" 1, \"right\" 2)"));
+    for (const char* series : {"p50", "p99.9", "max", "in contact", "missed deadlines"}) {
+        CHECK_THAT(gp, Catch::Contains(std::string("title \"") + series + "\""));
+    }
+    const auto png = test::runHapto("report plot " + (dir / "report.json").string() + " -o " +
+                                    (dir / "report.png").string());
+    REQUIRE(png.exitCode == 0);
+    CHECK(startsWith(test::readFile(dir / "report.png"), "\x89PNG\r\n\x1a\n"));
 }

@@ -31,10 +31,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         hapto::TraceHeader header;
         const auto samples =
             hapto::TraceReader::load("/proc/self/fd/" + std::to_string(fd), &header);
+        // ... a unit orientation and at most three contacts, and a usable configuration.
+        if (!(header.transform.scale > 0.0) ||
+            std::abs(glm::length(header.transform.rotation) - 1.0) > 1e-6) {
+            __builtin_trap();
+        }
         for (const hapto::TraceSample& s : samples) {
+            if (std::abs(glm::length(s.orientation) - 1.0) > 1e-6 || s.contactCount > 3) {
+                __builtin_trap();
+            }
             // The reader promises finite values.
             for (int i = 0; i < 3; ++i) {
-                if (!std::isfinite(s.positionM[i]) || !std::isfinite(s.forceN[i])) {
+                if (!std::isfinite(s.positionM[i]) || !std::isfinite(s.forceN[i]) ||
+                    !std::isfinite(s.proxyM[i]) || !std::isfinite(s.velocityMps[i]) ||
+                    !std::isfinite(s.angularVelocity[i])) {
                     __builtin_trap();
                 }
             }

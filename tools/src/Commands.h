@@ -17,8 +17,16 @@ void addSceneCommands(CLI::App& app);
 /// [control]
 void addIndexCommands(CLI::App& app);
 
-/// `hapto trace export|info`: trace files as CSV, and what they hold. [control]
+/// `hapto trace export|info|plot`: trace files as CSV, what they hold, and plots. [control]
 void addTraceCommands(CLI::App& app);
+
+/// `hapto report plot`: a `hapto run --report` JSON file drawn per device. [control]
+void addReportCommands(CLI::App& app);
+
+/// Refuses, before any work, a plot output `out` not ending in .png or .svg or not writable,
+/// and a `script` output (may be empty) that is `out` or not writable. Throws InputError.
+/// [control]
+void checkPlotOutputs(const std::string& out, const std::string& script);
 
 /// `hapto bench query`: per-query cost of indices along a hand-speed walk. [control]
 void addBenchCommands(CLI::App& app);

@@ -79,7 +79,7 @@ int runDemo(const DemoArgs& a) {
                          ": the grasp demo takes exactly two devices (left, right), got " +
                          std::to_string(configs.size()));
     }
-    useTraceRates(configs);
+    useTraceSettings(configs);
     checkSessionFiles({a.scene, a.devices, a.report, ""}, configs);
     World world(scene, IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb));
     std::vector<RuntimeDevice> devices;

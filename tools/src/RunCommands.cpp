@@ -68,13 +68,12 @@ void printSummary(const RunReport& r) {
     }
 }
 
-// Gives replay devices their trace's rate unless --rate set one for all, then refuses, before
-// anything starts, what cannot work: too many devices, a spin as long as a period, outputs
-// that cannot be written or would overwrite an input. Throws InputError.
+// Gives replay devices their trace's transform, tool tip and rate (the rate unless --rate set
+// one for all), then refuses, before anything starts, what cannot work: too many devices, a
+// spin as long as a period, outputs that cannot be written or would overwrite an input.
+// Throws InputError.
 void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
-    if (!(a.rateHz > 0)) {
-        useTraceRates(configs);
-    }
+    useTraceSettings(configs, !(a.rateHz > 0));
     checkDeviceCount(configs.size(), a.devices);
     checkSpinAgainstRates(a.spinUs, configs);
     checkSessionFiles({a.scene, a.devices, a.report, a.record}, configs);
@@ -108,6 +107,9 @@ int runSession(const RunArgs& a) {
             header.rateHz = c.rateHz;
             header.kind = std::string(name(c.kind));
             header.name = c.name;
+            header.transform = c.transform;
+            header.toolTipM = c.toolTipM;
+            header.maxForceN = c.maxForceN;
             header.startUnixNs =
                 static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                                std::chrono::system_clock::now().time_since_epoch())

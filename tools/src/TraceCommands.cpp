@@ -1,8 +1,9 @@
-// `hapto trace export|info`: look inside trace files written by `hapto run --record`.
+// `hapto trace export|info|plot`: look inside trace files written by `hapto run --record`.
 
 #include "Commands.h"
 
 #include "hapto/devices/TraceReader.h"
+#include "hapto/experiments/Plot.h"
 #include "hapto/scenes/InputError.h"
 #include "hapto/scenes/OutputFile.h"
 
@@ -98,6 +99,15 @@ void printInfo(const std::string& tracePath) {
     std::printf("trace:    %s\n", tracePath.c_str());
     std::printf("device:   %s (%s)\n", h.name.c_str(), h.kind.c_str());
     std::printf("rate:     %g Hz\n", h.rateHz);
+    std::printf("format:   version %u\n", h.version);
+    if (h.hasConfiguration()) {
+        const WorkspaceTransform& t = h.transform;
+        std::printf("transform: translation [%g, %g, %g] m, rotation [%g, %g, %g, %g], scale %g\n",
+                    t.translation.x, t.translation.y, t.translation.z, t.rotation.w, t.rotation.x,
+                    t.rotation.y, t.rotation.z, t.scale);
+        std::printf("tool tip: [%g, %g, %g] m\n", h.toolTipM.x, h.toolTipM.y, h.toolTipM.z);
+        std::printf("clamp:    %g N%s\n", h.maxForceN, h.maxForceN > 0 ? "" : " (the default)");
+    }
     std::printf("samples:  %llu%s\n", static_cast<unsigned long long>(n),
                 h.finished ? "" : " (recording was not closed)");
     if (n > 0) {
@@ -109,7 +119,152 @@ void printInfo(const std::string& tracePath) {
     }
 }
 
+/// The most points a plotted series gets: a longer trace is drawn from every k-th sample (the
+/// contact spans still come from every sample).
+constexpr std::size_t kMaxPlotPoints = 4000;
+
+/// An empty panel with its title and axis labels (units in the labels).
+experiments::PlotPanel panel(const std::string& title, const std::string& x, const std::string& y) {
+    experiments::PlotPanel p;
+    p.title = title;
+    p.xLabel = x;
+    p.yLabel = y;
+    return p;
+}
+
+/// The time axis of a sample (s since the session started).
+double seconds(const TraceSample& s) {
+    return static_cast<double>(s.timeNs) * 1e-9;
+}
+
+/// A figure of traces: position, proxy, force and tick time against time, one colour per
+/// device, shaded where a device was in contact (version 2 traces: contact count > 0).
+experiments::PlotSpec tracePlot(const std::vector<std::string>& paths) {
+    using experiments::PlotPanel;
+    using experiments::PlotSeries;
+    experiments::PlotSpec spec;
+    spec.name = "trace";
+    spec.title = "hapto trace";
+    spec.columns = 2;
+    spec.panelWidthPx = 640;
+    spec.heightPx = 400;
+    PlotPanel position =
+        panel("position (gimbal centre, device frame)", "time (s)", "position (m)");
+    PlotPanel proxy = panel("proxy (device frame)", "time (s)", "proxy (m)");
+    PlotPanel force = panel("force written (device frame)", "time (s)", "force (N)");
+    PlotPanel tick = panel("tick time (wake-up to force written)", "time (s)", "tick time (us)");
+    std::vector<std::pair<double, double>> contact;
+    const char* axes[3] = {"x", "y", "z"};
+    int style = 0;
+    for (const std::string& path : paths) {
+        TraceHeader h;
+        const std::vector<TraceSample> samples = TraceReader::load(path, &h);
+        const std::string device = h.name.empty() ? path : h.name;
+        if (paths.size() > 1 && spec.title == "hapto trace") {
+            spec.title = "hapto trace: " + std::to_string(paths.size()) + " devices";
+        } else if (paths.size() == 1) {
+            spec.title = "hapto trace: " + device + " (" + h.kind + ", " + path + ")";
+        }
+        const std::size_t stride =
+            std::max<std::size_t>(1, (samples.size() + kMaxPlotPoints - 1) / kMaxPlotPoints);
+        PlotSeries pos[3], prox[3], f[4], t;
+        for (int a = 0; a < 3; ++a) {
+            pos[a].title = device + " " + axes[a];
+            prox[a].title = device + " " + axes[a];
+            f[a].title = device + " F" + axes[a];
+            f[a].dashed = true;
+        }
+        f[3].title = device + " |F|";
+        t.title = device;
+        for (std::size_t k = 0; k < samples.size(); ++k) {
+            const TraceSample& s = samples[k];
+            const double x = seconds(s);
+            if (s.contactCount > 0) {
+                // Extend the last span when this sample follows it, else start one.
+                const double step = k > 0 ? x - seconds(samples[k - 1]) : 0.0;
+                if (!contact.empty() && k > 0 && samples[k - 1].contactCount > 0 &&
+                    x >= contact.back().first && x - contact.back().second <= step) {
+                    contact.back().second = std::max(contact.back().second, x);
+                } else {
+                    contact.emplace_back(x, x);
+                }
+            }
+            if (k % stride != 0 && k + 1 != samples.size()) {
+                continue;
+            }
+            for (int a = 0; a < 3; ++a) {
+                pos[a].points.emplace_back(x, s.positionM[a]);
+                if (h.version >= 2) {
+                    prox[a].points.emplace_back(x, s.proxyM[a]);
+                }
+                f[a].points.emplace_back(x, s.forceN[a]);
+            }
+            f[3].points.emplace_back(x, glm::length(s.forceN));
+            t.points.emplace_back(x, static_cast<double>(s.computeNs) * 1e-3);
+        }
+        // One colour per device: its |F| and tick time solid, the components beside them.
+        ++style;
+        const int base = (style - 1) * 4;
+        for (int a = 0; a < 3; ++a) {
+            for (PlotSeries* series : {&pos[a], &prox[a], &f[a]}) {
+                series->linesOnly = true;
+                series->style = base + a + 2;
+            }
+            position.series.push_back(pos[a]);
+            proxy.series.push_back(prox[a]);
+            force.series.push_back(f[a]);
+        }
+        f[3].linesOnly = true;
+        f[3].style = base + 1;
+        force.series.push_back(f[3]);
+        t.linesOnly = true;
+        t.style = base + 1;
+        tick.series.push_back(t);
+    }
+    // Overlapping spans of several devices: merged, in time order.
+    std::sort(contact.begin(), contact.end());
+    std::vector<std::pair<double, double>> merged;
+    for (const auto& span : contact) {
+        if (!merged.empty() && span.first <= merged.back().second) {
+            merged.back().second = std::max(merged.back().second, span.second);
+        } else {
+            merged.push_back(span);
+        }
+    }
+    for (PlotPanel* p : {&position, &proxy, &force, &tick}) {
+        p->spans = merged;
+        p->spanTitle = "in contact";
+        spec.panels.push_back(*p);
+    }
+    return spec;
+}
+
+void plotTraces(const std::vector<std::string>& paths, const std::string& out,
+                const std::string& script) {
+    for (const std::string& path : paths) {
+        refuseSameFile(out, "-o", path, "a trace");
+        if (!script.empty()) {
+            refuseSameFile(script, "--script", path, "a trace");
+        }
+    }
+    checkPlotOutputs(out, script);
+    experiments::drawPlotFile(tracePlot(paths), out, script);
+    std::cerr << "wrote " << out << (script.empty() ? "" : " and " + script) << "\n";
+}
+
 } // namespace
+
+void checkPlotOutputs(const std::string& out, const std::string& script) {
+    const std::string ext = std::filesystem::path(out).extension().string();
+    if (ext != ".png" && ext != ".svg") {
+        throw InputError(out + ": -o names the plot, a file ending in .png or .svg");
+    }
+    checkOutputFile(out, "-o");
+    if (!script.empty()) {
+        refuseSameFile(script, "--script", out, "the plot");
+        checkOutputFile(script, "--script");
+    }
+}
 
 void addTraceCommands(CLI::App& app) {
     CLI::App* trace =
@@ -130,6 +285,18 @@ void addTraceCommands(CLI::App& app) {
         auto path = std::make_shared<std::string>();
         cmd->add_option("trace", *path, "The trace file")->required();
         cmd->callback([path] { printInfo(*path); });
+    }
+    {
+        auto* cmd = trace->add_subcommand(
+            "plot", "Draw traces (one per device) as PNG or SVG with gnuplot: position, proxy "
+                    "and force (device frame) and tick time against time, shaded in contact");
+        auto paths = std::make_shared<std::vector<std::string>>();
+        auto out = std::make_shared<std::string>();
+        auto script = std::make_shared<std::string>();
+        cmd->add_option("traces", *paths, "The trace files (one line colour each)")->required();
+        cmd->add_option("-o,--output", *out, "The plot: OUT.png or OUT.svg")->required();
+        cmd->add_option("--script", *script, "Also keep the gnuplot script, data inline");
+        cmd->callback([paths, out, script] { plotTraces(*paths, *out, *script); });
     }
 }
 

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
     hapto::cli::addIndexCommands(app);
     hapto::cli::addRenderCommands(app);
     hapto::cli::addTraceCommands(app);
+    hapto::cli::addReportCommands(app);
     hapto::cli::addExperimentCommands(app);
     hapto::cli::addSoakCommands(app);
 

@@ -7,6 +7,11 @@
 //   - one scheduler thread calling the scheduled callbacks, highest priority first, at 1 kHz
 //     (hdSetSchedulerRate changes it);
 //   - positions following p0 + v * t (mm, t = scheduler ticks / rate), velocity v (mm/s);
+//   - a stylus orientation (axis, angle) and gimbal angles (rad) set by the test:
+//     HD_CURRENT_TRANSFORM (0x2052) gives them as OpenHaptics does, 16 doubles laid out as
+//     hduMatrix stores them (HDU/hduMatrix.h: "stored by row", translations "along the last
+//     row": m[4 i + j] = R(j, i) for the column-vector rotation R, m[12..14] = the position in
+//     mm, m[15] = 1), HD_CURRENT_GIMBAL_ANGLES (0x2150) three doubles (rad);
 //   - a force recorder: the force applied by each hdEndFrame with force output enabled.
 // Errors go on a per-thread stack (hdGetError pops the newest), the current device is
 // per-thread, as in the HD API. Test hooks (fakehd_*) script errors, stalls and removal, and
@@ -57,6 +62,8 @@ constexpr HDerror kIllegalEnd = 0x0401;
 constexpr HDenum kCurrentButtons = 0x2000;
 constexpr HDenum kCurrentPosition = 0x2050;
 constexpr HDenum kCurrentVelocity = 0x2051;
+constexpr HDenum kCurrentTransform = 0x2052;
+constexpr HDenum kCurrentGimbalAngles = 0x2150;
 constexpr HDenum kDeviceModelType = 0x2501;
 constexpr HDenum kDeviceVendor = 0x2503;
 constexpr HDenum kDeviceSerialNumber = 0x2504;
@@ -79,6 +86,9 @@ struct FakeDevice {
     double p0[3] = {0, 0, 0}; // mm
     double v[3] = {0, 0, 0};  // mm/s
     int buttons = 0;
+    double axis[3] = {0, 0, 1}; // stylus rotation axis (unit) and angle (rad)
+    double angle = 0.0;
+    double gimbal[3] = {0, 0, 0}; // rad
     double framePos[3] = {0, 0, 0};
     double pendingForce[3] = {0, 0, 0};
     double lastForce[3] = {0, 0, 0};
@@ -354,6 +364,41 @@ FAKEHD_EXPORT void hdGetDoublev(HDenum name, HDdouble* out) {
     case kCurrentVelocity:
         std::copy(std::begin(d->v), std::end(d->v), out);
         break;
+    case kCurrentTransform: {
+        // Rodrigues: R = I cos a + sin a [k]x + (1 - cos a) k k^T, then hduMatrix's layout.
+        const double* k = d->axis;
+        const double c = std::cos(d->angle), s = std::sin(d->angle);
+        double r[3][3];
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) {
+                r[i][j] = (i == j ? c : 0.0) + (1.0 - c) * k[i] * k[j];
+            }
+        }
+        r[0][1] -= s * k[2];
+        r[0][2] += s * k[1];
+        r[1][0] += s * k[2];
+        r[1][2] -= s * k[0];
+        r[2][0] -= s * k[1];
+        r[2][1] += s * k[0];
+        double p[3];
+        if (d->inFrame) {
+            std::copy(std::begin(d->framePos), std::end(d->framePos), p);
+        } else {
+            positionNow(*d, p);
+        }
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) {
+                out[4 * i + j] = r[j][i];
+            }
+            out[4 * i + 3] = 0.0;
+            out[12 + i] = p[i];
+        }
+        out[15] = 1.0;
+        break;
+    }
+    case kCurrentGimbalAngles:
+        std::copy(std::begin(d->gimbal), std::end(d->gimbal), out);
+        break;
     case kNominalMaxForce:
         *out = 3.3; // N, a Touch
         break;
@@ -493,6 +538,21 @@ FAKEHD_EXPORT void fakehd_set_motion(int dev, double px, double py, double pz, d
         d.v[k] = v[k];
         d.p0[k] = p[k] - v[k] * t;
     }
+}
+
+/// The stylus orientation: a rotation of `angle` rad about the unit axis (x, y, z), and the
+/// gimbal angles (rad) reported with it.
+FAKEHD_EXPORT void fakehd_set_stylus(int dev, double x, double y, double z, double angle, double g0,
+                                     double g1, double g2) {
+    std::lock_guard lock(gState);
+    FakeDevice& d = gDevices[dev];
+    d.axis[0] = x;
+    d.axis[1] = y;
+    d.axis[2] = z;
+    d.angle = angle;
+    d.gimbal[0] = g0;
+    d.gimbal[1] = g1;
+    d.gimbal[2] = g2;
 }
 
 FAKEHD_EXPORT void fakehd_set_buttons(int dev, int mask) {

@@ -35,7 +35,7 @@ run_case() {
     local name=$1 expect=$2 args=$3
     local scratch
     scratch=$(mktemp -d "${TMPDIR:-/tmp}/hapto-bad-input.XXXXXX")
-    cp -R "$corpus/scenes" "$corpus/devices" "$corpus/points" "$corpus/traces" "$scratch/"
+    cp -R "$corpus/scenes" "$corpus/devices" "$corpus/points" "$corpus/traces" "$corpus/reports" "$scratch/"
     mkdir "$scratch/adir" "$scratch/outputs"
     mkfifo "$scratch/fifo"
     printf 'a report from before\n' >"$scratch/outputs/report.json"

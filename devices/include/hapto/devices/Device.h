@@ -23,13 +23,28 @@ enum class DeviceStatus : std::uint8_t {
 /// A short lower-case name for a status ("ok", "stalled", ...). [any thread]
 std::string_view statusName(DeviceStatus status);
 
-/// One reading of a device, in the device's own frame.
+/// One reading of a device, in the device's own frame. Position is the gimbal centre (the end
+/// of the arm, where the device's force acts); the stylus frame turns with `orientation`. Each
+/// `has...` flag says whether the field beside it is real: a device that does not measure a
+/// quantity leaves the flag false and the field at its default.
 struct DeviceState {
-    Vec3 position{0.0};         ///< End-effector position (m), device frame.
-    Vec3 velocity{0.0};         ///< End-effector velocity (m/s), device frame, if hasVelocity.
-    bool hasVelocity = false;   ///< True when the device measured or estimated velocity.
-    std::uint32_t buttons = 0;  ///< Bit i set while button i is pressed.
-    std::uint64_t sequence = 0; ///< Increases with every fresh sample from the device.
+    Vec3 position{0.0};              ///< End-effector (gimbal centre) position (m), device frame.
+    Vec3 velocity{0.0};              ///< End-effector velocity (m/s), device frame, if hasVelocity.
+    Quat orientation{1, 0, 0, 0};    ///< Stylus frame in the device frame, unit quaternion
+                                     ///< (w, x, y, z), if hasOrientation; identity otherwise.
+    Vec3 angularVelocity{0.0};       ///< Stylus angular velocity (rad/s), device frame, if
+                                     ///< hasAngularVelocity.
+    Vec3 gimbalAnglesRad{0.0};       ///< The gimbal's three joint angles (rad), as the device
+                                     ///< reports them, if hasGimbalAngles.
+    double gripper = 0.0;            ///< Gripper opening as the device reports it (device units:
+                                     ///< rad for an angle, 0..1 for a fraction), if hasGripper.
+    bool hasVelocity = false;        ///< True when the device measured or estimated velocity.
+    bool hasOrientation = false;     ///< True when the device measures the stylus orientation.
+    bool hasAngularVelocity = false; ///< True when the device measures angular velocity.
+    bool hasGimbalAngles = false;    ///< True when gimbalAnglesRad holds the joint angles.
+    bool hasGripper = false;         ///< True when the device has a gripper and read it.
+    std::uint32_t buttons = 0;       ///< Bit i set while button i is pressed.
+    std::uint64_t sequence = 0;      ///< Increases with every fresh sample from the device.
 };
 
 /// What a device can do, each with its unit.

@@ -61,6 +61,13 @@ struct SimConfig {
     double resolutionM = 1.0e-5;   ///< Encoder quantum (m), >= 0; 0 = continuous. `resolution_m`.
     double noiseM = 2.0e-6;        ///< Uniform position noise per axis, |noise| <= noiseM (m),
                                    ///< >= 0. `noise_m`.
+    /// The stylus orientation at the start, device frame, unit quaternion [w, x, y, z]. With
+    /// it (or a spin) the hand reports an orientation and angular velocity; without either it
+    /// reports none, like a 3-DOF device. `orientation`.
+    std::optional<Quat> orientation;
+    Vec3 spinRadPerS{0.0}; ///< The stylus turns at this constant angular velocity (rad/s, device
+                           ///< frame) from `orientation`; each component within +-100.
+                           ///< `spin_rad_per_s`.
 };
 
 /// Playback of a recorded trace (`"kind": "replay"`).
@@ -68,6 +75,12 @@ struct ReplayConfig {
     std::filesystem::path trace; ///< A trace file written by `hapto run --record`; a relative
                                  ///< path in a file is relative to that file's folder.
     bool loop = false;           ///< Start over at the end instead of stalling.
+    // Set by the parser when the device's own fields give them; otherwise a version 2 trace's
+    // recorded rate, transform and tool tip are used (useTraceSettings).
+    bool ownRate = false;      ///< The device gave `rate_hz`.
+    bool ownTransform = false; ///< The device gave `transform`.
+    bool ownToolTip = false;   ///< The device gave `tool_tip`.
+    bool ownMaxForce = false;  ///< The device gave `max_force_n`.
 };
 
 /// The longest a device's own I/O thread may keep applying the servo's last force (ms): a
@@ -220,6 +233,8 @@ struct EffectProblem {
 /// non-finite value, an axis that is not of unit length), or none. The one home of the
 /// effect rules: device files and Runtime::setEffects() both apply it. [any thread]
 std::optional<EffectProblem> checkForceEffect(const ForceEffect& effect);
+/// The longest tool tip component a file may give (m).
+inline constexpr double kMaxToolTipM = 0.5;
 
 /// The device configuration file format version this build reads.
 inline constexpr int kDeviceConfigFormatVersion = 1;
@@ -231,6 +246,12 @@ struct DeviceConfig {
     WorkspaceTransform transform;      ///< Device frame into the world.
     double maxForceN = 0.0;            ///< Force clamp (N); 0 = the device's own maximum.
     double rateHz = 1000.0;            ///< Servo rate (Hz), 100..100000. A replay uses its trace's.
+    Vec3 toolTipM{0.0}; ///< The contact point in the stylus frame (m), JSON `tool_tip`: the
+                        ///< renderer touches with position + R * toolTipM (R the stylus
+                        ///< orientation; the identity on a device without one) instead of the
+                        ///< gimbal centre, and its force acts there. A 3-DOF device applies that
+                        ///< force at the gimbal, as it can: the same force, no torque. Each
+                        ///< component within +-kMaxToolTipM.
     std::variant<SimConfig, ReplayConfig, FalconConfig, PhantomConfig> params; ///< Per kind.
     /// Force effects from the first tick on, at most kMaxEffectsPerDevice, each passing
     /// checkForceEffect(). JSON `effects`.

@@ -13,7 +13,9 @@ namespace hapto {
 
 /// A device whose positions come from a trace, one recorded tick per read(): the n-th read
 /// after open() plays tick first + n (a tick missing from the trace, dropped while recording,
-/// repeats the sample before it). Each read returns the recorded status and buttons. At the end
+/// repeats the sample before it). Each read returns the recorded status and buttons, and from
+/// a version 2 trace the recorded velocity, orientation and angular velocity with their flags
+/// (a version 1 trace has none: the runtime then differentiates positions). At the end
 /// it starts over when ReplayConfig::loop, else it keeps the last position and returns Stalled.
 /// Written forces are kept next to the recorded ones, so a rerun of a session against another
 /// index or renderer can compare them tick by tick. Its rate is the trace's.
@@ -66,10 +68,14 @@ private:
     std::string mError;
 };
 
-/// Gives every replay configuration its trace's rate (`rateHz` := the recorded rate), which
-/// is what a replay runs at unless the user sets a rate for the whole session (`hapto run
-/// --rate`); other kinds are left alone. Reads only the trace headers. Throws InputError for a
-/// trace that cannot be read. [control]
-void useTraceRates(std::span<DeviceConfig> configs);
+/// Gives every replay configuration what its trace recorded, unless the device gives its own:
+/// from a version 2 trace the transform (unless `transform` was given), the tool tip (unless
+/// `tool_tip` was) and the force clamp (unless `max_force_n` was), and when `rates` the rate
+/// (unless `rate_hz` was), which is what a replay runs at unless the user sets a rate for the whole
+/// session (`hapto run --rate`: then pass rates = false). So a replay of a recorded run against the
+/// same scene and index touches the same points and writes the same forces, tick for tick. Other
+/// kinds are left alone. Reads only the trace headers. Throws InputError for a trace that cannot be
+/// read or a recorded rate outside 100..100000 Hz. [control]
+void useTraceSettings(std::span<DeviceConfig> configs, bool rates = true);
 
 } // namespace hapto

@@ -89,4 +89,10 @@ private:
     Vec3 mContactNormal{0.0};
 };
 
+/// A simulated stylus orientation at `timeS` (s): `start` turned at the constant angular
+/// velocity `spinRadPerS` (rad/s, device frame) for `timeS`, i.e. a rotation of
+/// |spin| * timeS about spin's direction applied after `start`; `start` itself for no spin.
+/// Allocates nothing. [servo]
+Quat scriptedOrientation(const Quat& start, const Vec3& spinRadPerS, double timeS) noexcept;
+
 } // namespace hapto

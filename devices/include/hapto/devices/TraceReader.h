@@ -9,9 +9,12 @@
 
 namespace hapto {
 
-/// Reads a trace file sample by sample, checking everything: magic, version, sizes, rate, that
-/// the file holds exactly the samples its header announces, and per sample a known status,
-/// finite position and force, zero padding, strictly increasing ticks. Any problem is an
+/// Reads a trace file (version 1 or 2) sample by sample, checking everything: magic, version,
+/// sizes, rate, the recorded configuration (version 2: finite transform, unit rotation,
+/// positive scale, finite tool tip, zero reserved bytes), that the file holds exactly the
+/// samples its header announces, and per sample a known status, finite position and force,
+/// zero padding, strictly increasing ticks (version 2 also: finite proxy and velocity, a unit
+/// orientation, at most kTraceMaxContacts contacts, known flags). Any problem is an
 /// InputError naming the file and the byte offset. A trace whose recorder was never closed (a
 /// crash) reads its whole records and ignores a partial last one. All [control].
 class TraceReader {
@@ -38,10 +41,15 @@ public:
 
 private:
     [[noreturn]] void fail(std::uint64_t offset, const std::string& what) const;
+    void checkConfiguration(const TraceHeaderFields& h);
+    void checkVersion2(const TraceSample& s, const unsigned char* bytes, std::uint64_t offset,
+                       const std::string& which) const;
 
     std::filesystem::path mPath;
     std::FILE* mFile = nullptr;
     TraceHeader mHeader;
+    std::size_t mHeaderBytes = kTraceHeaderBytes;
+    std::size_t mSampleBytes = kTraceSampleBytes;
     std::uint64_t mIndex = 0;
     bool mHaveTick = false;
     std::uint64_t mLastTick = 0;

@@ -15,8 +15,9 @@ struct PlotSeries {
     std::vector<std::pair<double, double>> points; ///< (x, y) in the panel's units.
     /// Per point: drawn with the panel's unstable mark as well (empty: none is).
     std::vector<bool> unstable;
-    bool dashed = false; ///< A dashed line (e.g. p50 beside the solid p99.9).
-    int style = -1;      ///< Colour and point type (1, 2, ...); -1: the series' position + 1.
+    bool dashed = false;    ///< A dashed line (e.g. p50 beside the solid p99.9).
+    int style = -1;         ///< Colour and point type (1, 2, ...); -1: the series' position + 1.
+    bool linesOnly = false; ///< A plain line, no point marks (a time series of many points).
 };
 
 /// One set of axes.
@@ -28,9 +29,13 @@ struct PlotPanel {
     std::optional<double> limitY;    ///< A dashed horizontal line (e.g. 100 % load).
     std::string limitTitle;          ///< Its legend text.
     std::vector<double> xTics;       ///< A labelled tic at each of these x (empty: gnuplot's).
+    std::vector<std::string> xTicLabels{}; ///< Text for each of xTics (empty: the numbers).
+    /// Shaded x intervals [from, to] behind the lines (e.g. when a device was in contact).
+    std::vector<std::pair<double, double>> spans{};
+    std::string spanTitle{}; ///< Legend text of the shading (empty: none).
 };
 
-/// A figure: panels side by side.
+/// A figure: panels side by side, or in a grid of `columns` columns.
 struct PlotSpec {
     std::string name;  ///< File stem: NAME.gp, NAME.png, NAME.svg.
     std::string title; ///< Figure title.
@@ -39,6 +44,9 @@ struct PlotSpec {
     int heightPx = 420;     ///< Height (px).
     bool shareY = false;    ///< One y range for every panel (panels of the same quantity).
     std::string unstableTitle = "unstable"; ///< Key text of the unstable mark.
+    int columns = 0; ///< Panels per row (0: all in one row); the image grows by rows.
+    bool png = true; ///< Draw NAME.png.
+    bool svg = true; ///< Draw NAME.svg.
 };
 
 /// What drawPlot made.
@@ -60,5 +68,13 @@ bool gnuplotAvailable();
 /// Writes DIR/NAME.gp (data inline) and runs gnuplot on it to make DIR/NAME.png and
 /// DIR/NAME.svg. Never throws for a missing or failing gnuplot: says so in `problem`. [control]
 PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec);
+
+/// Draws one image, `out` (PNG or SVG by its extension, ".png" or ".svg"), through a temporary
+/// beside it renamed into place when whole, so `out` is either as before or complete; the
+/// script goes to `script` (atomically) when not empty, else to a temporary removed after.
+/// Throws InputError for an extension other than .png or .svg, std::runtime_error when gnuplot
+/// is missing or fails (naming its log). [control]
+void drawPlotFile(const PlotSpec& spec, const std::filesystem::path& out,
+                  const std::filesystem::path& script = {});
 
 } // namespace hapto::experiments
