@@ -170,21 +170,22 @@ template <class F> void forEachObjLine(std::string_view text, F&& f) {
 
 void checkObjIndex(std::string_view token, std::string_view part, const char* what,
                    const char* plural, std::int64_t total, std::int64_t soFar,
-                   const std::string& place) {
+                   const std::string& name, std::size_t line) {
+    const auto place = [&] { return atLine(name, line); };
     const auto i = parseInteger(part);
     if (!i) {
-        fail(place + "'" + std::string(part) + "' in " + quoted(token) + " is not a " + what +
+        fail(place() + "'" + std::string(part) + "' in " + quoted(token) + " is not a " + what +
              " index (a whole number)");
     }
     if (*i == 0) {
-        fail(place + what + " index 0 in " + quoted(token) + ": indices start at 1");
+        fail(place() + what + " index 0 in " + quoted(token) + ": indices start at 1");
     }
     if (*i > total) {
-        fail(place + what + " index " + std::to_string(*i) + " is out of range (the file has " +
+        fail(place() + what + " index " + std::to_string(*i) + " is out of range (the file has " +
              std::to_string(total) + " " + plural + ")");
     }
     if (*i < 0 && -*i > soFar) {
-        fail(place + "relative " + what + " index " + std::to_string(*i) +
+        fail(place() + "relative " + what + " index " + std::to_string(*i) +
              " is out of range (only " + std::to_string(soFar) + " " + plural +
              " come before this line)");
     }
@@ -218,22 +219,22 @@ void checkObj(std::string_view text, const std::string& name) {
         }
         const std::string_view key = tok[0];
         if (key == "v") {
-            const std::string place = atLine(name, lineNo);
+            const auto place = [&] { return atLine(name, lineNo); };
             if (tok.size() < 4) {
-                fail(place + "a vertex needs x y z, got " + std::to_string(tok.size() - 1) +
+                fail(place() + "a vertex needs x y z, got " + std::to_string(tok.size() - 1) +
                      " numbers");
             }
             const std::size_t n = tok.size() == 5 ? 4 : 3; // x y z w; or x y z r g b
             for (std::size_t k = 1; k <= n; ++k) {
                 const auto v = parseNumber(tok[k]);
                 if (!v) {
-                    fail(place + quoted(tok[k]) + " is not a number");
+                    fail(place() + quoted(tok[k]) + " is not a number");
                 }
                 if (!std::isfinite(*v)) {
-                    fail(place + "vertex coordinate " + quoted(tok[k]) + " is not finite");
+                    fail(place() + "vertex coordinate " + quoted(tok[k]) + " is not finite");
                 }
                 if (k == 4 && *v == 0.0) {
-                    fail(place + "the vertex's weight w is 0 (x y z are divided by it)");
+                    fail(place() + "the vertex's weight w is 0 (x y z are divided by it)");
                 }
             }
             ++seen.v;
@@ -242,15 +243,16 @@ void checkObj(std::string_view text, const std::string& name) {
         } else if (key == "vn") {
             ++seen.vn;
         } else if (key == "f") {
-            const std::string place = atLine(name, lineNo);
+            const auto place = [&] { return atLine(name, lineNo); };
             if (tok.size() < 4) {
-                fail(place + "a face needs at least 3 vertices, got " +
+                fail(place() + "a face needs at least 3 vertices, got " +
                      std::to_string(tok.size() - 1));
             }
             for (std::size_t k = 1; k < tok.size(); ++k) {
                 const std::string_view t = tok[k];
                 const std::size_t s1 = t.find('/');
-                checkObjIndex(t, t.substr(0, s1), "vertex", "vertices", total.v, seen.v, place);
+                checkObjIndex(t, t.substr(0, s1), "vertex", "vertices", total.v, seen.v, name,
+                              lineNo);
                 if (s1 == std::string_view::npos) {
                     continue;
                 }
@@ -258,11 +260,11 @@ void checkObj(std::string_view text, const std::string& name) {
                 const std::string_view vt = t.substr(s1 + 1, s2 - (s1 + 1));
                 if (!vt.empty()) {
                     checkObjIndex(t, vt, "texture coordinate", "texture coordinates", total.vt,
-                                  seen.vt, place);
+                                  seen.vt, name, lineNo);
                 }
                 if (s2 != std::string_view::npos) {
-                    checkObjIndex(t, t.substr(s2 + 1), "normal", "normals", total.vn, seen.vn,
-                                  place);
+                    checkObjIndex(t, t.substr(s2 + 1), "normal", "normals", total.vn, seen.vn, name,
+                                  lineNo);
                 }
             }
             triangles += tok.size() - 3;
@@ -338,37 +340,37 @@ void checkAsciiStl(std::string_view text, const std::string& name) {
         if (tok.empty()) {
             return;
         }
-        const std::string place = atLine(name, lineNo);
+        const auto place = [&] { return atLine(name, lineNo); };
         if (tok[0] == "facet") {
             if (facetLine != 0) {
-                fail(place + "a facet begins inside the facet of line " +
+                fail(place() + "a facet begins inside the facet of line " +
                      std::to_string(facetLine) + " (no endfacet)");
             }
             facetLine = lineNo;
             vertices = 0;
         } else if (tok[0] == "vertex") {
             if (facetLine == 0) {
-                fail(place + "a vertex outside a facet");
+                fail(place() + "a vertex outside a facet");
             }
             if (tok.size() != 4) {
-                fail(place + "expected 'vertex x y z', got " + std::to_string(tok.size() - 1) +
+                fail(place() + "expected 'vertex x y z', got " + std::to_string(tok.size() - 1) +
                      " numbers");
             }
             for (int c = 0; c < 3; ++c) {
                 const auto v = parseNumber(tok[1 + c]);
                 if (!v) {
-                    fail(place + std::string(kAxis[c]) + " " + quoted(tok[1 + c]) +
+                    fail(place() + std::string(kAxis[c]) + " " + quoted(tok[1 + c]) +
                          " is not a number");
                 }
                 if (!std::isfinite(*v)) {
-                    fail(place + std::string(kAxis[c]) + " " + quoted(tok[1 + c]) +
+                    fail(place() + std::string(kAxis[c]) + " " + quoted(tok[1 + c]) +
                          " is not finite");
                 }
             }
             ++vertices;
         } else if (tok[0] == "endfacet") {
             if (facetLine == 0) {
-                fail(place + "endfacet without a facet");
+                fail(place() + "endfacet without a facet");
             }
             if (vertices != 3) {
                 fail(atLine(name, facetLine) + "the facet has " + std::to_string(vertices) +
@@ -491,13 +493,20 @@ public:
               const std::string& name)
         : mBytes(bytes), mAt(bodyStart), mLine(bodyLine), mFormat(f), mName(name) {}
 
-    /// Where the next value starts: "NAME:LINE: " or "NAME: byte N: ".
-    std::string place() {
+    /// Where a value starts: its byte and line.
+    struct Mark {
+        std::size_t at, line;
+    };
+    /// Where the next value starts (cheap: no text is made until a message needs it).
+    Mark mark() {
         if (mFormat == PlyFormat::Ascii) {
             skipSpace();
-            return atLine(mName, mLine);
         }
-        return atByte(mName, mAt);
+        return {mAt, mLine};
+    }
+    /// A mark for messages: "NAME:LINE: " (ASCII) or "NAME: byte N: " (binary).
+    std::string place(Mark m) const {
+        return mFormat == PlyFormat::Ascii ? atLine(mName, m.line) : atByte(mName, m.at);
     }
     /// The next value; nullopt at the end of the file. Throws for text that is not a number.
     std::optional<double> next(PlyType t) {
@@ -603,11 +612,11 @@ void checkPly(std::string_view bytes, const std::string& name) {
         const std::string_view line = bytes.substr(at, end - at);
         at = end + 1;
         ++lineNo;
-        const std::string place = atLine(name, lineNo);
+        const auto place = [&] { return atLine(name, lineNo); };
         tokens(line, tok);
         if (lineNo == 1) {
             if (tok.size() != 1 || tok[0] != "ply") {
-                fail(place + "not a PLY file (the first line must be 'ply')");
+                fail(place() + "not a PLY file (the first line must be 'ply')");
             }
             continue;
         }
@@ -616,7 +625,8 @@ void checkPly(std::string_view bytes, const std::string& name) {
         }
         if (tok[0] == "format") {
             if (tok.size() != 3 || tok[2] != "1.0") {
-                fail(place + "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+                fail(place() +
+                     "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
             }
             if (tok[1] == "ascii") {
                 format = PlyFormat::Ascii;
@@ -625,35 +635,35 @@ void checkPly(std::string_view bytes, const std::string& name) {
             } else if (tok[1] == "binary_big_endian") {
                 format = PlyFormat::Big;
             } else {
-                fail(place + "unknown PLY format " + quoted(tok[1]));
+                fail(place() + "unknown PLY format " + quoted(tok[1]));
             }
         } else if (tok[0] == "element") {
             const auto count = tok.size() == 3 ? parseInteger(tok[2]) : std::nullopt;
             if (!count || *count < 0) {
-                fail(place + "expected 'element NAME COUNT'");
+                fail(place() + "expected 'element NAME COUNT'");
             }
             elements.push_back({std::string(tok[1]), static_cast<std::uint64_t>(*count), {}});
         } else if (tok[0] == "property") {
             if (elements.empty()) {
-                fail(place + "a property before any element");
+                fail(place() + "a property before any element");
             }
             PlyProperty p;
             const bool list = tok.size() == 5 && tok[1] == "list";
             if (!list && tok.size() != 3) {
-                fail(place + "expected 'property TYPE NAME' or 'property list COUNT_TYPE "
-                             "ITEM_TYPE NAME'");
+                fail(place() + "expected 'property TYPE NAME' or 'property list COUNT_TYPE "
+                               "ITEM_TYPE NAME'");
             }
             const auto count = list ? plyType(tok[2]) : std::optional<PlyType>(PlyType::U8);
             const auto type = plyType(tok[list ? 3 : 1]);
             if (!count || !type || (list && plyIsFloat(*count))) {
-                fail(place + "unknown property type in " + quoted(line));
+                fail(place() + "unknown property type in " + quoted(line));
             }
             elements.back().properties.push_back(
                 {std::string(tok[list ? 4 : 2]), list, *count, *type});
         } else if (tok[0] == "end_header") {
             ended = true;
         } else {
-            fail(place + "unknown PLY header line " + quoted(line));
+            fail(place() + "unknown PLY header line " + quoted(line));
         }
     }
     if (!format) {
@@ -713,13 +723,14 @@ void checkPly(std::string_view bytes, const std::string& name) {
     std::uint64_t triangles = 0;
     for (const PlyElement& e : elements) {
         for (std::uint64_t i = 0; i < e.count; ++i) {
-            const std::string what = e.name + " element " + std::to_string(i);
+            const auto what = [&] { return e.name + " element " + std::to_string(i); };
             for (std::size_t k = 0; k < e.properties.size(); ++k) {
                 const PlyProperty& p = e.properties[k];
-                std::string place = r.place();
+                auto mark = r.mark();
+                const auto place = [&] { return r.place(mark); };
                 const auto value = r.next(p.list ? p.countType : p.type);
                 const auto truncated = [&] {
-                    fail(place + "the file ends inside " + what + ", but the header declares " +
+                    fail(place() + "the file ends inside " + what() + ", but the header declares " +
                          std::to_string(e.count) + " " + e.name + " elements");
                 };
                 if (!value) {
@@ -730,28 +741,28 @@ void checkPly(std::string_view bytes, const std::string& name) {
                         (static_cast<int>(k) == xyz[0] || static_cast<int>(k) == xyz[1] ||
                          static_cast<int>(k) == xyz[2])) {
                         if (!std::isfinite(*value)) {
-                            fail(place + what + ": " + p.name + " is not finite");
+                            fail(place() + what() + ": " + p.name + " is not finite");
                         }
                     }
                     continue;
                 }
                 const double n = *value;
                 if (n < 0) {
-                    fail(place + what + ": a negative list length");
+                    fail(place() + what() + ": a negative list length");
                 }
                 const bool isIndices = &e == face && static_cast<int>(k) == indices;
                 if (isIndices && n < 3) {
-                    fail(place + what + ": a face needs at least 3 vertices, got " +
+                    fail(place() + what() + ": a face needs at least 3 vertices, got " +
                          std::to_string(static_cast<long long>(n)));
                 }
                 for (std::uint64_t j = 0; j < static_cast<std::uint64_t>(n); ++j) {
-                    place = r.place();
+                    mark = r.mark();
                     const auto item = r.next(p.type);
                     if (!item) {
                         truncated();
                     }
                     if (isIndices && !(*item >= 0 && *item < static_cast<double>(vertex->count))) {
-                        fail(place + what + ": vertex index " +
+                        fail(place() + what() + ": vertex index " +
                              std::to_string(static_cast<long long>(*item)) +
                              " is out of range (the file has " + std::to_string(vertex->count) +
                              " vertices)");
@@ -765,7 +776,7 @@ void checkPly(std::string_view bytes, const std::string& name) {
         }
     }
     if (!r.atEnd()) {
-        fail(r.place() + "data after the last element the header declares (" +
+        fail(r.place(r.mark()) + "data after the last element the header declares (" +
              std::to_string(face->count) + " faces, " + std::to_string(vertex->count) +
              " vertices)");
     }

@@ -15,8 +15,10 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <span>
 #include <sstream>
+#include <tuple>
 
 namespace hapto {
 namespace {
@@ -30,11 +32,68 @@ struct LoadContext {
     std::filesystem::path baseDir;
     std::map<std::pair<std::string, double>, std::shared_ptr<const TriangleMesh>> models;
     std::int64_t version = 0;
+    /// The inline "vertices" (unscaled) and "triangles" of the object being read, converted
+    /// element by element as the parser completes them, so a large inline mesh never sits in
+    /// the parser's DOM. A triangle's index too large for 32 bits is kept as kFarIndex, and
+    /// the first such is remembered (triangle, corner, value) for its message.
+    std::vector<Vec3> vertices;
+    std::vector<TriangleIndices> triangles;
+    std::optional<std::tuple<std::size_t, std::size_t, std::int64_t>> farIndex;
+    static constexpr std::uint32_t kFarIndex = 0xFFFFFFFFu; // > TriangleMesh::kMaxVertices
+
+    void startObject() {
+        vertices.clear();
+        triangles.clear();
+        farIndex.reset();
+    }
 };
 
-/// An inline mesh: "vertices" [[x,y,z],...] (times `scale`) and "triangles" [[i,j,k],...].
-std::shared_ptr<const TriangleMesh> parseInlineMesh(const Source& w, const Json& j,
-                                                    const Path& path, double scale) {
+/// One element of an inline "vertices" array. [control]
+void streamVertex(const Source& w, const Json& j, const Path& vp, LoadContext& c) {
+    if (c.vertices.size() >= TriangleMesh::kMaxVertices) {
+        w.fail(vp, "more than " + std::to_string(TriangleMesh::kMaxVertices) +
+                       " vertices; a mesh may have at most that many");
+    }
+    c.vertices.push_back(vec3(w, j, vp[c.vertices.size()]));
+}
+
+/// One element of an inline "triangles" array; the index range is checked once the vertices
+/// are known (parseInlineMesh). [control]
+void streamTriangle(const Source& w, const Json& t, const Path& tp, LoadContext& c) {
+    const std::size_t i = c.triangles.size();
+    if (i >= TriangleMesh::kMaxTriangles) {
+        w.fail(tp, "more than " + std::to_string(TriangleMesh::kMaxTriangles) +
+                       " triangles; a mesh may have at most that many");
+    }
+    if (!t.is_array() || t.size() != 3) {
+        w.fail(tp[i], "expected [i, j, k], three vertex indices, got " +
+                          (t.is_array() ? "an array of " + std::to_string(t.size()) : typeName(t)));
+    }
+    TriangleIndices tri{};
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!t[k].is_number_integer()) {
+            w.fail(tp[i][k], "expected a vertex index (a whole number), got " + describe(t[k]));
+        }
+        const std::int64_t index = t[k].is_number_unsigned()
+                                       ? static_cast<std::int64_t>(std::min<std::uint64_t>(
+                                             t[k].get<std::uint64_t>(), std::uint64_t(1) << 62))
+                                       : t[k].get<std::int64_t>();
+        if (index < 0 || index >= static_cast<std::int64_t>(LoadContext::kFarIndex)) {
+            if (!c.farIndex) {
+                c.farIndex.emplace(i, k, index);
+            }
+            tri[k] = LoadContext::kFarIndex;
+        } else {
+            tri[k] = static_cast<std::uint32_t>(index);
+        }
+    }
+    c.triangles.push_back(tri);
+}
+
+/// An inline mesh: "vertices" [[x,y,z],...] (times `scale`) and "triangles" [[i,j,k],...],
+/// their elements already converted into `c` by parseScene's callback. [control]
+std::shared_ptr<const TriangleMesh>
+parseInlineMesh(const Source& w, const Json& j, const Path& path, double scale, LoadContext& c) {
     const Path vp = path / "vertices";
     const Path tp = path / "triangles";
     const Json& vj = required(w, j, path, "vertices");
@@ -45,54 +104,30 @@ std::shared_ptr<const TriangleMesh> parseInlineMesh(const Source& w, const Json&
     if (!tj.is_array()) {
         w.fail(tp, "expected an array of [i, j, k], got " + typeName(tj));
     }
-    if (vj.size() > TriangleMesh::kMaxVertices) {
-        w.fail(vp, std::to_string(vj.size()) + " vertices; a mesh may have at most " +
-                       std::to_string(TriangleMesh::kMaxVertices));
-    }
-    if (tj.size() > TriangleMesh::kMaxTriangles) {
-        w.fail(tp, std::to_string(tj.size()) + " triangles; a mesh may have at most " +
-                       std::to_string(TriangleMesh::kMaxTriangles));
-    }
-    std::vector<Vec3> vertices;
-    vertices.reserve(vj.size());
-    for (std::size_t i = 0; i < vj.size(); ++i) {
-        const Vec3 v = vec3(w, vj[i], vp[i]);
-        const Vec3 scaled = v * scale;
+    std::vector<Vec3> vertices = std::move(c.vertices);
+    std::vector<TriangleIndices> triangles = std::move(c.triangles);
+    c.startObject();
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const Vec3 scaled = vertices[i] * scale;
         if (!finite(scaled)) {
             w.fail(vp[i], "the vertex times the scale " + show(scale) + " is not finite");
         }
-        vertices.push_back(scaled);
+        vertices[i] = scaled;
     }
-    std::vector<TriangleIndices> triangles;
-    triangles.reserve(tj.size());
-    const auto count = static_cast<std::int64_t>(vertices.size());
-    for (std::size_t i = 0; i < tj.size(); ++i) {
-        const Json& t = tj[i];
-        if (!t.is_array() || t.size() != 3) {
-            w.fail(tp[i],
-                   "expected [i, j, k], three vertex indices, got " +
-                       (t.is_array() ? "an array of " + std::to_string(t.size()) : typeName(t)));
-        }
-        TriangleIndices tri{};
+    const std::size_t count = vertices.size();
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
         for (std::size_t k = 0; k < 3; ++k) {
-            if (!t[k].is_number_integer()) {
-                w.fail(tp[i][k], "expected a vertex index (a whole number), got " + describe(t[k]));
-            }
-            const std::int64_t index = t[k].is_number_unsigned()
-                                           ? static_cast<std::int64_t>(std::min<std::uint64_t>(
-                                                 t[k].get<std::uint64_t>(), std::uint64_t(1) << 62))
-                                           : t[k].get<std::int64_t>();
-            if (index < 0 || index >= count) {
-                w.fail(tp[i][k], "vertex index " + std::to_string(index) +
+            if (triangles[i][k] >= count) {
+                const bool far = triangles[i][k] == LoadContext::kFarIndex;
+                const std::int64_t value = far ? std::get<2>(*c.farIndex) : triangles[i][k];
+                w.fail(tp[i][k], "vertex index " + std::to_string(value) +
                                      " is out of range (the mesh has " + std::to_string(count) +
                                      " vertices)");
             }
-            tri[k] = static_cast<std::uint32_t>(index);
         }
-        triangles.push_back(tri);
     }
-    // make() names the element of what it refuses (triangles[i] for an index, "no triangles
-    // left" when all are degenerate) after the file and the object.
+    // make() names the element of what it refuses ("no triangles left" when all are
+    // degenerate) after the file and the object.
     return TriangleMesh::make(std::move(vertices), std::move(triangles), MeshSource{"", scale},
                               std::string(w.name()) + ": " + path.str());
 }
@@ -175,7 +210,7 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
                                    "\"triangles\"");
         }
         o.mesh = hasFile ? parseFileMesh(w, j, path, scale, context)
-                         : parseInlineMesh(w, j, path, scale);
+                         : parseInlineMesh(w, j, path, scale, context);
         o.halfExtents = o.mesh->localBounds().halfExtents();
     } else {
         w.fail(path / "shape",
@@ -322,20 +357,39 @@ Scene parseScene(std::string_view text, std::string_view sourceName,
     std::vector<SceneObject> objects;
     std::string topKey;
     bool inObjects = false;
-    LoadContext context{baseDir, {}, 0};
+    LoadContext context;
+    context.baseDir = baseDir;
 
     // Depth 0 is the top-level object; its keys are reported at depth 1, and elements of the
     // "objects" array end at depth 2: each is converted as soon as it is complete, then dropped.
+    // Inside an element of "objects", its keys are reported at depth 3, and the elements of
+    // its "vertices" or "triangles" array end at depth 4: each is converted into the context
+    // and dropped too (`objectKey` names the element's array being read, "" outside one).
+    std::string objectKey;
+    bool inMeshArray = false;
     auto callback = [&](int depth, Json::parse_event_t event, Json& parsed) -> bool {
         switch (event) {
         case Json::parse_event_t::key:
             if (depth == 1) {
                 topKey = parsed.get<std::string>();
+            } else if (depth == 3 && inObjects) {
+                objectKey = parsed.get<std::string>();
+            }
+            return true;
+        case Json::parse_event_t::object_start:
+            if (inObjects && depth == 2) {
+                context.startObject();
+                objectKey.clear();
             }
             return true;
         case Json::parse_event_t::array_start:
             if (depth == 1 && topKey == "objects") {
                 inObjects = true;
+            } else if (inObjects && depth == 2) {
+                context.startObject();
+                objectKey.clear();
+            } else if (inObjects && depth == 3) {
+                inMeshArray = objectKey == "vertices" || objectKey == "triangles";
             }
             return true;
         case Json::parse_event_t::array_end:
@@ -343,9 +397,22 @@ Scene parseScene(std::string_view text, std::string_view sourceName,
                 inObjects = false;
                 return true;
             }
+            if (depth == 3) {
+                inMeshArray = false;
+                return true;
+            }
             [[fallthrough]]; // an array as an element of "objects": refused by parseObject
         case Json::parse_event_t::object_end:
         case Json::parse_event_t::value:
+            if (inObjects && depth == 4 && inMeshArray) {
+                const Path element = objectsPath[objects.size()];
+                if (objectKey == "vertices") {
+                    streamVertex(w, parsed, element / "vertices", context);
+                } else {
+                    streamTriangle(w, parsed, element / "triangles", context);
+                }
+                return false;
+            }
             if (inObjects && depth == 2) {
                 objects.push_back(parseObject(w, parsed, objectsPath[objects.size()], context));
                 return false;

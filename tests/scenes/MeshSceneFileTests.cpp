@@ -95,6 +95,31 @@ TEST_CASE("an inline mesh is placed by its scale, rotation and centre") {
     }
 }
 
+TEST_CASE("inline arrays stream in any field order, and each object gets its own") {
+    // Triangles before vertices, scale last; then a second mesh and a box: nothing of the
+    // first mesh's arrays may leak into the next object.
+    const Scene s = parseScene(
+        scene2(R"({"id": 0, "shape": "mesh", "triangles": [[0,2,1], [0,1,3], [0,3,2], [1,2,3]],
+                   "vertices": [[0,0,0], [1,0,0], [0,1,0], [0,0,1]], "center": [0,0,0],
+                   "scale": 3},
+                  {"id": 1, "shape": "mesh", "center": [5,0,0],
+                   "vertices": [[0,0,0], [1,0,0], [0,1,0]], "triangles": [[0,1,2]]},
+                  {"id": 2, "shape": "box", "center": [0,5,0], "half_extents": [1,1,1]})"),
+        "order.json");
+    REQUIRE(s.size() == 3);
+    CHECK(s.object(0).mesh->triangleCount() == 4);
+    CHECK(s.object(0).mesh->vertices()[3] == Vec3(0, 0, 3));
+    CHECK(s.object(1).mesh->triangleCount() == 1);
+    CHECK(s.object(1).mesh->vertices().size() == 3);
+    CHECK_FALSE(s.object(1).mesh->closed());
+    CHECK(s.triangleCount() == 5);
+    // An index beyond 32 bits is named with its own value.
+    CHECK_THAT(errorOf(scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0],
+                   "triangles": [[0,1,2],[0,99999999999,1]], "vertices": [[0,0,0],[1,0,0],[0,1,0]]})")),
+               Catch::Contains("objects[0].triangles[1][1]: vertex index 99999999999 is out of "
+                               "range (the mesh has 3 vertices)"));
+}
+
 TEST_CASE("a mesh from a model file is read relative to the scene file, once per file") {
     test::TempDir dir;
     std::filesystem::create_directories(dir / "scenes/models");
