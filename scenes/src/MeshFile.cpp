@@ -2,13 +2,14 @@
 // regular file of bounded size, never a FIFO or a folder) and read whole; its bytes are checked
 // for what assimp misses (MeshFileChecks.cpp) and then handed to assimp from memory, so the
 // bytes checked are the bytes read. assimp runs with the least post-processing that gives
-// triangles: Triangulate (polygons to triangles), JoinIdenticalVertices (one vertex per
-// position and attributes within each of its meshes) and ValidateDataStructure (a last net for
+// triangles: Triangulate (polygons to triangles) and ValidateDataStructure (a last net for
 // indices out of range). Its meshes are then gathered through the node tree (with the node
-// transforms) into one mesh, and vertices at exactly the same position are merged across
-// meshes and attributes too: JoinIdenticalVertices keeps a corner apart when its normals or
-// texture coordinates differ, and the renderer needs triangles that share an edge to share its
-// vertex indices.
+// transforms) into one mesh, and vertices at exactly the same position are merged (weld(): one
+// sort), so triangles that share an edge share its vertex indices, as the renderer needs.
+// assimp's own JoinIdenticalVertices is not used: it merges only within one of its meshes and
+// only corners whose normals and texture coordinates agree too (so weld() is needed anyway),
+// and on a 10^6-triangle binary STL it took 2.2 s of a 3 s load and 450 MB of its 720 MB peak
+// (assimp 5.2.5, this machine; see docs/DESIGN.md).
 
 #include "hapto/scenes/MeshFile.h"
 
@@ -153,8 +154,7 @@ std::shared_ptr<const TriangleMesh> loadMeshFile(const std::filesystem::path& pa
 
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFileFromMemory(
-        bytes.data(), bytes.size(),
-        aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure,
+        bytes.data(), bytes.size(), aiProcess_Triangulate | aiProcess_ValidateDataStructure,
         hintOf(*format));
     if (!scene || !scene->mRootNode) {
         throw InputError(name + ": the " + hintOf(*format) +
