@@ -1,6 +1,6 @@
 // The checks made on model files before assimp reads them. Design note: assimp 5.2.5 validates
-// little of what it reads (see docs/DESIGN.md, "Meshes"): it keeps NaN vertices (and
-// JoinIdenticalVertices then merges them with unrelated ones), reads PLY face indices past the
+// little of what it reads (see docs/DESIGN.md, "Model files"): it keeps NaN vertices (and
+// its JoinIdenticalVertices merges them with unrelated ones), reads PLY face indices past the
 // vertex array and crashes on a truncated binary PLY, cuts an STL facet of four vertices to a
 // triangle, and names no line or byte in the errors it does find. So each format is walked
 // once here, cheaply and without building anything, and the first bad thing is refused with its
