@@ -500,19 +500,42 @@ public:
     /// Where the next value starts (cheap: no text is made until a message needs it).
     Mark mark() {
         if (mFormat == PlyFormat::Ascii) {
-            skipSpace();
+            skipBlanks();
         }
         return {mAt, mLine};
+    }
+    /// Moves to the next element: in ASCII, one element is one line (assimp's reader is
+    /// line-based, and misreads, then aborts on, an element split over lines).
+    void beginElement() {
+        if (mFormat == PlyFormat::Ascii) {
+            skipSpace();
+        }
+    }
+    /// True when an ASCII element's line has ended (next() returned nullopt before the end of
+    /// the file).
+    bool atLineEnd() const {
+        return mFormat == PlyFormat::Ascii && mAt < mBytes.size() && mBytes[mAt] == '\n';
+    }
+    /// Refuses values left on an ASCII element's line. `what` names the element.
+    template <class What> void endElement(const What& what) {
+        if (mFormat == PlyFormat::Ascii) {
+            skipBlanks();
+            if (mAt < mBytes.size() && mBytes[mAt] != '\n') {
+                fail(atLine(mName, mLine) + "more values on the line of " + what() +
+                     " than its properties (an ASCII PLY element is one line)");
+            }
+        }
     }
     /// A mark for messages: "NAME:LINE: " (ASCII) or "NAME: byte N: " (binary).
     std::string place(Mark m) const {
         return mFormat == PlyFormat::Ascii ? atLine(mName, m.line) : atByte(mName, m.at);
     }
-    /// The next value; nullopt at the end of the file. Throws for text that is not a number.
+    /// The next value; nullopt at the end of the file (or, in ASCII, of the element's line).
+    /// Throws for text that is not a number.
     std::optional<double> next(PlyType t) {
         if (mFormat == PlyFormat::Ascii) {
-            skipSpace();
-            if (mAt >= mBytes.size()) {
+            skipBlanks();
+            if (mAt >= mBytes.size() || mBytes[mAt] == '\n') {
                 return std::nullopt;
             }
             const std::size_t start = mAt;
@@ -576,6 +599,11 @@ private:
     static std::optional<double> parseIntegerAsDouble(std::string_view t) {
         const auto i = parseInteger(t);
         return i ? std::optional<double>(static_cast<double>(*i)) : std::nullopt;
+    }
+    void skipBlanks() {
+        while (mAt < mBytes.size() && isSpace(mBytes[mAt])) {
+            ++mAt;
+        }
     }
     void skipSpace() {
         while (mAt < mBytes.size() && (isSpace(mBytes[mAt]) || mBytes[mAt] == '\n')) {
@@ -724,12 +752,18 @@ void checkPly(std::string_view bytes, const std::string& name) {
     for (const PlyElement& e : elements) {
         for (std::uint64_t i = 0; i < e.count; ++i) {
             const auto what = [&] { return e.name + " element " + std::to_string(i); };
+            r.beginElement();
             for (std::size_t k = 0; k < e.properties.size(); ++k) {
                 const PlyProperty& p = e.properties[k];
                 auto mark = r.mark();
                 const auto place = [&] { return r.place(mark); };
                 const auto value = r.next(p.list ? p.countType : p.type);
                 const auto truncated = [&] {
+                    if (r.atLineEnd()) {
+                        fail(place() + "the line ends inside " + what() +
+                             " (an ASCII PLY element is one line, with a value for each of its "
+                             "properties)");
+                    }
                     fail(place() + "the file ends inside " + what() + ", but the header declares " +
                          std::to_string(e.count) + " " + e.name + " elements");
                 };
@@ -773,6 +807,7 @@ void checkPly(std::string_view bytes, const std::string& name) {
                     checkTriangleLimit(triangles, name);
                 }
             }
+            r.endElement(what);
         }
     }
     if (!r.atEnd()) {

@@ -285,6 +285,16 @@ TEST_CASE("bad model files are refused with the file and the place") {
          "more than 16777216 triangles; a mesh may have at most 16777216"},
         {"trailing.ply", asciiPly(kTet, kTetFaces) + "3 0 1 2\n",
          ":19: data after the last element the header declares"},
+        // One element split over two lines: assimp's line-based reader misread it and then
+        // aborted (an ai_assert in its Triangulate step), found by mutating a valid file.
+        {"split.ply",
+         plyHeader("ascii", 4, 4) +
+             "0 0 0\n1 0\n0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+         ":12: the line ends inside vertex element 1 (an ASCII PLY element is one line"},
+        {"long-line.ply",
+         plyHeader("ascii", 4, 4) +
+             "0 0 0 5\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+         ":11: more values on the line of vertex element 0 than its properties"},
         {"noface.ply",
          "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty "
          "float y\nproperty float z\nend_header\n0 0 0\n",
