@@ -9,6 +9,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <string>
 
@@ -273,4 +275,21 @@ TEST_CASE("bad mesh objects are refused with the file, the JSON path and the pla
         INFO(c.name);
         CHECK_THAT(errorOf(c.text, dir.path()), Catch::Contains(c.expected));
     }
+}
+
+TEST_CASE("the README's inline mesh loads, and the README shows it as tested") {
+    const std::string object =
+        R"({"id": 1, "shape": "mesh", "center": [0.05, 0, 0], "rotation": [1, 0, 0, 0], "scale": 0.01,
+   "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+   "triangles": [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]})";
+    const Scene s = parseScene(scene2(object), "readme.json");
+    REQUIRE(s.size() == 1);
+    CHECK(s.object(0).mesh->triangleCount() == 4);
+    CHECK(s.object(0).mesh->closed());
+    const auto squash = [](std::string t) {
+        t.erase(std::remove_if(t.begin(), t.end(), ::isspace), t.end());
+        return t;
+    };
+    const std::string readme = test::readFile(std::string(HAPTO_SOURCE_DIR) + "/README.md");
+    CHECK(squash(readme).find(squash(object)) != std::string::npos);
 }
