@@ -434,6 +434,7 @@ TEST_CASE("sim: a scripted stylus reports its orientation turning at the given r
     CHECK_FALSE(fresh.hasOrientation);
     CHECK_FALSE(fresh.hasAngularVelocity);
     CHECK(fresh.orientation == Quat{1, 0, 0, 0});
+}
 
 TEST_CASE("sim touch and slide on a mesh: pressed where its triangles are, not its bounding box") {
     // A wavy sheet through the origin, heights within +-1 cm: its bounding box's top face is
