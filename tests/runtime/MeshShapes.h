@@ -55,6 +55,29 @@ inline std::shared_ptr<const TriangleMesh> cornerMesh(double s) {
     return TriangleMesh::make(std::move(v), std::move(t), {}, "corner");
 }
 
+/// A closed L-shaped prism: the L (0,0) (2a,0) (2a,a) (a,a) (a,2a) (0,2a) in the local x-y
+/// plane, extruded over z in [-d, d]. Its inner corner is a concave edge.
+inline std::shared_ptr<const TriangleMesh> lPrismMesh(double a, double d) {
+    const double xy[6][2] = {{0, 0}, {2 * a, 0}, {2 * a, a}, {a, a}, {a, 2 * a}, {0, 2 * a}};
+    std::vector<Vec3> v;
+    for (const double z : {-d, d}) {
+        for (const auto& p : xy) {
+            v.emplace_back(p[0], p[1], z);
+        }
+    }
+    std::vector<TriangleIndices> t;
+    for (std::uint32_t i = 1; i + 1 < 6; ++i) { // the L is star-shaped from (0, 0): two fans
+        t.push_back({0, i + 1, i});             // bottom (z = -d), facing -z
+        t.push_back({6, 6 + i, 6 + i + 1});     // top (z = d), facing +z
+    }
+    for (std::uint32_t i = 0; i < 6; ++i) { // the sides, facing out of the counter-clockwise L
+        const std::uint32_t j = (i + 1) % 6;
+        t.push_back({i, j, 6 + j});
+        t.push_back({i, 6 + j, 6 + i});
+    }
+    return TriangleMesh::make(std::move(v), std::move(t), {}, "L prism");
+}
+
 /// A torus about the local z axis (it stands in the x-y plane): ring radius `ring`, tube
 /// radius `tube`, `around` x `across` quads split in two.
 inline std::shared_ptr<const TriangleMesh> torusMesh(double ring, double tube, std::uint32_t around,
