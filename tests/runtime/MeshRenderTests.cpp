@@ -222,6 +222,22 @@ TEST_CASE("a concave corner holds two and three planes") {
     }
 }
 
+TEST_CASE("the crease between two separate meshes holds both planes") {
+    // A floor square (id 1) and a wall square (id 2) standing on it along x = 0, facing +x.
+    const Rig rig(
+        {makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), material(kK)),
+         makeMesh(2, Vec3(0.0, 0.05, 0.0), squareMesh(0.05),
+                  glm::angleAxis(-0.5 * glm::pi<double>(), Vec3(0, 0, 1)), material(kK))});
+    const Vec3 goal(-0.002, -0.003, 0.01);
+    const auto outs =
+        follow(rig.scene, rig.byItems(), polyline({Vec3(0.02, 0.02, 0.01), goal}, 100));
+    const RenderOutput& o = outs.back();
+    REQUIRE(o.contactCount == 2);
+    CHECK(o.contacts[0].id != o.contacts[1].id);
+    CHECK(glm::length(o.proxy - Vec3(kSkin, kSkin, 0.01)) <= 1e-12);
+    CHECK(glm::length(o.force - kK * (Vec3(kSkin, kSkin, 0.01) - goal)) <= kSameN);
+}
+
 TEST_CASE("an open mesh is one-sided: from behind the device passes, from the front it is held") {
     const Rig rig({makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), material(kK))});
     // Up through the square from below, then back down onto it from above.
