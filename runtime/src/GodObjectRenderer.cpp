@@ -346,19 +346,10 @@ std::uint32_t firstTriangleItem(const Scene& scene, std::uint32_t slot) {
 }
 
 /// Visits (calls fn(t) for) every triangle of `mesh` whose local bounds meet `localBox` (m,
-/// mesh frame), without allocating. A linear visit, to be replaced by the mesh's own
-/// local-frame index (TriangleMesh::forEachTriangleNear) when it lands: this is the one line
-/// to swap.
+/// mesh frame), without allocating: the mesh's own local-frame BVH, built once with the mesh.
 template <class Fn>
 void visitMeshTrianglesNear(const TriangleMesh& mesh, const Aabb& localBox, Fn&& fn) {
-    const std::uint32_t n = mesh.triangleCount();
-    for (std::uint32_t t = 0; t < n; ++t) {
-        const std::array<Vec3, 3> c = mesh.corners(t);
-        const Aabb box{glm::min(glm::min(c[0], c[1]), c[2]), glm::max(glm::max(c[0], c[1]), c[2])};
-        if (box.overlaps(localBox)) {
-            fn(t);
-        }
-    }
+    mesh.forEachTriangleNear(localBox, std::forward<Fn>(fn));
 }
 
 /// Distance (m) from p to an item's skin, 0 inside. A triangle's skin, like a box face's: the
