@@ -132,6 +132,9 @@ function showDevice(dev, f, touched) {
     for (const id of f.contacts || []) touched.add(id);
     field(dev, 'contacts', (f.contacts || []).length ? 'touching ' + f.contacts.join(', ') : '');
   }
+  if (dev.row.dataset.firstTicks === undefined) {
+    dev.row.dataset.firstTicks = String(f.ticks); // what the page first showed, for its test
+  }
   field(dev, 'ticks', String(f.ticks));
   field(dev, 'misses', String(f.misses));
   field(dev, 'loadP50', (100 * f.loadP50).toFixed(2));
@@ -179,6 +182,7 @@ function showFrame(frame, devices) {
   view.frames++;
   const status = document.getElementById('status');
   status.dataset.frames = String(view.frames);
+  if (status.dataset.firstT === undefined) status.dataset.firstT = String(frame.t);
   status.dataset.t = String(frame.t);
 }
 
