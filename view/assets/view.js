@@ -130,7 +130,7 @@ function showDevice(dev, f, touched) {
     }
     field(dev, 'forceN', n.toFixed(2));
     for (const id of f.contacts || []) touched.add(id);
-    field(dev, 'contacts', (f.contacts || []).length ? 'touching ' + f.contacts.join(', ') : '');
+    field(dev, 'contacts', (f.contacts || []).length ? 'touching #' + f.contacts.join(', #') : '');
   }
   if (dev.row.dataset.firstTicks === undefined) {
     dev.row.dataset.firstTicks = String(f.ticks); // what the page first showed, for its test
@@ -190,7 +190,8 @@ function followLive() {
   const status = document.getElementById('status');
   const source = new EventSource('/stream');
   source.onopen = () => { status.textContent = 'live'; };
-  source.onerror = () => { status.textContent = 'disconnected'; };
+  // The stream ends with the session; EventSource keeps trying to reconnect.
+  source.onerror = () => { status.textContent = view.frames ? 'stream closed' : 'connecting'; };
   source.onmessage = (e) => { const frame = JSON.parse(e.data); showFrame(frame, frame.devices); };
 }
 
