@@ -51,6 +51,8 @@ TEST_CASE("a live frame carries each device's ticks, misses, load, point, force 
         // The window covers the whole run so far: the report's quantiles (bucket bounds).
         CHECK(d["loadP50"].get<double>() >= r.loadFraction.p50 - 1e-12);
         CHECK(d["loadP50"].get<double>() <= r.loadFraction.p50 * 1.04 + 1e-12);
+        // The first frame's second reaches back to the start: the report's mean.
+        CHECK(d["candidates"].get<double>() == Approx(r.candidatesMean));
         ContactReport c;
         REQUIRE(runtime.contact(i, c));
         CHECK(d["point"] ==

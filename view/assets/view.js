@@ -98,7 +98,8 @@ function makeDevice(world, d, i) {
     '|F| <span data-field="forceN">-</span> N &middot; ticks <span data-field="ticks">0</span>' +
     ' &middot; misses <span data-field="misses">0</span><br>' +
     'load p50 <span data-field="loadP50">-</span> % &middot; p99.9 ' +
-    '<span data-field="loadP999">-</span> % <span data-field="contacts"></span>' +
+    '<span data-field="loadP999">-</span> % &middot; candidates/tick ' +
+    '<span data-field="candidates">-</span> <span data-field="contacts"></span>' +
     '<canvas width="254" height="56"></canvas>';
   row.querySelector('.name').textContent = d.name;
   row.querySelector('.name').style.color = '#' + color.toString(16).padStart(6, '0');
@@ -139,6 +140,7 @@ function showDevice(dev, f, touched) {
   field(dev, 'misses', String(f.misses));
   field(dev, 'loadP50', (100 * f.loadP50).toFixed(2));
   field(dev, 'loadP999', (100 * f.loadP999).toFixed(2));
+  if (f.candidates !== undefined) field(dev, 'candidates', f.candidates.toFixed(1));
   if (f.verdict !== undefined) {
     const v = dev.row.querySelector('[data-field="verdict"]');
     v.textContent = f.verdict;

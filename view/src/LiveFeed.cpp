@@ -27,6 +27,7 @@ LiveFeed::LiveFeed(const Runtime& runtime, ViewServer& server, double frameHz)
         mDevices.push_back({d.name, d.rateHz});
         // One second of copies at the frame rate, plus slack for a late frame.
         mWindows.emplace_back(1e9 / d.rateHz, 1'000'000'000, static_cast<std::size_t>(frameHz) + 2);
+        mSums.push_back({{0, 0, 0}}); // the session's start: nothing yet
     }
 }
 
@@ -77,6 +78,18 @@ std::string LiveFeed::frame(std::uint64_t sessionNs) {
         const WindowLoad load = mWindows[i].sample(m.tickNs, sessionNs);
         const std::uint64_t ticks = m.ticks.load(std::memory_order_relaxed);
         const std::uint64_t misses = m.missedDeadlines.load(std::memory_order_relaxed);
+        // Candidates per tick over the same second: two sums about a second apart.
+        std::deque<Sums>& sums = mSums[i];
+        sums.push_back({sessionNs, ticks, m.candidatesSum.load(std::memory_order_relaxed)});
+        while (sums.size() > 2 && sessionNs - sums[1].timeNs >= 1'000'000'000) {
+            sums.pop_front();
+        }
+        const std::uint64_t windowTicks = ticks - sums.front().ticks;
+        const double candidates =
+            windowTicks > 0
+                ? static_cast<double>(sums.back().candidates - sums.front().candidates) /
+                      static_cast<double>(windowTicks)
+                : 0.0;
         const FaultKind fault = m.fault.load(std::memory_order_relaxed);
         const double periodNs = 1e9 / mDevices[i].rateHz;
         const bool stable = fault == FaultKind::None && m.tickNs.summary().p999 / periodNs < 1.0 &&
@@ -87,6 +100,7 @@ std::string LiveFeed::frame(std::uint64_t sessionNs) {
                          {"loadP50", load.p50},
                          {"loadP999", load.p999},
                          {"windowS", load.spanS},
+                         {"candidates", candidates},
                          {"verdict", fault != FaultKind::None
                                          ? std::string("FAULT ") + faultName(fault)
                                      : stable ? "stable"

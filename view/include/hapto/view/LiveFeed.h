@@ -11,6 +11,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <string>
@@ -26,7 +27,9 @@ namespace hapto {
 /// thread (World::current() is its to read): updatePoses() copies the moving objects' poses
 /// when the world's version changes, under a mutex the servo threads never see. Frames carry,
 /// per device: point, proxy, force (world frame, N), the objects in contact, ticks, misses,
-/// the load p50 / p99.9 over the last second and the verdict over the run so far (the
+/// the load p50 / p99.9 and the candidates per tick (objects handed to the renderer: the
+/// cursor leaves' and the moving ones) over the last second, and the verdict over the run so
+/// far (the
 /// report's rule: p99.9 load < 1, misses <= 0.1 % of ticks, no fault).
 class LiveFeed {
 public:
@@ -62,6 +65,10 @@ private:
     double mFrameHz;
     std::vector<ViewDevice> mDevices;
     std::vector<LoadWindow> mWindows; // per device, feed thread only
+    struct Sums {
+        std::uint64_t timeNs, ticks, candidates;
+    };
+    std::vector<std::deque<Sums>> mSums; // per device, about a second of frames; feed thread
 
     std::mutex mPoseMutex; // control thread writes, feed thread copies
     std::map<ObjectId, Pose> mPoses;
