@@ -10,9 +10,13 @@
 #include "hapto/runtime/Realtime.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
+#include "hapto/view/LiveFeed.h"
+#include "hapto/view/ViewServer.h"
 
 #include <catch2/catch.hpp>
+#include <httplib.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdlib>
@@ -283,4 +287,61 @@ TEST_CASE("the renderer makes no heap allocation with mesh candidates: triangle 
     CHECK(gServoAllocations.load() == before);
     CHECK(nearListFull > 0); // the fallback over the raw spans ran too
     CHECK(r.counters().ticks == 600);
+}
+
+TEST_CASE("servo threads make no heap allocation while a viewer follows the live view",
+          "[realtime]") {
+    const Scene scene = makeDefaultScene();
+    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    world.setRestDelay(std::chrono::milliseconds(5));
+    std::vector<RuntimeDevice> devices;
+    for (DeviceConfig c : defaultDeviceConfigs()) {
+        c.rateHz = 2000;
+        devices.push_back({makeDevice(c, scene), c, nullptr});
+    }
+    RuntimeOptions opt;
+    opt.realtime = false;
+    Runtime runtime(world, std::move(devices), opt);
+    ViewServer server;
+    LiveFeed feed(runtime, server);
+    server.setDocument("/scene.json", viewSceneJson(scene, feed.devices(), ViewMode::Live));
+    const int port = server.start();
+    const std::uint64_t servoBefore = gServoAllocations.load();
+    runtime.start();
+    feed.start();
+    // A viewer on its own thread, reading frames as the page's EventSource does.
+    std::atomic<int> frames{0};
+    std::atomic<bool> done{false};
+    std::thread viewer([&] {
+        httplib::Client client("127.0.0.1", port);
+        client.Get("/stream", [&](const char* data, std::size_t n) {
+            frames.fetch_add(static_cast<int>(std::count(data, data + n, '\n')) / 2);
+            return !done.load();
+        });
+    });
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    for (int i = 0; std::chrono::steady_clock::now() < until; ++i) {
+        if (frames.load() >= 10 && runtime.metrics(0).snapshotsSeen.load() >= 5 &&
+            runtime.metrics(1).snapshotsSeen.load() >= 5) {
+            break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        if (i % 10 == 0) {
+            world.moveObject(scene.object(0).id, scene.object(0).center + Vec3(0, 0.0001 * i, 0),
+                             Quat(1, 0, 0, 0));
+        }
+        runtime.maintain();
+        feed.updatePoses(world.current());
+    }
+    runtime.stop();
+    done = true;
+    feed.stop();
+    server.stop();
+    viewer.join();
+    CHECK(frames.load() >= 10);
+    for (const DeviceReport& d : runtime.report().devices) {
+        CHECK(d.ticks > 0);
+        CHECK(d.fault.empty());
+    }
+    CHECK(gServoAllocations.load() == servoBefore);
 }

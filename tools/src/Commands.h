@@ -51,6 +51,9 @@ void addSoakCommands(CLI::App& app);
 /// `hapto render`: one device point along a path through the haptic tick, as CSV. [control]
 void addRenderCommands(CLI::App& app);
 
+/// `hapto view`: the 3-D view over a recorded session, in the browser. [control]
+void addViewCommands(CLI::App& app);
+
 /// Loads `path`, or the embedded default scene when it is empty. Throws InputError. [control]
 Scene loadSceneOrDefault(const std::string& path);
 

@@ -1,6 +1,7 @@
 // `hapto demo grasp`: two simulated hands pick up, carry and put down an object.
 
 #include "Commands.h"
+#include "LiveView.h"
 #include "Options.h"
 #include "SessionChecks.h"
 #include "StopSignals.h"
@@ -35,6 +36,7 @@ struct DemoArgs {
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
     ObjectId object = 0;
     bool realtime = false;
+    ViewArgs view;
 };
 
 // Two simulated hands for the grasp scene: left starts at the -x side, right at the +x side,
@@ -94,6 +96,7 @@ int runDemo(const DemoArgs& a) {
     Runtime runtime(world, std::move(devices), options);
     GraspController grasp(world, runtime, 0, 1);
     signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
+    LiveView view(a.view, "hapto demo grasp", scene, runtime);
 
     const Vec3 startPosition = scene.object(*scene.slotOf(a.object)).center;
     std::printf(
@@ -107,6 +110,7 @@ int runDemo(const DemoArgs& a) {
             runtime.report().devices[1].fault);
     }
 
+    view.start();
     // Until both scripts are done (simulated hands) or 12 s, plus a second to settle.
     Felt felt[2];
     const auto t0 = std::chrono::steady_clock::now();
@@ -119,6 +123,7 @@ int runDemo(const DemoArgs& a) {
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         runtime.maintain();
         grasp.step(0.001);
+        view.update(world);
         if (grasp.state() != last) {
             const auto& p = grasp.path().back();
             std::printf("  %6.3f s  %-8s object at (%.3f, %.3f, %.3f) m\n", p.timeS,
@@ -149,6 +154,7 @@ int runDemo(const DemoArgs& a) {
         }
     }
     runtime.stop();
+    view.stop();
     world.setRestDelay(std::chrono::nanoseconds(0));
     world.settle();
 
@@ -246,6 +252,7 @@ void addDemoCommands(CLI::App& app) {
     addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--report", a->report, "Write a JSON report here");
     addRealtimeFlag(cmd, a->realtime, "default: do not, the demo shares the machine");
+    addViewOptions(cmd, a->view);
     cmd->callback([a] { runDemo(*a); });
 }
 

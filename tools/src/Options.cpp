@@ -2,6 +2,8 @@
 
 #include "Options.h"
 
+#include <arpa/inet.h>
+
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -85,6 +87,36 @@ CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes) {
                      "Most memory an index build may take (MB); a larger index is refused")
         ->capture_default_str()
         ->check(finiteRange(1, kMaxIndexMbOption));
+}
+
+CLI::Option* addViewBindOption(CLI::App* cmd, ViewArgs& args) {
+    return cmd
+        ->add_option("--view-bind", args.bindAddress,
+                     "Address the view listens on (default 127.0.0.1, this machine only; "
+                     "another address lets anyone who reaches it watch, read-only)")
+        ->check([](const std::string& text) -> std::string {
+            in6_addr any{};
+            if (inet_pton(AF_INET, text.c_str(), &any) == 1 ||
+                inet_pton(AF_INET6, text.c_str(), &any) == 1) {
+                return {};
+            }
+            return "'" + text + "' is not an IPv4 or IPv6 address";
+        });
+}
+
+void addViewOptions(CLI::App* cmd, ViewArgs& args) {
+    auto* view = cmd->add_option_function<int>(
+                        "--view",
+                        [&args](int port) {
+                            args.enabled = true;
+                            args.port = port;
+                        },
+                        "Serve a live 3-D view of the session on http://127.0.0.1:PORT/ (default " +
+                            std::to_string(kDefaultViewPort) + "; 0 takes any free port)")
+                     ->expected(0, 1)
+                     ->default_str(std::to_string(kDefaultViewPort))
+                     ->check(finiteRange(0, 65535));
+    addViewBindOption(cmd, args)->needs(view);
 }
 
 } // namespace hapto::cli

@@ -47,4 +47,20 @@ CLI::Option* addIndexOption(CLI::App* cmd, std::string& spec);
 /// Adds `--max-index-mb MB`, the most memory an index build may take. [control]
 CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes);
 
+/// The view's default port (`--view` without a port).
+inline constexpr int kDefaultViewPort = 8340;
+
+/// Where a command serves its view.
+struct ViewArgs {
+    bool enabled = false;                  ///< `--view` given.
+    int port = kDefaultViewPort;           ///< TCP port; 0 takes any free one.
+    std::string bindAddress = "127.0.0.1"; ///< `--view-bind ADDR`.
+};
+/// Adds `--view-bind ADDR` (an IPv4 or IPv6 address; a non-loopback one is warned about when
+/// the view starts) to a command that serves the view. [control]
+CLI::Option* addViewBindOption(CLI::App* cmd, ViewArgs& args);
+/// Adds `--view [PORT]` (live 3-D view in the browser, default port kDefaultViewPort) and
+/// `--view-bind ADDR`, which needs it. [control]
+void addViewOptions(CLI::App* cmd, ViewArgs& args);
+
 } // namespace hapto::cli

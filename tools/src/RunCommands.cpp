@@ -2,6 +2,7 @@
 
 #include "Commands.h"
 #include "LiveLines.h"
+#include "LiveView.h"
 #include "Options.h"
 #include "SessionChecks.h"
 #include "StopSignals.h"
@@ -42,6 +43,7 @@ struct RunArgs {
     int missLimit = 3;
     double reopenMs = 1000;
     bool quiet = false;
+    ViewArgs view;
 };
 
 void printSummary(const RunReport& r) {
@@ -129,6 +131,8 @@ int runSession(const RunArgs& a) {
     // A second signal while the orderly stop below is under way (or blocked): zero force
     // now, from the signal thread, and exit.
     signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
+    // The view binds before the devices open: a port in use fails the run before it starts.
+    LiveView view(a.view, "hapto run", scene, runtime);
 
     const bool live = !a.quiet && isatty(STDERR_FILENO);
     char header[256];
@@ -151,10 +155,12 @@ int runSession(const RunArgs& a) {
             }
             return 1;
         }
+        view.start();
         const auto start = std::chrono::steady_clock::now();
         while (!signals.requested() && runtime.anyRunning()) {
             std::this_thread::sleep_for(std::chrono::milliseconds(5));
             runtime.maintain();
+            view.update(world);
             for (auto& rec : recorders) {
                 rec->drain();
             }
@@ -164,6 +170,7 @@ int runSession(const RunArgs& a) {
             }
         }
         runtime.stop(); // zero force on every device before anything else
+        view.stop();
     }
     for (auto& rec : recorders) {
         rec->close();
@@ -226,7 +233,8 @@ void addRunCommands(CLI::App& app) {
                     "it again this often, then drive it again from zero force (ms); 0 = never")
         ->capture_default_str()
         ->check(finiteRange(0, 3600000));
-    cmd->add_flag("--quiet", a->quiet, "No live view");
+    cmd->add_flag("--quiet", a->quiet, "No live lines on the terminal");
+    addViewOptions(cmd, a->view);
     cmd->callback([a] {
         const int rc = runSession(*a);
         if (rc != 0) {

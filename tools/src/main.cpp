@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
     hapto::cli::addReportCommands(app);
     hapto::cli::addExperimentCommands(app);
     hapto::cli::addSoakCommands(app);
+    hapto::cli::addViewCommands(app);
 
     // A first word that is no option and no command is named as an unknown command (CLI11
     // would only say that an argument was not expected).

@@ -45,6 +45,14 @@ public:
     HistogramSummary summary() const noexcept;
     /// Values recorded so far. [any thread]
     std::uint64_t count() const noexcept { return mCount.load(std::memory_order_acquire); }
+    /// Copies every bucket's count into `out` (for windowed quantiles: the difference of two
+    /// copies is the histogram of the values recorded between them). [any thread]
+    void counts(std::array<std::uint64_t, kBuckets>& out) const noexcept {
+        for (int i = 0; i < kBuckets; ++i) {
+            out[static_cast<std::size_t>(i)] =
+                mBuckets[static_cast<std::size_t>(i)].load(std::memory_order_relaxed);
+        }
+    }
 
     /// The bucket a value falls in. [any thread]
     static int bucketOf(std::uint64_t v) noexcept {

@@ -1,0 +1,80 @@
+// The live feed in step mode: its frames say what the runtime's own metrics say.
+
+#include "hapto/view/LiveFeed.h"
+
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/devices/DeviceFactory.h"
+#include "hapto/runtime/ManualClock.h"
+#include "hapto/scenes/Generators.h"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+using namespace hapto;
+
+TEST_CASE("a live frame carries each device's ticks, misses, load, point, force and contacts, "
+          "and the poses of moved objects") {
+    const Scene scene = makeDefaultScene();
+    ManualClock clock;
+    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    world.useClock(clock);
+    std::vector<RuntimeDevice> devices;
+    for (DeviceConfig c : defaultDeviceConfigs()) {
+        devices.push_back({makeDevice(c, scene), c, nullptr});
+    }
+    RuntimeOptions options;
+    options.realtime = false;
+    Runtime runtime(world, std::move(devices), options);
+    ViewServer server;
+    LiveFeed feed(runtime, server);
+    REQUIRE(feed.devices().size() == 2);
+    CHECK(feed.devices()[0].name == runtime.report().devices[0].name);
+
+    const std::uint64_t t0 = clock.nowNs();
+    REQUIRE(runtime.startStepped(clock) == 2);
+    runtime.runUntil(t0 + 500'000'000);
+    const SceneObject& moved = scene.object(0);
+    world.moveObject(moved.id, moved.center + Vec3(0, 0.01, 0), moved.rotation);
+    feed.updatePoses(world.current());
+
+    const auto frame = nlohmann::json::parse(feed.frame(500'000'000));
+    CHECK(frame["t"] == 0.5);
+    const RunReport report = runtime.report();
+    for (std::size_t i = 0; i < 2; ++i) {
+        const auto& d = frame["devices"][i];
+        const DeviceReport& r = report.devices[i];
+        INFO(r.name);
+        CHECK(d["name"] == r.name);
+        CHECK(d["ticks"] == r.ticks);
+        CHECK(d["misses"] == r.missedDeadlines);
+        CHECK(d["verdict"] == (r.stable ? "stable" : "UNSTABLE"));
+        // The window covers the whole run so far: the report's quantiles (bucket bounds).
+        CHECK(d["loadP50"].get<double>() >= r.loadFraction.p50 - 1e-12);
+        CHECK(d["loadP50"].get<double>() <= r.loadFraction.p50 * 1.04 + 1e-12);
+        // The first frame's second reaches back to the start: the report's mean.
+        CHECK(d["candidates"].get<double>() == Approx(r.candidatesMean));
+        ContactReport c;
+        REQUIRE(runtime.contact(i, c));
+        CHECK(d["point"] ==
+              nlohmann::json::array({c.devicePoint.x, c.devicePoint.y, c.devicePoint.z}));
+        CHECK(d["proxy"][0] == c.proxy.x);
+        CHECK(d["forceN"].get<double>() == Approx(glm::length(c.force)));
+        CHECK(d["contacts"].size() == c.contactCount);
+    }
+    REQUIRE(frame["poses"].size() == 1);
+    CHECK(frame["poses"][0]["id"] == moved.id);
+    CHECK(frame["poses"][0]["moving"] == true);
+    CHECK(frame["poses"][0]["center"][1].get<double>() == Approx(moved.center.y + 0.01));
+
+    // Once it rests and is re-indexed it keeps its new pose, no longer moving.
+    runtime.runUntil(t0 + 800'000'000);
+    runtime.maintain();
+    feed.updatePoses(world.current());
+    const auto later = nlohmann::json::parse(feed.frame(800'000'000));
+    REQUIRE(later["poses"].size() == 1);
+    CHECK(later["poses"][0]["moving"] == false);
+    CHECK(later["poses"][0]["center"][1].get<double>() == Approx(moved.center.y + 0.01));
+    CHECK(later["devices"][0]["ticks"].get<std::uint64_t>() >
+          frame["devices"][0]["ticks"].get<std::uint64_t>());
+    runtime.stop();
+}

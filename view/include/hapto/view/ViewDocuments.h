@@ -1,0 +1,45 @@
+#pragma once
+/// The JSON the page reads once: the scene (/scene.json) and, offline, a recorded session
+/// (/trace.json). The formats are written down in docs/DESIGN.md ("The view").
+
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/devices/TraceFormat.h"
+#include "hapto/scenes/Scene.h"
+
+#include <string>
+#include <vector>
+
+namespace hapto {
+
+/// Whether the page follows a live session or plays a recording.
+enum class ViewMode : std::uint8_t { Live, Trace };
+
+/// A device as the page names it.
+struct ViewDevice {
+    std::string name;  ///< "left", ...
+    double rateHz = 0; ///< Servo rate (Hz).
+};
+
+/// The scene for the page: bounds, every object (box or sphere: centre, half extents,
+/// rotation (w, x, y, z)), the devices and the mode. A `"mesh"` shape with `vertices` and
+/// `triangles` is drawn by the page when a scene carries one (the hook for meshes; hapto's
+/// scenes have none yet). [control]
+std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& devices,
+                          ViewMode mode);
+
+/// One recorded device for the offline player.
+struct ViewTrace {
+    TraceHeader header;               ///< Name and rate.
+    WorkspaceTransform transform;     ///< Device frame into the world.
+    std::vector<TraceSample> samples; ///< As recorded (device frame).
+};
+
+/// The recording as frames at `frameHz` (at most one per frame time per device): time (s),
+/// device point and force in the world frame, the objects whose solid holds the point (a
+/// god-object device point is inside what it touches), and the load over the last second
+/// (p50, p99.9 of compute time over the period) and the misses so far (a force written after
+/// the next deadline: lateness plus compute beyond one period). [control]
+std::string viewTraceJson(const Scene& scene, const std::vector<ViewTrace>& traces,
+                          double frameHz = 60.0);
+
+} // namespace hapto

@@ -1,0 +1,151 @@
+// The live view's feed thread (LiveFeed.h).
+
+#include "hapto/view/LiveFeed.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+
+namespace hapto {
+namespace {
+
+nlohmann::json vec(const Vec3& v) {
+    return nlohmann::json::array({v.x, v.y, v.z});
+}
+
+std::uint64_t steadyNs() {
+    return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                          std::chrono::steady_clock::now().time_since_epoch())
+                                          .count());
+}
+
+} // namespace
+
+LiveFeed::LiveFeed(const Runtime& runtime, ViewServer& server, double frameHz)
+    : mRuntime(runtime), mServer(server), mFrameHz(frameHz) {
+    for (const DeviceReport& d : runtime.report().devices) {
+        mDevices.push_back({d.name, d.rateHz});
+        // One second of copies at the frame rate, plus slack for a late frame.
+        mWindows.emplace_back(1e9 / d.rateHz, 1'000'000'000, static_cast<std::size_t>(frameHz) + 2);
+        mSums.push_back({{0, 0, 0}}); // the session's start: nothing yet
+    }
+}
+
+LiveFeed::~LiveFeed() {
+    stop();
+}
+
+void LiveFeed::start() {
+    mStop = false;
+    mThread = std::thread([this] { run(); });
+}
+
+void LiveFeed::stop() {
+    {
+        std::lock_guard lock(mStopMutex);
+        mStop = true;
+    }
+    mStopWake.notify_all();
+    if (mThread.joinable()) {
+        mThread.join();
+    }
+}
+
+void LiveFeed::updatePoses(const WorldSnapshot& snapshot) {
+    if (snapshot.version == mPoseVersion) {
+        return;
+    }
+    mPoseVersion = snapshot.version;
+    std::lock_guard lock(mPoseMutex);
+    for (auto& [id, pose] : mPoses) {
+        const auto slot = snapshot.scene->slotOf(id);
+        pose.moving = false;
+        if (slot) { // the last pose of an object that rests now
+            pose.center = snapshot.scene->object(*slot).center;
+            pose.rotation = snapshot.scene->object(*slot).rotation;
+        }
+    }
+    for (std::uint32_t slot : snapshot.moving) {
+        const SceneObject& o = snapshot.scene->object(slot);
+        mPoses[o.id] = Pose{o.center, o.rotation, true};
+    }
+}
+
+std::string LiveFeed::frame(std::uint64_t sessionNs) {
+    nlohmann::json devices = nlohmann::json::array();
+    for (std::size_t i = 0; i < mDevices.size(); ++i) {
+        const DeviceMetrics& m = mRuntime.metrics(i);
+        const WindowLoad load = mWindows[i].sample(m.tickNs, sessionNs);
+        const std::uint64_t ticks = m.ticks.load(std::memory_order_relaxed);
+        const std::uint64_t misses = m.missedDeadlines.load(std::memory_order_relaxed);
+        // Candidates per tick over the same second: two sums about a second apart.
+        std::deque<Sums>& sums = mSums[i];
+        sums.push_back({sessionNs, ticks, m.candidatesSum.load(std::memory_order_relaxed)});
+        while (sums.size() > 2 && sessionNs - sums[1].timeNs >= 1'000'000'000) {
+            sums.pop_front();
+        }
+        const std::uint64_t windowTicks = ticks - sums.front().ticks;
+        const double candidates =
+            windowTicks > 0
+                ? static_cast<double>(sums.back().candidates - sums.front().candidates) /
+                      static_cast<double>(windowTicks)
+                : 0.0;
+        const FaultKind fault = m.fault.load(std::memory_order_relaxed);
+        const double periodNs = 1e9 / mDevices[i].rateHz;
+        const bool stable = fault == FaultKind::None && m.tickNs.summary().p999 / periodNs < 1.0 &&
+                            misses * 1000 <= ticks;
+        nlohmann::json d{{"name", mDevices[i].name},
+                         {"ticks", ticks},
+                         {"misses", misses},
+                         {"loadP50", load.p50},
+                         {"loadP999", load.p999},
+                         {"windowS", load.spanS},
+                         {"candidates", candidates},
+                         {"verdict", fault != FaultKind::None
+                                         ? std::string("FAULT ") + faultName(fault)
+                                     : stable ? "stable"
+                                              : "UNSTABLE"}};
+        ContactReport c;
+        if (mRuntime.contact(i, c)) {
+            nlohmann::json contacts = nlohmann::json::array();
+            for (std::uint32_t k = 0; k < c.contactCount && k < c.objects.size(); ++k) {
+                contacts.push_back(c.objects[k]);
+            }
+            d["point"] = vec(c.devicePoint);
+            d["proxy"] = vec(c.proxy);
+            d["force"] = vec(c.force);
+            d["forceN"] = glm::length(c.force);
+            d["contacts"] = contacts;
+        }
+        devices.push_back(std::move(d));
+    }
+    nlohmann::json poses = nlohmann::json::array();
+    {
+        std::lock_guard lock(mPoseMutex);
+        for (const auto& [id, p] : mPoses) {
+            poses.push_back({{"id", id},
+                             {"center", vec(p.center)},
+                             {"rotation", {p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z}},
+                             {"moving", p.moving}});
+        }
+    }
+    return nlohmann::json{
+        {"t", static_cast<double>(sessionNs) * 1e-9}, {"devices", devices}, {"poses", poses}}
+        .dump();
+}
+
+void LiveFeed::run() {
+    const std::uint64_t startNs = steadyNs();
+    const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / mFrameHz));
+    auto next = std::chrono::steady_clock::now();
+    std::unique_lock lock(mStopMutex);
+    while (!mStop) {
+        lock.unlock();
+        mServer.publish(frame(steadyNs() - startNs));
+        lock.lock();
+        next += period;
+        mStopWake.wait_until(lock, next, [this] { return mStop; });
+    }
+}
+
+} // namespace hapto
