@@ -52,6 +52,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     mCandidates.add(snapshot.movingSlots());
     out.locateSteps = atDevice.steps + atProxy.steps;
     out.outside = atDevice.outside;
+    out.deviceLeaf = atDevice.leaf;
 
     // 3. Render.
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);

@@ -148,6 +148,8 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
     }
     storeVec(m.forceN, force);
     storeVec(m.positionM, p);
+    m.leafAtVersion.store((snap.version & 0xFFFFFFFFu) << 32 | out.deviceLeaf,
+                          std::memory_order_relaxed);
     ContactReport report;
     report.tick = s.tick;
     report.devicePoint = p;

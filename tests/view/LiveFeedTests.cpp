@@ -10,6 +10,9 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <vector>
+
 using namespace hapto;
 
 TEST_CASE("a live frame carries each device's ticks, misses, load, point, force and contacts, "
@@ -76,5 +79,56 @@ TEST_CASE("a live frame carries each device's ticks, misses, load, point, force 
     CHECK(later["poses"][0]["center"][1].get<double>() == Approx(moved.center.y + 0.01));
     CHECK(later["devices"][0]["ticks"].get<std::uint64_t>() >
           frame["devices"][0]["ticks"].get<std::uint64_t>());
+    runtime.stop();
+}
+
+TEST_CASE("a live frame shows each device's cursor leaf: the box holding its point and the "
+          "objects the leaf lists, as a fresh locate in the same snapshot gives them") {
+    const Scene scene = makeDefaultScene();
+    ManualClock clock;
+    World world(scene, IndexSpec::parse("octree:4:0.005"));
+    world.useClock(clock);
+    std::vector<RuntimeDevice> devices;
+    for (DeviceConfig c : defaultDeviceConfigs()) {
+        devices.push_back({makeDevice(c, scene), c, nullptr});
+    }
+    RuntimeOptions options;
+    options.realtime = false;
+    Runtime runtime(world, std::move(devices), options);
+    ViewServer server;
+    LiveFeed feed(runtime, server);
+    const std::uint64_t t0 = clock.nowNs();
+    REQUIRE(runtime.startStepped(clock) == 2);
+    int checked = 0;
+    for (int step = 1; step <= 8; ++step) {
+        runtime.runUntil(t0 + step * 150'000'000ull);
+        const WorldSnapshot& snap = world.current();
+        feed.updateLeaves(snap);
+        const auto frame = nlohmann::json::parse(feed.frame(step * 150'000'000ull));
+        for (std::size_t i = 0; i < 2; ++i) {
+            ContactReport c;
+            REQUIRE(runtime.contact(i, c));
+            const LocateResult fresh = snap.index->locate(c.devicePoint);
+            const auto& d = frame["devices"][i];
+            if (fresh.outside) {
+                CHECK_FALSE(d.contains("leaf"));
+                continue;
+            }
+            REQUIRE(d.contains("leaf"));
+            const Aabb box = snap.index->leafBounds(fresh.leaf);
+            CHECK(d["leaf"]["min"] == nlohmann::json::array({box.min.x, box.min.y, box.min.z}));
+            CHECK(d["leaf"]["max"] == nlohmann::json::array({box.max.x, box.max.y, box.max.z}));
+            CHECK(d["leaf"]["items"] == fresh.candidates.size());
+            std::vector<ObjectId> ids;
+            for (const std::uint32_t item : fresh.candidates) {
+                ids.push_back(snap.scene->object(snap.scene->objectSlotOf(item)).id);
+            }
+            std::sort(ids.begin(), ids.end());
+            ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+            CHECK(d["leaf"]["objects"].get<std::vector<ObjectId>>() == ids);
+            ++checked;
+        }
+    }
+    CHECK(checked > 0); // the hands were inside the bounds at some of the frames
     runtime.stop();
 }

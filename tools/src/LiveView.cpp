@@ -41,6 +41,7 @@ void LiveView::start() {
 void LiveView::update(const World& world) {
     if (mFeed) {
         mFeed->updatePoses(world.current());
+        mFeed->updateLeaves(world.current());
     }
 }
 

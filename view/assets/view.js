@@ -4,9 +4,10 @@
 
 const COLORS = [0x4fc3f7, 0xffb74d, 0xba68c8, 0x81c784, 0xf06292, 0xfff176];
 const OBJECT_COLOR = 0x8a96a8, CONTACT_COLOR = 0xff7043, MOVING_COLOR = 0x66bb6a;
+const LISTED_COLOR = 0xd4c15a; // in a shown cursor leaf
 const HISTORY = 300; // chart samples (10 s at 30 Hz)
 
-const view = { objects: new Map(), devices: [], frames: 0 };
+const view = { objects: new Map(), devices: [], frames: 0, listed: new Set() };
 
 function v3(a) { return new THREE.Vector3(a[0], a[1], a[2]); }
 
@@ -89,7 +90,10 @@ function makeDevice(world, d, i) {
   const proxy = new THREE.Mesh(new THREE.SphereBufferGeometry(r, 12, 8),
                                new THREE.MeshBasicMaterial({ color, wireframe: true }));
   const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 1, 0), new THREE.Vector3(), r, color);
-  for (const o of [point, proxy, arrow]) { o.visible = false; world.add(o); }
+  // The device point's cursor leaf: the paper's idea made visible (the box the cursor caches
+  // and the objects it hands to the renderer); shown when "leaves" is ticked.
+  const leaf = new THREE.Box3Helper(new THREE.Box3(), color);
+  for (const o of [point, proxy, arrow, leaf]) { o.visible = false; world.add(o); }
   const row = document.createElement('div');
   row.className = 'device';
   row.dataset.device = d.name;
@@ -100,11 +104,12 @@ function makeDevice(world, d, i) {
     'load p50 <span data-field="loadP50">-</span> % &middot; p99.9 ' +
     '<span data-field="loadP999">-</span> % &middot; candidates/tick ' +
     '<span data-field="candidates">-</span> <span data-field="contacts"></span>' +
+    '<br><span data-field="leaf"></span>' +
     '<canvas width="254" height="56"></canvas>';
   row.querySelector('.name').textContent = d.name;
   row.querySelector('.name').style.color = '#' + color.toString(16).padStart(6, '0');
   document.getElementById('devices').appendChild(row);
-  return { name: d.name, point, proxy, arrow, row, chart: row.querySelector('canvas'),
+  return { name: d.name, point, proxy, arrow, leaf, row, chart: row.querySelector('canvas'),
            history: [] };
 }
 
@@ -141,10 +146,25 @@ function showDevice(dev, f, touched) {
   field(dev, 'loadP50', (100 * f.loadP50).toFixed(2));
   field(dev, 'loadP999', (100 * f.loadP999).toFixed(2));
   if (f.candidates !== undefined) field(dev, 'candidates', f.candidates.toFixed(1));
+  showLeaf(dev, f);
   if (f.verdict !== undefined) {
     const v = dev.row.querySelector('[data-field="verdict"]');
     v.textContent = f.verdict;
     v.className = f.verdict === 'stable' ? 'stable' : f.verdict.startsWith('FAULT') ? 'fault' : 'unstable';
+  }
+}
+
+// The cursor leaf's box and what it lists (live frames only; a trace has no leaves).
+function showLeaf(dev, f) {
+  const on = document.getElementById('leaves').checked;
+  dev.leaf.visible = on && !!f.leaf;
+  if (f.leaf) {
+    dev.leaf.box.set(v3(f.leaf.min), v3(f.leaf.max));
+    field(dev, 'leaf', 'leaf: ' + f.leaf.items + ' items' +
+          (f.leaf.objects.length ? ' (#' + f.leaf.objects.join(', #') + ')' : ''));
+    if (on) for (const id of f.leaf.objects) view.listed.add(id);
+  } else {
+    field(dev, 'leaf', f.ticks !== undefined && f.point ? 'leaf: outside the bounds' : '');
   }
 }
 
@@ -171,6 +191,7 @@ function chart(dev, f) {
 
 function showFrame(frame, devices) {
   const touched = new Set();
+  view.listed = new Set();
   devices.forEach((f, i) => { if (view.devices[i]) { showDevice(view.devices[i], f, touched); chart(view.devices[i], f); } });
   const moving = new Set();
   for (const p of frame.poses || []) {
@@ -179,7 +200,8 @@ function showFrame(frame, devices) {
     if (p.moving) moving.add(p.id);
   }
   for (const [id, mesh] of view.objects) {
-    mesh.material.color.setHex(touched.has(id) ? CONTACT_COLOR : moving.has(id) ? MOVING_COLOR : OBJECT_COLOR);
+    mesh.material.color.setHex(touched.has(id) ? CONTACT_COLOR : moving.has(id) ? MOVING_COLOR
+                               : view.listed.has(id) ? LISTED_COLOR : OBJECT_COLOR);
   }
   view.frames++;
   const status = document.getElementById('status');

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 
 namespace hapto {
@@ -29,6 +30,7 @@ LiveFeed::LiveFeed(const Runtime& runtime, ViewServer& server, double frameHz)
         mWindows.emplace_back(1e9 / d.rateHz, 1'000'000'000, static_cast<std::size_t>(frameHz) + 2);
         mSums.push_back({{0, 0, 0}}); // the session's start: nothing yet
     }
+    mLeaves.resize(mDevices.size());
 }
 
 LiveFeed::~LiveFeed() {
@@ -68,6 +70,46 @@ void LiveFeed::updatePoses(const WorldSnapshot& snapshot) {
     for (std::uint32_t slot : snapshot.moving) {
         const SceneObject& o = snapshot.scene->object(slot);
         mPoses[o.id] = Pose{o.center, o.rotation, true};
+    }
+}
+
+void LiveFeed::updateLeaves(const WorldSnapshot& snapshot) {
+    for (std::size_t i = 0; i < mDevices.size(); ++i) {
+        const std::uint64_t packed =
+            mRuntime.metrics(i).leafAtVersion.load(std::memory_order_relaxed);
+        {
+            std::lock_guard lock(mPoseMutex);
+            if (packed == mLeaves[i].leafAtVersion) {
+                continue; // the same leaf of the same snapshot: nothing new
+            }
+        }
+        if (packed >> 32 != (snapshot.version & 0xFFFFFFFFu)) {
+            continue; // the servo's last tick used another snapshot: wait for a matching one
+        }
+        Leaf leaf;
+        leaf.leafAtVersion = packed;
+        const auto id = static_cast<std::uint32_t>(packed & 0xFFFFFFFFu);
+        if (id != kNoLeaf) {
+            const SpatialIndex& index = *snapshot.index;
+            const Scene& scene = *snapshot.scene;
+            leaf.box = index.leafBounds(id);
+            const std::span<const std::uint32_t> items = index.leafObjects(id);
+            leaf.items = items.size();
+            for (const std::uint32_t item : items) {
+                if (leaf.objects.size() >= kMaxLeafObjects) {
+                    break;
+                }
+                const ObjectId oid = scene.object(scene.objectSlotOf(item)).id;
+                if (std::find(leaf.objects.begin(), leaf.objects.end(), oid) ==
+                    leaf.objects.end()) {
+                    leaf.objects.push_back(oid);
+                }
+            }
+            std::sort(leaf.objects.begin(), leaf.objects.end());
+            leaf.valid = true;
+        }
+        std::lock_guard lock(mPoseMutex);
+        mLeaves[i] = std::move(leaf);
     }
 }
 
@@ -116,6 +158,16 @@ std::string LiveFeed::frame(std::uint64_t sessionNs) {
             d["force"] = vec(c.force);
             d["forceN"] = glm::length(c.force);
             d["contacts"] = contacts;
+        }
+        {
+            std::lock_guard lock(mPoseMutex);
+            const Leaf& leaf = mLeaves[i];
+            if (leaf.valid) {
+                d["leaf"] = {{"min", vec(leaf.box.min)},
+                             {"max", vec(leaf.box.max)},
+                             {"objects", leaf.objects},
+                             {"items", leaf.items}};
+            }
         }
         devices.push_back(std::move(d));
     }

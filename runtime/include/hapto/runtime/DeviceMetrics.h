@@ -50,6 +50,10 @@ struct alignas(64) DeviceMetrics {
     std::atomic<bool> realtime{false}; ///< The servo thread was granted SCHED_FIFO.
     std::atomic<double> forceN[3]{};   ///< Last force sent, world frame (N), for the live view.
     std::atomic<double> positionM[3]{}; ///< Last device point, world frame (m), for the live view.
+    /// The device point's cursor leaf and the snapshot it is a leaf of, in one word so a reader
+    /// never pairs a leaf with the wrong index: (version & 0xFFFFFFFF) << 32 | leaf (kNoLeaf
+    /// outside the bounds). For the live view. ~0 before the first tick.
+    std::atomic<std::uint64_t> leafAtVersion{~std::uint64_t{0}};
 
     /// Adds to a counter; the servo thread is the only writer. [servo]
     static void bump(std::atomic<std::uint64_t>& c, std::uint64_t by = 1) noexcept {

@@ -26,8 +26,9 @@ struct TickOutput {
     Vec3 effectsN{0.0};         ///< The force effects' sum this tick (N), before the safety filter.
     Vec3 hookN{0.0};            ///< The hook's force this tick (N; zero when it was not finite).
     bool hookNonFinite = false; ///< The hook returned a non-finite force (replaced by zero).
-    std::uint32_t locateSteps = 0; ///< Cursor steps, both cursors.
-    bool outside = false;          ///< The device point is outside the index's bounds.
+    std::uint32_t locateSteps = 0;          ///< Cursor steps, both cursors.
+    bool outside = false;                   ///< The device point is outside the index's bounds.
+    std::uint32_t deviceLeaf = 0xFFFFFFFFu; ///< The device point's leaf (kNoLeaf outside).
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
 };
 

@@ -48,6 +48,12 @@ public:
     /// Takes the poses of the snapshot's moving objects when its version is new (cheap when
     /// not); an object that moved keeps its last pose in the frames after it rests. [control]
     void updatePoses(const WorldSnapshot& snapshot);
+    /// Takes each device's cursor leaf (its box and the objects it lists, at most
+    /// kMaxLeafObjects ids) when the servo's last tick used this snapshot's index; a leaf of
+    /// another snapshot is left until the next call. Call it with every updatePoses. [control]
+    void updateLeaves(const WorldSnapshot& snapshot);
+    /// The most object ids a frame lists per leaf.
+    static constexpr std::size_t kMaxLeafObjects = 64;
     /// Builds one frame at `sessionNs` since the feed started (the feed thread's work; public
     /// for tests). [feed thread, or a test's thread while the feed is not started]
     std::string frame(std::uint64_t sessionNs);
@@ -72,6 +78,14 @@ private:
 
     std::mutex mPoseMutex; // control thread writes, feed thread copies
     std::map<ObjectId, Pose> mPoses;
+    struct Leaf {
+        std::uint64_t leafAtVersion = ~std::uint64_t{0}; // as DeviceMetrics publishes it
+        Aabb box;
+        std::vector<ObjectId> objects; // distinct, ascending, at most kMaxLeafObjects
+        std::size_t items = 0;         // what the leaf lists (triangles counted one by one)
+        bool valid = false;
+    };
+    std::vector<Leaf> mLeaves;      // per device, under mPoseMutex
     std::uint64_t mPoseVersion = 0; // control thread only
 
     std::thread mThread;
