@@ -147,4 +147,51 @@ bool overlapsAabbAabb(const Aabb& a, const Aabb& b) noexcept {
            a.max.y + tol >= b.min.y && a.min.z <= b.max.z + tol && a.max.z + tol >= b.min.z;
 }
 
+Aabb triangleAabb(const TriangleCorners& t) noexcept {
+    return {glm::min(glm::min(t[0], t[1]), t[2]), glm::max(glm::max(t[0], t[1]), t[2])};
+}
+
+bool overlapsTriangleAabb(const TriangleCorners& t, const Aabb& box, double tol) noexcept {
+    // In the box's frame: corners relative to its centre, h its half extents. An axis L
+    // separates when the triangle's projection interval [lo, hi] lies beyond the box's
+    // [-r, r], r = h . |L|, by more than tol * |L| (compared squared, no square root).
+    const Vec3 c = box.center();
+    const Vec3 h = box.halfExtents();
+    const Vec3 v0 = t[0] - c, v1 = t[1] - c, v2 = t[2] - c;
+    const auto separates = [&](const Vec3& axis) {
+        const double p0 = glm::dot(v0, axis), p1 = glm::dot(v1, axis), p2 = glm::dot(v2, axis);
+        const double lo = std::min({p0, p1, p2}), hi = std::max({p0, p1, p2});
+        const double r = glm::dot(h, glm::abs(axis));
+        const double gap = std::max(lo - r, -r - hi); // > 0: the intervals are apart
+        return gap > 0.0 && gap * gap > tol * tol * glm::dot(axis, axis);
+    };
+    // The box's face normals: the triangle's AABB against the box.
+    for (int a = 0; a < 3; ++a) {
+        const double lo = std::min({v0[a], v1[a], v2[a]}), hi = std::max({v0[a], v1[a], v2[a]});
+        if (lo > h[a] + tol || hi < -h[a] - tol) {
+            return false;
+        }
+    }
+    // The triangle's normal.
+    const Vec3 e0 = v1 - v0, e1 = v2 - v1, e2 = v0 - v2;
+    if (separates(glm::cross(e0, e1))) {
+        return false;
+    }
+    // The nine edge axes: unit axis a x edge is exact (a permutation of the edge's
+    // components), so only the projections round, and tol * |L| covers that.
+    const Vec3 edges[3] = {e0, e1, e2};
+    for (const Vec3& e : edges) {
+        if (separates(Vec3(0.0, -e.z, e.y)) || separates(Vec3(e.z, 0.0, -e.x)) ||
+            separates(Vec3(-e.y, e.x, 0.0))) {
+            return false;
+        }
+    }
+    return true;
+}
+
+bool overlapsTriangleAabb(const TriangleCorners& t, const Aabb& box) noexcept {
+    return overlapsTriangleAabb(t, box,
+                                overlapToleranceFor(aabbScale(triangleAabb(t)), aabbScale(box)));
+}
+
 } // namespace hapto

@@ -4,10 +4,44 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace hapto::detail {
 
+namespace {
+
+/// The distance along the ray o + s d (s >= 0) to the nearest of the mesh's triangles, placed
+/// by the object's pose (Moeller-Trumbore, both sides); none when the ray misses. O(triangles).
+std::optional<double> rayToMesh(const SceneObject& object, const Vec3& o, const Vec3& d) {
+    const TriangleMesh& mesh = *object.mesh;
+    const Mat3 r = glm::mat3_cast(object.rotation);
+    std::optional<double> best;
+    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
+        const auto [la, lb, lc] = mesh.corners(t);
+        const Vec3 a = object.center + r * la;
+        const Vec3 e1 = r * (lb - la), e2 = r * (lc - la);
+        const Vec3 q = glm::cross(d, e2);
+        const double det = glm::dot(e1, q);
+        if (std::abs(det) < 1e-300) {
+            continue;
+        }
+        const Vec3 w = o - a;
+        const double u = glm::dot(w, q) / det;
+        const Vec3 wc = glm::cross(w, e1);
+        const double v = glm::dot(d, wc) / det;
+        const double s = glm::dot(e2, wc) / det;
+        if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && s >= 0.0 && (!best || s < *best)) {
+            best = s;
+        }
+    }
+    return best;
+}
+
+} // namespace
+
 double signedDistance(const SceneObject& object, const Vec3& p) {
+    // A mesh plans by its oriented bounding box: never nearer than the mesh itself, so a path
+    // kept clear of the box is clear of the mesh.
     return object.shape == Shape::Sphere
                ? sphereSignedDistance(object.center, object.halfExtents.x, p)
                : boxSignedDistance(object.obb(), p);
@@ -34,7 +68,15 @@ SurfacePoint contactPoint(const SceneObject& object, const Vec3& p, double edgeM
         }
     }
     const Vec3 normal = box.axes[axis] * (l[axis] >= 0.0 ? 1.0 : -1.0);
-    return {box.center + box.axes * local, normal};
+    const Vec3 onBox = box.center + box.axes * local;
+    if (object.shape == Shape::Mesh) {
+        // The mesh's own surface below that face point, pressed along the face normal; the
+        // face point itself when the mesh leaves a hole there.
+        if (const auto s = rayToMesh(object, onBox, -normal)) {
+            return {onBox - *s * normal, normal};
+        }
+    }
+    return {onBox, normal};
 }
 
 std::vector<std::uint32_t> objectsNear(const Scene& scene, const Aabb& region, double padM) {

@@ -9,7 +9,8 @@
 
 namespace hapto::detail {
 
-/// Signed distance from p to the object's surface (m): < 0 inside. Exact for spheres and boxes.
+/// Signed distance from p to the object's surface (m): < 0 inside. Exact for spheres and boxes;
+/// for a mesh, to its oriented bounding box (never more than the mesh's own distance).
 double signedDistance(const SceneObject& object, const Vec3& p);
 
 /// A point on an object's surface and the outward unit normal there.
@@ -19,7 +20,8 @@ struct SurfacePoint {
 };
 
 /// The surface point a hand at p would press on: for a box the centre-most point of the face p
-/// lies beyond (kept `edgeMarginM` from the edges), for a sphere the radial point.
+/// lies beyond (kept `edgeMarginM` from the edges), for a sphere the radial point, for a mesh
+/// the point of its triangles straight below that face point of its bounding box (O(triangles)).
 SurfacePoint contactPoint(const SceneObject& object, const Vec3& p, double edgeMarginM);
 
 /// Slots of the objects whose AABB, padded by `padM`, overlaps `region`.

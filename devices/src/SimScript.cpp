@@ -416,8 +416,9 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
             } else {
                 const double speed = std::min(kSlideSpeed, cap);
                 loopStart = plan.size() - 1;
-                if (o.shape == Shape::Box) {
-                    // Along the longer in-face axis of the pressed face, within the face.
+                if (o.shape != Shape::Sphere) {
+                    // Along the longer in-face axis of the pressed face, within the face (a
+                    // mesh: of its bounding box's face).
                     const Obb box = o.obb();
                     int normalAxis = 0;
                     for (int i = 1; i < 3; ++i) {

@@ -11,6 +11,7 @@
 #include "hapto/experiments/Table.h"
 
 #include "hapto/index/Cursor.h"
+#include "hapto/index/Overlap.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
@@ -29,8 +30,9 @@ namespace {
 /// Hands start at least this far from every object's box (m) and from each other (x2).
 constexpr double kClearM = 0.005;
 
-/// True when no object's box, grown by `marginM`, holds `p`: checked against the candidates
-/// of the leaves holding p and p moved by the margin along each axis.
+/// True when no item's box (an object's, or a mesh triangle's), grown by `marginM`, holds `p`:
+/// checked against the candidates of the leaves holding p and p moved by the margin along
+/// each axis.
 bool isClear(const Scene& scene, const SpatialIndex& index, const Vec3& p, double marginM) {
     if (!index.inBounds(p)) {
         return false;
@@ -40,8 +42,8 @@ bool isClear(const Scene& scene, const SpatialIndex& index, const Vec3& p, doubl
         if (probe > 0) {
             q[(probe - 1) / 2] += (probe % 2 ? marginM : -marginM);
         }
-        for (const std::uint32_t slot : index.locate(q).candidates) {
-            Aabb box = scene.object(slot).aabb();
+        for (const std::uint32_t item : index.locate(q).candidates) {
+            Aabb box = itemAabb(scene, item);
             box.min -= Vec3(marginM);
             box.max += Vec3(marginM);
             if (box.contains(p)) {

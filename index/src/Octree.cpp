@@ -24,6 +24,7 @@
 #include "hapto/index/Octree.h"
 
 #include "BuildTimer.h"
+#include "IndexItems.h"
 #include "IndexMemory.h"
 #include "Parallel.h"
 
@@ -44,8 +45,8 @@ constexpr std::size_t kNestedGrain = 4096;
 
 } // namespace
 
-Octree::Octree(const IndexSpec& spec, const Aabb& bounds, std::uint32_t objects)
-    : SpatialIndex(spec, bounds, objects) {
+Octree::Octree(const IndexSpec& spec, const Aabb& bounds, std::uint32_t items)
+    : SpatialIndex(spec, bounds, items) {
     const Vec3 size = bounds.max - bounds.min;
     for (int l = 0; l <= kMaxDepth + 1; ++l) {
         mStep[l] = Vec3(std::ldexp(size.x, -l), std::ldexp(size.y, -l), std::ldexp(size.z, -l));
@@ -197,9 +198,11 @@ std::unique_ptr<Octree> Octree::build(const Scene& scene, const IndexSpec& spec)
                          spec.toString());
     }
     const BuildTimer timer;
-    std::unique_ptr<Octree> tree(new Octree(spec, partitionBounds(scene.bounds()), scene.size()));
-    tree->recordOutsideObjects(scene);
-    tree->buildNodes(scene);
+    const std::vector<std::uint32_t> items = detail::indexedItems(scene);
+    std::unique_ptr<Octree> tree(new Octree(spec, partitionBounds(scene.bounds()),
+                                            static_cast<std::uint32_t>(items.size())));
+    tree->recordOutsideObjects(scene, items);
+    tree->buildNodes(scene, items);
 
     IndexStats& st = tree->mStats;
     st.nodes = tree->mNodes.size();
@@ -214,22 +217,22 @@ std::unique_ptr<Octree> Octree::build(const Scene& scene, const IndexSpec& spec)
     st.recordLeaves(perLeaf);
     st.bytes = tree->mNodes.size() * sizeof(OctreeNode) +
                (tree->mSlots.size() + tree->outsideObjects().size()) * sizeof(std::uint32_t);
-    st.bytesPerObject = scene.size() == 0 ? 0.0 : static_cast<double>(st.bytes) / scene.size();
+    st.bytesPerObject = items.empty() ? 0.0 : static_cast<double>(st.bytes) / items.size();
     timer.finish(st);
     return tree;
 }
 
-void Octree::buildNodes(const Scene& scene) {
-    const std::uint32_t count = scene.size();
+void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items) {
+    const std::uint32_t count = static_cast<std::uint32_t>(items.size());
     const IndexSpec& sp = spec();
     const std::uint32_t maxObjects = static_cast<std::uint32_t>(sp.maxObjects);
-    // Work on the objects in Morton order of their centres, so a node's objects are close
+    // Work on the items in Morton order of their centres, so a node's items are close
     // together in memory (the build is bound by memory latency otherwise); "local" ids index
-    // that order and become slots again when leaves are written.
+    // that order and become item ids again when leaves are written.
     const Aabb box = bounds();
     std::vector<std::uint64_t> keys(count);
     parallel::forEach(0, count, 4096, [&](std::size_t i) {
-        const Vec3 c = scene.object(static_cast<std::uint32_t>(i)).center;
+        const Vec3 c = itemCenter(scene, items[i]);
         std::uint64_t code = 0;
         for (int a = 0; a < 3; ++a) {
             const double t = (c[a] - box.min[a]) / (box.max[a] - box.min[a]);
@@ -244,8 +247,8 @@ void Octree::buildNodes(const Scene& scene) {
     std::vector<std::uint32_t> slotOf(count);
     std::vector<OverlapShape> shapes(count);
     parallel::forEach(0, count, 4096, [&](std::size_t local) {
-        slotOf[local] = static_cast<std::uint32_t>(keys[local]);
-        shapes[local] = OverlapShape::of(scene.object(slotOf[local]));
+        slotOf[local] = items[static_cast<std::uint32_t>(keys[local])];
+        shapes[local] = OverlapShape::of(scene, slotOf[local]);
     });
     keys = {};
 
@@ -416,7 +419,7 @@ void Octree::buildNodes(const Scene& scene) {
         }
         parallel::forEach(0, width, 16, [&](std::size_t k) {
             const std::uint64_t b = start[k], e = start[k + 1];
-            if (!splits[k]) { // back to slots, ascending
+            if (!splits[k]) { // back to item ids, ascending
                 const auto out = mSlots.begin() + static_cast<std::ptrdiff_t>(leafAt[k]);
                 std::transform(entries.begin() + b, entries.begin() + e, out,
                                [&](std::uint32_t local) { return slotOf[local]; });

@@ -8,12 +8,39 @@ namespace hapto {
 OverlapShape OverlapShape::of(const SceneObject& object) {
     OverlapShape s;
     s.obb = object.obb();
-    s.sphere = object.shape == Shape::Sphere;
-    s.aabb = s.sphere ? object.aabb() : s.obb.aabb();
-    s.radius = s.sphere ? object.halfExtents.x : 0.0;
+    const bool sphere = object.shape == Shape::Sphere;
+    s.kind = sphere ? OverlapShape::Kind::Sphere : OverlapShape::Kind::Box;
+    s.aabb = sphere ? object.aabb() : s.obb.aabb();
+    s.radius = sphere ? object.halfExtents.x : 0.0;
     s.scale = maxAbsComponent(object.center) +
               std::max({object.halfExtents.x, object.halfExtents.y, object.halfExtents.z});
     return s;
+}
+
+OverlapShape OverlapShape::ofTriangle(const TriangleCorners& corners) noexcept {
+    OverlapShape s;
+    s.triangle = corners;
+    s.kind = OverlapShape::Kind::Triangle;
+    s.aabb = triangleAabb(corners);
+    s.scale = aabbScale(s.aabb);
+    return s;
+}
+
+OverlapShape OverlapShape::of(const Scene& scene, std::uint32_t item) {
+    return isTriangleItem(item) ? ofTriangle(scene.triangleCorners(item)) : of(scene.object(item));
+}
+
+Aabb itemAabb(const Scene& scene, std::uint32_t item) noexcept {
+    return isTriangleItem(item) ? triangleAabb(scene.triangleCorners(item))
+                                : scene.object(item).aabb();
+}
+
+Vec3 itemCenter(const Scene& scene, std::uint32_t item) noexcept {
+    if (isTriangleItem(item)) {
+        const TriangleCorners t = scene.triangleCorners(item);
+        return (t[0] + t[1] + t[2]) / 3.0;
+    }
+    return scene.object(item).center;
 }
 
 OverlapCell OverlapCell::of(const Aabb& box) noexcept {
@@ -40,16 +67,26 @@ bool overlaps(const OverlapShape& shape, const OverlapCell& prepared, OverlapMod
     if (mode == OverlapMode::Aabb) {
         return true;
     }
-    // The centre in the cell, or the AABB inside it: an overlap for sure.
-    const Vec3& c = shape.obb.center;
+    // The centre (a triangle: its centroid) in the cell, or the AABB inside it: an overlap for
+    // sure.
+    const bool triangle = shape.kind == OverlapShape::Kind::Triangle;
+    const Vec3 c = triangle ? (shape.triangle[0] + shape.triangle[1] + shape.triangle[2]) / 3.0
+                            : shape.obb.center;
     if ((c.x >= cell.min.x && c.x <= cell.max.x && c.y >= cell.min.y && c.y <= cell.max.y &&
          c.z >= cell.min.z && c.z <= cell.max.z) ||
         (a.min.x >= cell.min.x && a.max.x <= cell.max.x && a.min.y >= cell.min.y &&
          a.max.y <= cell.max.y && a.min.z >= cell.min.z && a.max.z <= cell.max.z)) {
         return true;
     }
-    return shape.sphere ? overlapsSphereAabb(shape.obb.center, shape.radius, cell)
-                        : overlapsObbAabb(shape.obb, cell);
+    switch (shape.kind) {
+    case OverlapShape::Kind::Sphere:
+        return overlapsSphereAabb(shape.obb.center, shape.radius, cell);
+    case OverlapShape::Kind::Triangle:
+        return overlapsTriangleAabb(shape.triangle, cell, tol);
+    case OverlapShape::Kind::Box:
+        break;
+    }
+    return overlapsObbAabb(shape.obb, cell);
 }
 
 } // namespace hapto

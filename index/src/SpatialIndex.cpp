@@ -4,6 +4,7 @@
 #include "hapto/index/Octree.h"
 #include "hapto/index/UniformGrid.h"
 
+#include "IndexItems.h"
 #include "IndexMemory.h"
 #include "Parallel.h"
 
@@ -15,10 +16,10 @@
 
 namespace hapto {
 
-SpatialIndex::SpatialIndex(const IndexSpec& spec, const Aabb& bounds, std::uint32_t objectCount)
-    : mSpec(spec), mBounds(bounds), mObjectCount(objectCount) {
+SpatialIndex::SpatialIndex(const IndexSpec& spec, const Aabb& bounds, std::uint32_t itemCount)
+    : mSpec(spec), mBounds(bounds), mItemCount(itemCount) {
     mStats.index = spec.toString();
-    mStats.objects = objectCount;
+    mStats.objects = itemCount;
 }
 
 SpatialIndex::~SpatialIndex() = default;
@@ -40,12 +41,12 @@ Aabb partitionBounds(const Aabb& sceneBounds) {
     return b;
 }
 
-void SpatialIndex::recordOutsideObjects(const Scene& scene) {
-    const std::uint32_t count = scene.size();
+void SpatialIndex::recordOutsideObjects(const Scene& scene, std::span<const std::uint32_t> items) {
+    const std::size_t count = items.size();
     std::vector<std::uint8_t> reaches(count, 0);
     const Aabb& b = mBounds;
     parallel::forEach(0, count, 4096, [&](std::size_t i) {
-        const Aabb box = scene.object(static_cast<std::uint32_t>(i)).aabb();
+        const Aabb box = itemAabb(scene, items[i]);
         // Widened like the overlap tests, so rounding in an AABB never hides a sticking-out
         // part (a spurious entry costs one candidate, and only outside the bounds).
         const double scale =
@@ -59,9 +60,9 @@ void SpatialIndex::recordOutsideObjects(const Scene& scene) {
         reaches[i] = out;
     });
     mOutside.clear();
-    for (std::uint32_t i = 0; i < count; ++i) {
+    for (std::size_t i = 0; i < count; ++i) {
         if (reaches[i]) {
-            mOutside.push_back(i);
+            mOutside.push_back(items[i]);
         }
     }
     mOutside.shrink_to_fit();
@@ -94,14 +95,18 @@ void refuseIndexMemory(const IndexSpec& spec, std::uint64_t bytes, const std::st
 } // namespace detail
 
 std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec) {
-    const std::uint64_t count = scene.size();
+    std::uint64_t count = 0;
+    for (std::uint32_t i = 0; i < scene.itemCount(); ++i) {
+        count += scene.isIndexed(scene.item(i));
+    }
     switch (spec.kind) {
     case IndexSpec::Kind::BruteForce:
         return count * sizeof(std::uint32_t);
     case IndexSpec::Kind::Octree:
-        // Per object: Morton key, slot, shape, root flag and list entry; plus the root node.
+        // Per item: Morton key, id, shape, root flag and list entry; plus the root node; the
+        // enumeration of the items.
         return count *
-                   (sizeof(std::uint64_t) + 2 * sizeof(std::uint32_t) + sizeof(OverlapShape) + 1) +
+                   (sizeof(std::uint64_t) + 3 * sizeof(std::uint32_t) + sizeof(OverlapShape) + 1) +
                sizeof(OctreeNode);
     case IndexSpec::Kind::Grid:
         break;
@@ -111,8 +116,12 @@ std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec) {
     const Vec3 step = (b.max - b.min) / static_cast<double>(n);
     const double last = static_cast<double>(n - 1);
     std::uint64_t pairs = 0;
-    for (const SceneObject& o : scene.objects()) {
-        const Aabb box = o.aabb();
+    for (std::uint32_t i = 0; i < scene.itemCount(); ++i) {
+        const std::uint32_t item = scene.item(i);
+        if (!scene.isIndexed(item)) {
+            continue;
+        }
+        const Aabb box = itemAabb(scene, item);
         const double scale =
             std::max({std::abs(box.min.x), std::abs(box.min.y), std::abs(box.min.z),
                       std::abs(box.max.x), std::abs(box.max.y), std::abs(box.max.z)}) +
@@ -132,10 +141,10 @@ std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec) {
         pairs += cells;
     }
     const std::uint64_t cellCount = n * n * n;
-    // Cell offsets and the per-cell counts of the stats; per object its shape and pair offset;
-    // per pair the (cell, slot) sort key and the slot.
+    // Cell offsets and the per-cell counts of the stats; per item its id, shape and pair
+    // offset; per pair the (cell, item) sort key and the item.
     return (2 * cellCount + 1) * sizeof(std::uint32_t) +
-           count * (sizeof(OverlapShape) + sizeof(std::uint64_t)) +
+           count * (sizeof(std::uint32_t) + sizeof(OverlapShape) + sizeof(std::uint64_t)) +
            pairs * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
 }
 
@@ -145,8 +154,8 @@ std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& sp
         const std::string detail =
             spec.kind == IndexSpec::Kind::Grid
                 ? std::to_string(std::uint64_t(spec.gridCells) * spec.gridCells * spec.gridCells) +
-                      " cells over " + std::to_string(scene.size()) + " objects"
-                : std::to_string(scene.size()) + " objects";
+                      " cells over " + std::to_string(scene.itemCount()) + " items"
+                : std::to_string(scene.itemCount()) + " items";
         detail::refuseIndexMemory(spec, need, detail, spec.kind == IndexSpec::Kind::Octree);
     }
     switch (spec.kind) {

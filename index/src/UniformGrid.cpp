@@ -1,6 +1,7 @@
 #include "hapto/index/UniformGrid.h"
 
 #include "BuildTimer.h"
+#include "IndexItems.h"
 #include "Parallel.h"
 
 #include "hapto/scenes/InputError.h"
@@ -14,8 +15,8 @@
 namespace hapto {
 
 UniformGrid::UniformGrid(const IndexSpec& spec, const Aabb& bounds, const Vec3& step,
-                         std::uint32_t objects)
-    : SpatialIndex(spec, bounds, objects), mN(static_cast<std::uint32_t>(spec.gridCells)),
+                         std::uint32_t items)
+    : SpatialIndex(spec, bounds, items), mN(static_cast<std::uint32_t>(spec.gridCells)),
       mStep(step), mInvStep(1.0 / step) {}
 
 std::uint32_t UniformGrid::cellIndex(double v, int axis) const noexcept {
@@ -51,17 +52,19 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         }
         bounds.max[a] = sb.min[a] + static_cast<double>(n) * step[a];
     }
-    std::unique_ptr<UniformGrid> grid(new UniformGrid(spec, bounds, step, scene.size()));
-    grid->recordOutsideObjects(scene);
+    // Items are worked on by their position k in `items` (ascending ids), so sorting pairs by
+    // (cell, k) lists each cell's items ascending.
+    const std::vector<std::uint32_t> items = detail::indexedItems(scene);
+    const std::uint32_t count = static_cast<std::uint32_t>(items.size());
+    std::unique_ptr<UniformGrid> grid(new UniformGrid(spec, bounds, step, count));
+    grid->recordOutsideObjects(scene, items);
     const UniformGrid& g = *grid;
 
-    const std::uint32_t count = scene.size();
     std::vector<OverlapShape> shapes(count);
-    parallel::forEach(0, count, 4096, [&](std::size_t i) {
-        shapes[i] = OverlapShape::of(scene.object(static_cast<std::uint32_t>(i)));
-    });
+    parallel::forEach(0, count, 4096,
+                      [&](std::size_t k) { shapes[k] = OverlapShape::of(scene, items[k]); });
 
-    // The candidate cell range of an object: the cells its AABB reaches, widened by the
+    // The candidate cell range of an item: the cells its AABB reaches, widened by the
     // overlap tolerance, plus the lower neighbour when that touches a cell's lower face
     // exactly (closed cells share faces); overlaps() then decides cell by cell.
     struct Range {
@@ -82,8 +85,8 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         }
         return r;
     };
-    const auto forEachCell = [&](std::uint32_t slot, auto&& visit) {
-        const OverlapShape& s = shapes[slot];
+    const auto forEachCell = [&](std::uint32_t k, auto&& visit) {
+        const OverlapShape& s = shapes[k];
         const Range r = rangeOf(s);
         if (r.empty) {
             return;
@@ -100,7 +103,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         }
     };
 
-    // Count, then write (cell, slot) pairs, sort them by cell, and cut them into runs.
+    // Count, then write (cell, k) pairs, sort them by cell, and cut them into runs.
     std::vector<std::uint64_t> pairStart(std::size_t(count) + 1, 0);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
         std::uint64_t c = 0;
@@ -113,7 +116,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
     const std::uint64_t pairs = pairStart[count];
     if (pairs >= std::numeric_limits<std::uint32_t>::max()) {
         throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
-                         " object-cell pairs do not fit 32-bit offsets; use fewer cells");
+                         " item-cell pairs do not fit 32-bit offsets; use fewer cells");
     }
     std::vector<std::uint64_t> keys(pairs);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
@@ -122,7 +125,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
                     [&](std::uint32_t cell) { keys[k++] = (std::uint64_t(cell) << 32) | i; });
     });
     parallel::sort(keys.begin(), keys.end());
-    grid->mSlots.resize(pairs);
+    grid->mItems.resize(pairs);
     grid->mCellStart.assign(std::size_t(g.cellCount()) + 1, 0);
     for (const std::uint64_t k : keys) {
         ++grid->mCellStart[(k >> 32) + 1];
@@ -131,7 +134,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         grid->mCellStart[c + 1] += grid->mCellStart[c];
     }
     parallel::forEach(0, pairs, 65536, [&](std::size_t i) {
-        grid->mSlots[i] = static_cast<std::uint32_t>(keys[i]);
+        grid->mItems[i] = items[static_cast<std::uint32_t>(keys[i])];
     });
 
     IndexStats& st = grid->mStats;
@@ -141,7 +144,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         perCell[c] = grid->mCellStart[c + 1] - grid->mCellStart[c];
     }
     st.recordLeaves(perCell);
-    st.bytes = (grid->mCellStart.size() + grid->mSlots.size() + grid->outsideObjects().size()) *
+    st.bytes = (grid->mCellStart.size() + grid->mItems.size() + grid->outsideObjects().size()) *
                sizeof(std::uint32_t);
     st.bytesPerObject = count == 0 ? 0.0 : static_cast<double>(st.bytes) / count;
     timer.finish(st);
@@ -161,7 +164,7 @@ LocateResult UniformGrid::locateFrom(std::uint32_t, const Vec3& p, CursorStrateg
 }
 
 std::span<const std::uint32_t> UniformGrid::leafObjects(std::uint32_t cell) const noexcept {
-    return {mSlots.data() + mCellStart[cell], mCellStart[cell + 1] - mCellStart[cell]};
+    return {mItems.data() + mCellStart[cell], mCellStart[cell + 1] - mCellStart[cell]};
 }
 
 Aabb UniformGrid::leafBounds(std::uint32_t cell) const noexcept {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -110,7 +111,81 @@ std::shared_ptr<const TriangleMesh> TriangleMesh::make(std::vector<Vec3> vertice
     mesh->mTriangles = std::move(triangles);
     mesh->mVertices.shrink_to_fit();
     mesh->mTriangles.shrink_to_fit();
+    mesh->buildBvh();
     return mesh;
+}
+
+namespace {
+
+float roundDown(double v) {
+    float f = static_cast<float>(v);
+    return f > v ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+
+float roundUp(double v) {
+    float f = static_cast<float>(v);
+    return f < v ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+} // namespace
+
+void TriangleMesh::buildBvh() {
+    // Design note in the header. Per triangle, its local AABB and centroid once; then ranges of
+    // the order array are split at their median centroid (nth_element) along the longest axis
+    // of their centroids' box, depth first, so the left child is always the next node.
+    const std::uint32_t n = triangleCount();
+    std::vector<Aabb> boxes(n);
+    std::vector<Vec3> centroids(n);
+    for (std::uint32_t t = 0; t < n; ++t) {
+        const auto [a, b, c] = corners(t);
+        boxes[t] = {glm::min(glm::min(a, b), c), glm::max(glm::max(a, b), c)};
+        centroids[t] = (a + b + c) / 3.0;
+    }
+    mBvhOrder.resize(n);
+    for (std::uint32_t t = 0; t < n; ++t) {
+        mBvhOrder[t] = t;
+    }
+    mBvhNodes.clear();
+    mBvhNodes.reserve(2 * (n / kBvhLeafTriangles + 1));
+    mBvhDepth = 0;
+    // Recursion depth is the tree's, at most kBvhMaxDepth (median splits).
+    const auto build = [&](const auto& self, std::uint32_t begin, std::uint32_t end,
+                           int depth) -> void {
+        Aabb box = Aabb::empty();
+        Aabb spread = Aabb::empty();
+        for (std::uint32_t k = begin; k < end; ++k) {
+            box.expand(boxes[mBvhOrder[k]]);
+            spread.expand(centroids[mBvhOrder[k]]);
+        }
+        const std::uint32_t at = static_cast<std::uint32_t>(mBvhNodes.size());
+        MeshBvhNode node;
+        for (int a = 0; a < 3; ++a) {
+            node.min[a] = roundDown(box.min[a]);
+            node.max[a] = roundUp(box.max[a]);
+        }
+        node.first = begin;
+        node.count = end - begin;
+        mBvhNodes.push_back(node);
+        mBvhDepth = std::max(mBvhDepth, depth);
+        if (end - begin <= kBvhLeafTriangles) {
+            return;
+        }
+        const Vec3 size = spread.size();
+        const int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
+        // Half the leaves to each side, the left ones full: leaves of 4, n / 2 nodes.
+        const std::uint32_t leaves = (end - begin + kBvhLeafTriangles - 1) / kBvhLeafTriangles;
+        const std::uint32_t mid = begin + (leaves + 1) / 2 * kBvhLeafTriangles;
+        std::nth_element(mBvhOrder.begin() + begin, mBvhOrder.begin() + mid,
+                         mBvhOrder.begin() + end, [&](std::uint32_t l, std::uint32_t r) {
+                             return centroids[l][axis] < centroids[r][axis];
+                         });
+        self(self, begin, mid, depth + 1); // the left child: node at + 1
+        mBvhNodes[at].count = 0;
+        mBvhNodes[at].first = static_cast<std::uint32_t>(mBvhNodes.size());
+        self(self, mid, end, depth + 1);
+    };
+    build(build, 0, n, 0);
+    mBvhNodes.shrink_to_fit();
 }
 
 } // namespace hapto

@@ -101,3 +101,136 @@ TEST_CASE("shape geometry: separating-axis overlap never misses an overlap that 
     CHECK(overlapsSphereAabb(Vec3(1.5, 0.5, 0.5), 0.5, unit));
     CHECK_FALSE(overlapsSphereAabb(Vec3(1.6, 0.5, 0.5), 0.5, unit));
 }
+
+namespace {
+
+/// The smallest distance (m) from a grid of barycentric samples on the triangle to the box:
+/// within maxEdge / steps of the true distance, 0 when a sample lies in the box.
+double sampledDistance(const TriangleCorners& t, const Aabb& box, int steps) {
+    const Obb obb{box.center(), box.halfExtents(), Mat3(1.0)};
+    double best = 1e300;
+    for (int i = 0; i <= steps; ++i) {
+        for (int j = 0; i + j <= steps; ++j) {
+            const double u = double(i) / steps, v = double(j) / steps;
+            const Vec3 p = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
+            best = std::min(best, boxDistanceOutside(obb, p));
+        }
+    }
+    return best;
+}
+
+double longestEdge(const TriangleCorners& t) {
+    return std::max({glm::length(t[1] - t[0]), glm::length(t[2] - t[1]), glm::length(t[0] - t[2])});
+}
+
+} // namespace
+
+TEST_CASE("shape geometry: the triangle/box test agrees with sampling the triangle") {
+    Cases c;
+    constexpr int kSteps = 40;
+    int overlapsSeen = 0, separatedSeen = 0;
+    for (int n = 0; n < 3000; ++n) {
+        const Vec3 lo = c.point(0.1);
+        const Aabb box{
+            lo, lo + Vec3(c.uniform(0.001, 0.08), c.uniform(0.001, 0.08), c.uniform(0.001, 0.08))};
+        const Vec3 at = box.center() + c.point(0.08);
+        const double size = c.uniform(0.002, 0.1);
+        const TriangleCorners t{at + c.point(size), at + c.point(size), at + c.point(size)};
+        const bool sat = overlapsTriangleAabb(t, box);
+        const double d = sampledDistance(t, box, kSteps);
+        INFO("case " << n << ": sampled distance " << d);
+        if (d == 0.0) {
+            REQUIRE(sat); // a sample lies in the box: never "separated"
+        }
+        if (sat) {
+            // Exact up to the tolerance: some point of the triangle touches the box, and every
+            // point of it is within longestEdge / steps of a sample.
+            REQUIRE(d <= longestEdge(t) / kSteps + 1e-12);
+        }
+        overlapsSeen += sat;
+        separatedSeen += !sat;
+    }
+    // Both answers were exercised (the cases are fixed by the seed).
+    CHECK(overlapsSeen > 200);
+    CHECK(separatedSeen > 200);
+}
+
+TEST_CASE("shape geometry: a triangle in a face plane, touching an edge or a corner overlaps") {
+    const Aabb box{Vec3(0.0), Vec3(1.0)};
+    const double hair = 1e-6; // far above the tolerance (~1e-9 m here)
+    SECTION("in the plane of the upper z face, inside it and beside it") {
+        const TriangleCorners in{Vec3(0.2, 0.2, 1.0), Vec3(0.8, 0.2, 1.0), Vec3(0.5, 0.8, 1.0)};
+        CHECK(overlapsTriangleAabb(in, box));
+        TriangleCorners above = in;
+        for (Vec3& v : above) {
+            v.z += hair;
+        }
+        CHECK_FALSE(overlapsTriangleAabb(above, box));
+        TriangleCorners rounding = in;
+        for (Vec3& v : rounding) {
+            v.z += 1e-12; // below the tolerance: still touching
+        }
+        CHECK(overlapsTriangleAabb(rounding, box));
+        // Coplanar with the face but beside it, only an edge of the triangle on the box's edge.
+        const TriangleCorners beside{Vec3(1.0, 0.2, 1.0), Vec3(2.0, 0.2, 1.0), Vec3(1.5, 0.8, 1.0)};
+        CHECK(overlapsTriangleAabb(beside, box));
+        TriangleCorners besideApart = beside;
+        for (Vec3& v : besideApart) {
+            v.x += hair;
+        }
+        CHECK_FALSE(overlapsTriangleAabb(besideApart, box));
+    }
+    SECTION("an edge crossing a box edge: only an edge cross product separates when moved") {
+        // The edge (2,0)-(0,2) at z = 0.5 touches the box's edge x = y = 1.
+        const TriangleCorners touch{Vec3(2.0, 0.0, 0.5), Vec3(0.0, 2.0, 0.5), Vec3(2.0, 2.0, 0.5)};
+        CHECK(overlapsTriangleAabb(touch, box));
+        TriangleCorners apart = touch;
+        for (Vec3& v : apart) {
+            v += Vec3(hair, hair, 0.0);
+        }
+        // The AABBs still overlap and the triangle's plane cuts the box: the face normals and
+        // the triangle normal do not separate, the axis z x (1, -1, 0) does.
+        CHECK(overlapsAabbAabb(triangleAabb(apart), box));
+        CHECK_FALSE(overlapsTriangleAabb(apart, box));
+    }
+    SECTION("a corner touching a box corner") {
+        const TriangleCorners touch{Vec3(1.0), Vec3(2.0, 1.5, 1.2), Vec3(1.4, 2.0, 1.9)};
+        CHECK(overlapsTriangleAabb(touch, box));
+        TriangleCorners apart = touch;
+        for (Vec3& v : apart) {
+            v += Vec3(hair);
+        }
+        CHECK_FALSE(overlapsTriangleAabb(apart, box));
+    }
+    SECTION("edges parallel to box axes (null cross products) never separate by rounding") {
+        // Every edge axis with the x axis is exactly null for the first edge.
+        const TriangleCorners t{Vec3(-0.5, 0.5, 0.5), Vec3(1.5, 0.5, 0.5), Vec3(0.5, 0.5, 2.0)};
+        CHECK(overlapsTriangleAabb(t, box));
+        // A triangle lying along the box's edge x = y = 1, in the plane y = 1.
+        const TriangleCorners onEdge{Vec3(1.0, 1.0, 0.2), Vec3(1.0, 1.0, 0.8), Vec3(1.5, 1.0, 0.5)};
+        CHECK(overlapsTriangleAabb(onEdge, box));
+    }
+    SECTION("a degenerate (collinear) triangle is tested as its segment") {
+        const TriangleCorners segment{Vec3(2.0, 0.0, 0.5), Vec3(0.0, 2.0, 0.5),
+                                      Vec3(1.0, 1.0, 0.5)};
+        CHECK(overlapsTriangleAabb(segment, box));
+        TriangleCorners apart = segment;
+        for (Vec3& v : apart) {
+            v += Vec3(0.25, 0.25, 0.0);
+        }
+        CHECK_FALSE(overlapsTriangleAabb(apart, box));
+        const TriangleCorners point{Vec3(0.5), Vec3(0.5), Vec3(0.5)};
+        CHECK(overlapsTriangleAabb(point, box));
+    }
+    SECTION("the tolerance scales with the distance from the origin") {
+        const Aabb far{Vec3(1000.0), Vec3(1001.0)};
+        const TriangleCorners t{Vec3(1001.0 + 1e-7, 1000.5, 1000.5), Vec3(1002.0, 1000.2, 1000.5),
+                                Vec3(1002.0, 1000.8, 1000.5)};
+        CHECK(overlapsTriangleAabb(t, far)); // 1e-7 m apart, below 1e-9 * ~2000 m
+        TriangleCorners apart = t;
+        for (Vec3& v : apart) {
+            v.x += 1e-5;
+        }
+        CHECK_FALSE(overlapsTriangleAabb(apart, far));
+    }
+}

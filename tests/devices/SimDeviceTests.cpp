@@ -1,3 +1,5 @@
+#include "TestMeshes.h"
+
 #include "hapto/devices/DeviceFactory.h"
 #include "hapto/devices/HandModel.h"
 #include "hapto/devices/SimDevice.h"
@@ -388,6 +390,39 @@ TEST_CASE("sim: any number of devices run side by side without sharing state") {
                 REQUIRE(alone.read(a) == DeviceStatus::Ok);
                 REQUIRE(a.position == s.position);
             }
+        }
+    }
+}
+
+TEST_CASE("sim touch and slide on a mesh: pressed where its triangles are, not its bounding box") {
+    // A wavy sheet through the origin, heights within +-1 cm: its bounding box's top face is
+    // 1 cm above the sheet's centre, where the sheet itself is at height 0.
+    const Scene scene({Vec3(-0.125), Vec3(0.125)},
+                      {makeMesh(5, Vec3(0.0), test::makeWavySheet(20, 0.2, 0.01))});
+    for (const char* script : {"touch", "slide"}) {
+        INFO(script);
+        DeviceConfig c = simConfig(script, 1);
+        sim(c).object = 5;
+        SimDevice d(c, scene);
+        REQUIRE(d.open() == DeviceStatus::Ok);
+        REQUIRE(d.script()->object() == std::optional<ObjectId>(5));
+        CHECK(d.script()->contactNormal().z == Approx(1.0));
+        const double depth = sim(c).pressForceN / sim(c).handStiffness;
+        bool pressed = false;
+        for (const ScriptKeyframe& k : d.script()->keyframes()) {
+            if (k.phase == ScriptPhase::Press) {
+                pressed = true;
+                // The sheet's surface at the centre (height 0) pressed by `depth`, not the
+                // box face at 1 cm.
+                CHECK(k.target.z == Approx(-depth).margin(1e-6));
+                CHECK(std::abs(k.target.x) < 1e-6);
+                CHECK(std::abs(k.target.y) < 1e-6);
+            }
+        }
+        CHECK(pressed);
+        const std::vector<Vec3> path = run(d, 8000); // free hand: the plan runs to its end
+        for (const Vec3& p : path) {
+            REQUIRE(std::isfinite(p.x + p.y + p.z));
         }
     }
 }

@@ -1,6 +1,8 @@
 #pragma once
 /// Scenes, index specs and query points shared by the index tests: random, clustered and
-/// lattice scenes, and one full of degenerate objects.
+/// lattice scenes, one full of degenerate objects, and one with meshes among boxes and spheres.
+
+#include "TestMeshes.h"
 
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/scenes/Generators.h"
@@ -57,6 +59,31 @@ inline Scene makeDegenerateScene() {
     return Scene({Vec3(-0.125), Vec3(0.125)}, std::move(o));
 }
 
+/// Boxes and spheres with two meshes among them (a closed icosphere of 1280 triangles and an
+/// open wavy sheet of 512, both rotated; a small icosphere partly outside the bounds), so
+/// object slots and triangle items mix and the meshes' own slots are not indexed.
+inline Scene makeMeshScene() {
+    std::vector<SceneObject> o;
+    Random rng(23);
+    ObjectId id = 1;
+    for (int i = 0; i < 20; ++i) {
+        const Vec3 c(rng.uniform(-0.11, 0.11), rng.uniform(-0.11, 0.11), rng.uniform(-0.11, 0.11));
+        o.push_back(makeBox(id++, c, Vec3(rng.uniform(0.002, 0.01)),
+                            glm::angleAxis(rng.uniform(0, 3), glm::normalize(Vec3(1, 2, 3)))));
+    }
+    o.push_back(makeMesh(id++, Vec3(0.02, -0.01, 0.0), test::makeIcosphere(3, 0.06),
+                         glm::angleAxis(0.4, glm::normalize(Vec3(1, -1, 2)))));
+    for (int i = 0; i < 10; ++i) {
+        const Vec3 c(rng.uniform(-0.11, 0.11), rng.uniform(-0.11, 0.11), rng.uniform(-0.11, 0.11));
+        o.push_back(makeSphere(id++, c, rng.uniform(0.002, 0.02)));
+    }
+    o.push_back(makeMesh(id++, Vec3(0.0, 0.0, -0.08), test::makeWavySheet(16, 0.2, 0.01),
+                         glm::angleAxis(0.3, glm::normalize(Vec3(1, 0, 0)))));
+    o.push_back(makeMesh(id++, Vec3(0.12, 0.12, 0.0), test::makeIcosphere(1, 0.02)));
+    o.push_back(makeBox(id++, Vec3(0.0), Vec3(0.0625))); // faces on octree cell faces
+    return Scene({Vec3(-0.125), Vec3(0.125)}, std::move(o));
+}
+
 /// The scenes every index test runs over.
 inline std::vector<std::pair<std::string, Scene>> testScenes() {
     std::vector<std::pair<std::string, Scene>> s;
@@ -84,6 +111,7 @@ inline std::vector<std::pair<std::string, Scene>> testScenes() {
     l.gap = 0.01; // the paper's experiment 1
     s.emplace_back("lattice paper", makeLatticeScene(l));
     s.emplace_back("degenerate", makeDegenerateScene());
+    s.emplace_back("meshes", makeMeshScene());
     return s;
 }
 
@@ -160,6 +188,19 @@ inline std::vector<Vec3> queryPoints(const Scene& scene, std::uint64_t seed, int
         p.push_back(o.center + o.axes[0] * o.halfExtents.x);
         p.push_back(o.center);
     }
+    // Triangle corners, edge midpoints and points inside triangles: on mesh surfaces.
+    for (std::uint32_t i = 0, used = 0; i < scene.itemCount() && used < 600; ++i) {
+        const std::uint32_t item = scene.item(i);
+        if (!isTriangleItem(item) || rng.uniform() > 0.3) {
+            continue;
+        }
+        ++used;
+        const auto [a, b, c] = scene.triangleCorners(item);
+        p.push_back(a);
+        p.push_back(0.5 * (a + b));
+        const double u = rng.uniform(), v = rng.uniform() * (1.0 - u);
+        p.push_back(a + u * (b - a) + v * (c - a));
+    }
     // Outside.
     p.emplace_back(b.max.x + 1e-3, b.center().y, b.center().z);
     p.emplace_back(b.min.x - 1e-9, b.min.y, b.min.z);
@@ -169,33 +210,60 @@ inline std::vector<Vec3> queryPoints(const Scene& scene, std::uint64_t seed, int
     return p;
 }
 
-/// The ground truth: which objects' solids hold a point (SceneObject::contains, after a
-/// slightly widened AABB reject so it stays fast).
+/// The ground truth: which items hold a point: a box's or sphere's solid
+/// (SceneObject::contains), a triangle's own points (the exact triangle test against the point
+/// as a box, no tolerance); each after a slightly widened AABB reject so it stays fast. A mesh
+/// object's slot is no item (its triangles are).
 class Containment {
 public:
     explicit Containment(const Scene& scene) : mScene(scene) {
-        for (const SceneObject& o : scene.objects()) {
-            Aabb b = o.aabb();
+        for (std::uint32_t i = 0; i < scene.itemCount(); ++i) {
+            const std::uint32_t item = scene.item(i);
+            if (!scene.isIndexed(item)) {
+                continue;
+            }
+            Aabb b = isTriangleItem(item) ? triangleAabb(scene.triangleCorners(item))
+                                          : scene.object(item).aabb();
             b.min -= Vec3(1e-9);
             b.max += Vec3(1e-9);
+            mItems.push_back(item);
             mBoxes.push_back(b);
         }
     }
-    /// Slots of the objects holding p, ascending.
+    /// The items holding p, ascending.
     std::vector<std::uint32_t> operator()(const Vec3& p) const {
-        std::vector<std::uint32_t> slots;
-        for (std::uint32_t s = 0; s < mScene.size(); ++s) {
-            if (mBoxes[s].contains(p) && mScene.object(s).contains(p)) {
-                slots.push_back(s);
+        std::vector<std::uint32_t> items;
+        for (std::size_t k = 0; k < mItems.size(); ++k) {
+            if (!mBoxes[k].contains(p)) {
+                continue;
+            }
+            const std::uint32_t item = mItems[k];
+            if (isTriangleItem(item)
+                    ? overlapsTriangleAabb(mScene.triangleCorners(item), {p, p}, 0.0)
+                    : mScene.object(item).contains(p)) {
+                items.push_back(item);
             }
         }
-        return slots;
+        return items;
     }
 
 private:
     const Scene& mScene;
+    std::vector<std::uint32_t> mItems;
     std::vector<Aabb> mBoxes;
 };
+
+/// Every indexed item's bounds, prepared like the builders do, with its item id.
+inline std::vector<std::pair<std::uint32_t, OverlapShape>> itemShapes(const Scene& scene) {
+    std::vector<std::pair<std::uint32_t, OverlapShape>> shapes;
+    for (std::uint32_t i = 0; i < scene.itemCount(); ++i) {
+        const std::uint32_t item = scene.item(i);
+        if (scene.isIndexed(item)) {
+            shapes.emplace_back(item, OverlapShape::of(scene, item));
+        }
+    }
+    return shapes;
+}
 
 /// True when every element of `needles` (sorted) is in `haystack` (sorted).
 inline bool includesAll(std::span<const std::uint32_t> haystack,

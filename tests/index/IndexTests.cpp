@@ -13,7 +13,7 @@
 using namespace hapto;
 using namespace hapto::test;
 
-TEST_CASE("every object holding the query point is a candidate: every index, mode, strategy") {
+TEST_CASE("every item holding the query point is a candidate: every index, mode, strategy") {
     for (const auto& [name, scene] : testScenes()) {
         const std::vector<Vec3> points = queryPoints(scene, 3, 1500);
         const Containment containing(scene);
@@ -51,8 +51,8 @@ TEST_CASE("every object holding the query point is a candidate: every index, mod
                         ok = ok && includesAll(r.candidates, want[i]) &&
                              includesAll(fresh.candidates, want[i]);
                     } else if (spec.kind == IndexSpec::Kind::BruteForce) {
-                        // The standard renderer tests every object, in the bounds or not.
-                        ok = ok && r.candidates.size() == scene.size() && r.leaf == kNoLeaf;
+                        // The standard renderer tests every item, in the bounds or not.
+                        ok = ok && r.candidates.size() == index->itemCount() && r.leaf == kNoLeaf;
                     } else {
                         // Outside: the objects reaching outside the bounds, which include every
                         // object holding the point (index ⊇ brute force out here too).
@@ -75,12 +75,9 @@ TEST_CASE("every object holding the query point is a candidate: every index, mod
     }
 }
 
-TEST_CASE("a grid cell holds exactly the objects overlapping it (brute-force check)") {
+TEST_CASE("a grid cell holds exactly the items overlapping it (brute-force check)") {
     for (const auto& [name, scene] : testScenes()) {
-        std::vector<OverlapShape> shapes;
-        for (const SceneObject& o : scene.objects()) {
-            shapes.push_back(OverlapShape::of(o));
-        }
+        const auto shapes = itemShapes(scene);
         for (const IndexSpec& spec : {IndexSpec::grid(1), IndexSpec::grid(7),
                                       IndexSpec::grid(7, OverlapMode::Aabb), IndexSpec::grid(16)}) {
             INFO(name << " " << spec.toString());
@@ -89,9 +86,9 @@ TEST_CASE("a grid cell holds exactly the objects overlapping it (brute-force che
             for (std::uint32_t cell = 0; cell < grid->cellCount(); ++cell) {
                 const Aabb box = grid->leafBounds(cell);
                 std::vector<std::uint32_t> want;
-                for (std::uint32_t s = 0; s < scene.size(); ++s) {
-                    if (overlaps(shapes[s], box, spec.mode)) {
-                        want.push_back(s);
+                for (const auto& [item, shape] : shapes) {
+                    if (overlaps(shape, box, spec.mode)) {
+                        want.push_back(item);
                     }
                 }
                 const auto got = grid->leafObjects(cell);
@@ -111,12 +108,9 @@ TEST_CASE("a grid cell holds exactly the objects overlapping it (brute-force che
     }
 }
 
-TEST_CASE("octree leaves hold at most M objects unless at minimum size, exactly the overlapping") {
+TEST_CASE("octree leaves hold at most M items unless at minimum size, exactly the overlapping") {
     for (const auto& [name, scene] : testScenes()) {
-        std::vector<OverlapShape> shapes;
-        for (const SceneObject& o : scene.objects()) {
-            shapes.push_back(OverlapShape::of(o));
-        }
+        const auto shapes = itemShapes(scene);
         for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001),
                                       IndexSpec::octree(5, 0.005, OverlapMode::Aabb)}) {
             INFO(name << " " << spec.toString());
@@ -139,9 +133,9 @@ TEST_CASE("octree leaves hold at most M objects unless at minimum size, exactly 
                     ++overfull;
                 }
                 std::vector<std::uint32_t> want;
-                for (std::uint32_t s = 0; s < scene.size(); ++s) {
-                    if (overlaps(shapes[s], box, spec.mode)) {
-                        want.push_back(s);
+                for (const auto& [item, shape] : shapes) {
+                    if (overlaps(shape, box, spec.mode)) {
+                        want.push_back(item);
                     }
                 }
                 const auto got = tree->leafObjects(i);
@@ -301,6 +295,59 @@ TEST_CASE("an index that would exceed its memory limit is refused before it is b
                 INFO(name << " " << spec.toString());
                 CHECK(index->stats().bytes <= estimateIndexBytes(s, spec));
             }
+        }
+    }
+}
+
+TEST_CASE("a mesh's triangles, not the mesh object, are the index's items") {
+    const Scene scene = makeMeshScene();
+    std::vector<std::uint32_t> indexed;
+    std::uint32_t meshes = 0;
+    for (std::uint32_t i = 0; i < scene.itemCount(); ++i) {
+        if (scene.isIndexed(scene.item(i))) {
+            indexed.push_back(scene.item(i));
+        }
+        meshes += i < scene.size() && scene.object(i).shape == Shape::Mesh;
+    }
+    REQUIRE(meshes == 3);
+    REQUIRE(indexed.size() == scene.itemCount() - meshes);
+    const auto brute = buildIndex(scene, IndexSpec::brute());
+    const auto all = brute->locate(Vec3(0.0)).candidates;
+    CHECK(std::vector<std::uint32_t>(all.begin(), all.end()) == indexed);
+    for (const IndexSpec& spec : testSpecs()) {
+        INFO(spec.toString());
+        const auto index = buildIndex(scene, spec);
+        CHECK(index->itemCount() == indexed.size());
+        CHECK(index->stats().objects == indexed.size());
+        // No mesh slot in any leaf; every triangle in some leaf (they all lie in the bounds
+        // but the small sphere's, which may be listed outside only).
+        std::vector<std::uint8_t> seen(scene.itemCount(), 0);
+        const auto mark = [&](std::span<const std::uint32_t> items) {
+            for (const std::uint32_t item : items) {
+                CHECK(scene.isIndexed(item));
+                seen[isTriangleItem(item) ? scene.size() + (item & ~kTriangleItemBit) : item] = 1;
+            }
+        };
+        for (std::uint64_t leaf = 0; leaf < index->stats().nodes; ++leaf) {
+            if (spec.kind != IndexSpec::Kind::Octree ||
+                static_cast<const Octree&>(*index).nodes()[leaf].isLeaf()) {
+                mark(index->leafObjects(static_cast<std::uint32_t>(leaf)));
+            }
+        }
+        mark(index->outsideObjects());
+        std::size_t missing = 0;
+        for (const std::uint32_t item : indexed) {
+            missing +=
+                !seen[isTriangleItem(item) ? scene.size() + (item & ~kTriangleItemBit) : item];
+        }
+        CHECK(missing == 0);
+        // A point on a triangle finds that triangle; the item names its mesh and triangle.
+        for (std::uint32_t n = 0; n < scene.triangleCount(); n += 97) {
+            const std::uint32_t item = kTriangleItemBit | n;
+            const auto [a, b, c] = scene.triangleCorners(item);
+            const LocateResult r = index->locate((a + b + c) / 3.0);
+            CHECK(std::binary_search(r.candidates.begin(), r.candidates.end(), item));
+            CHECK(scene.object(scene.objectSlotOf(item)).shape == Shape::Mesh);
         }
     }
 }

@@ -23,6 +23,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 namespace hapto::cli {
@@ -103,12 +104,20 @@ void runQuery(const std::string& scenePath, const std::string& specText,
     std::ostream& out = file ? file->stream() : std::cout;
     std::string text = "point,candidates\n";
     Cursor cursor(*index);
-    std::vector<ObjectId> ids;
+    // A candidate is an object id, or for a mesh triangle "id:triangle" (its mesh's id and its
+    // number in that mesh); sorted by id, then triangle (the object itself first).
+    constexpr std::int64_t kWholeObject = -1;
+    std::vector<std::pair<ObjectId, std::int64_t>> ids;
     for (std::size_t i = 0; i < points.size(); ++i) {
         const LocateResult r = cursor.locate(points[i]);
         ids.clear();
-        for (const std::uint32_t slot : r.candidates) {
-            ids.push_back(scene.object(slot).id);
+        for (const std::uint32_t item : r.candidates) {
+            if (isTriangleItem(item)) {
+                const TriangleRef t = scene.triangle(item);
+                ids.emplace_back(scene.object(t.objectSlot).id, t.triangle);
+            } else {
+                ids.emplace_back(scene.object(item).id, kWholeObject);
+            }
         }
         std::sort(ids.begin(), ids.end());
         text += std::to_string(i);
@@ -117,7 +126,11 @@ void runQuery(const std::string& scenePath, const std::string& specText,
             if (k > 0) {
                 text += ' ';
             }
-            text += std::to_string(ids[k]);
+            text += std::to_string(ids[k].first);
+            if (ids[k].second != kWholeObject) {
+                text += ':';
+                text += std::to_string(ids[k].second);
+            }
         }
         text += '\n';
         if (text.size() > (1u << 20)) {
@@ -201,7 +214,7 @@ void addIndexCommands(CLI::App& app) {
     {
         auto* cmd = app.add_subcommand(
             "query", "Build an index and list each point's candidate object ids as CSV "
-                     "(point,candidates)");
+                     "(point,candidates; a mesh triangle as ID:TRIANGLE)");
         auto scene = std::make_shared<std::string>();
         auto spec = std::make_shared<std::string>();
         auto points = std::make_shared<std::string>();

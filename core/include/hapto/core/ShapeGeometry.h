@@ -13,6 +13,8 @@
 
 #include "hapto/core/Geometry.h"
 
+#include <array>
+
 namespace hapto {
 
 /// Relative tolerance of every overlap test: separation must exceed this times the sizes and
@@ -61,5 +63,20 @@ bool overlapsObbAabb(const Obb& box, const Aabb& cell) noexcept;
 bool overlapsSphereAabb(const Vec3& center, double radius, const Aabb& cell) noexcept;
 /// Closed AABB/AABB test widened by the tolerance. [any thread]
 bool overlapsAabbAabb(const Aabb& a, const Aabb& b) noexcept;
+
+/// The corners of a triangle (m), in the frame the caller works in.
+using TriangleCorners = std::array<Vec3, 3>;
+/// The tightest AABB of a triangle (m). [any thread]
+Aabb triangleAabb(const TriangleCorners& t) noexcept;
+/// Exact triangle/box separating-axis test (Akenine-Moeller 2001, "Fast 3D triangle-box
+/// overlap testing"): the box's three face normals, the triangle's normal and the nine cross
+/// products of box axes and triangle edges. Each axis L separates only by more than
+/// `toleranceM` * |L|, so a nearly null cross product (an edge almost parallel to a box axis)
+/// never separates by rounding, and a degenerate triangle is tested by its remaining axes.
+/// Conservative like the box tests: overlapToleranceFor(aabbScale(triangleAabb(t)),
+/// aabbScale(box)) is the tolerance of the overload without one. [any thread]
+bool overlapsTriangleAabb(const TriangleCorners& t, const Aabb& box, double toleranceM) noexcept;
+/// The same, with the scaled tolerance of every overlap test here. [any thread]
+bool overlapsTriangleAabb(const TriangleCorners& t, const Aabb& box) noexcept;
 
 } // namespace hapto

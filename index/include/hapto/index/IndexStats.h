@@ -19,7 +19,9 @@ struct IndexStats {
     };
 
     std::string index;                     ///< The spec, as IndexSpec::toString() writes it.
-    std::uint32_t objects = 0;             ///< Objects in the scene.
+    std::uint32_t objects = 0;             ///< Items indexed: boxes, spheres and mesh
+                                           ///< triangles (Scene::isIndexed); the "objects"
+                                           ///< of every leaf count below are items too.
     std::uint64_t nodes = 0;               ///< Octree nodes; grid cells; 1 for brute force.
     std::uint64_t leaves = 0;              ///< Leaves (grid: cells).
     std::uint64_t emptyLeaves = 0;         ///< Leaves holding no object.
@@ -32,7 +34,8 @@ struct IndexStats {
     std::uint64_t outsideObjects = 0;      ///< Objects reaching outside the bounds (grid and
                                            ///< octree: the candidates of outside points).
     std::uint64_t bytes = 0;               ///< Memory of the index's arrays (bytes).
-    double bytesPerObject = 0.0;           ///< bytes / objects.
+    double bytesPerObject = 0.0;           ///< bytes / objects (per item: a mesh's memory
+                                           ///< per triangle).
     double buildSeconds = 0.0;             ///< Wall-clock build time (s).
     double buildCpuSeconds = 0.0;          ///< CPU time of all threads during the build (s).
 

@@ -26,8 +26,8 @@ struct OctreeNode {
     /// Per face: the adjacent node of equal size, else the smallest larger node covering the
     /// face; kNoNode outside the bounds.
     std::array<std::uint32_t, 6> neighbours{kNoNode, kNoNode, kNoNode, kNoNode, kNoNode, kNoNode};
-    std::uint32_t firstSlot = 0; ///< Leaf: its objects are slots()[firstSlot, +slotCount).
-    std::uint32_t slotCount = 0; ///< Leaf: number of objects.
+    std::uint32_t firstSlot = 0; ///< Leaf: its items are slots()[firstSlot, +slotCount).
+    std::uint32_t slotCount = 0; ///< Leaf: number of items.
     std::array<std::uint32_t, 3> cell{0, 0, 0}; ///< Integer coordinates at this level.
     std::uint8_t level = 0;                     ///< Root 0.
     std::uint8_t atMinimumSize = 0; ///< 1 when halving it would go below the minimum size.
@@ -38,8 +38,9 @@ struct OctreeNode {
 };
 static_assert(sizeof(OctreeNode) == 56, "octree nodes are 56 bytes; update the note if not");
 
-/// A leaf holds at most M objects unless it reached the minimum size; each object is listed
-/// in every leaf its bounds overlap. Nodes are stored breadth first, eight siblings together.
+/// A leaf holds at most M items unless it reached the minimum size; each item (a box, a sphere
+/// or a mesh triangle) is listed in every leaf its bounds overlap. Nodes are stored breadth first,
+/// eight siblings together.
 class Octree final : public SpatialIndex {
 public:
     /// Deepest level a node may have (cells of size / 2^20).
@@ -55,7 +56,7 @@ public:
     /// The leaf holding the point, walking from `leaf` with the strategy. [servo]
     LocateResult locateFrom(std::uint32_t leaf, const Vec3& point,
                             CursorStrategy strategy) const noexcept override;
-    /// The objects of a leaf node (slots, ascending). [servo]
+    /// The items of a leaf node, ascending. [servo]
     std::span<const std::uint32_t> leafObjects(std::uint32_t node) const noexcept override;
     /// The closed box of any node (m). [servo]
     Aabb leafBounds(std::uint32_t node) const noexcept override { return nodeBounds(node); }
@@ -64,7 +65,7 @@ public:
     Aabb nodeBounds(std::uint32_t node) const noexcept;
     /// All nodes, breadth first; node 0 is the root. [any thread]
     std::span<const OctreeNode> nodes() const noexcept { return mNodes; }
-    /// Every leaf's objects, each leaf one contiguous run. [any thread]
+    /// Every leaf's items, each leaf one contiguous run. [any thread]
     std::span<const std::uint32_t> slots() const noexcept { return mSlots; }
     /// The neighbour of a node across a face, or kNoNode. [servo]
     std::uint32_t neighbour(std::uint32_t node, Face face) const noexcept {
@@ -75,7 +76,7 @@ public:
     bool holds(std::uint32_t node, const Vec3& point) const noexcept;
 
 private:
-    Octree(const IndexSpec& spec, const Aabb& bounds, std::uint32_t objects);
+    Octree(const IndexSpec& spec, const Aabb& bounds, std::uint32_t items);
     double coord(int level, std::uint32_t i, int axis) const noexcept {
         return bounds().min[axis] + static_cast<double>(i) * mStep[level][axis];
     }
@@ -84,7 +85,7 @@ private:
     LocateResult descend(std::uint32_t node, const Vec3& p, std::uint32_t steps) const noexcept;
     LocateResult climb(std::uint32_t leaf, const Vec3& p) const noexcept;
     LocateResult followLinks(std::uint32_t leaf, const Vec3& p) const noexcept;
-    void buildNodes(const Scene& scene);
+    void buildNodes(const Scene& scene, std::span<const std::uint32_t> items);
 
     std::array<Vec3, kMaxDepth + 2> mStep{}; // cell size per level (m)
     std::vector<OctreeNode> mNodes;

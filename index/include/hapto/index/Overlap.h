@@ -1,6 +1,6 @@
 #pragma once
-/// Conservative overlap tests between object bounds and index cells, over the separating-axis
-/// tests of hapto/core/ShapeGeometry.h.
+/// Conservative overlap tests between index items' bounds (boxes, spheres, triangles) and cells,
+/// over the separating-axis tests of hapto/core/ShapeGeometry.h.
 ///
 /// Every test here may say "overlap" for a pair that is separated by a hair (a tolerance scaled
 /// to the sizes and positions involved), and never says "separated" for a pair that overlaps:
@@ -9,6 +9,7 @@
 
 #include "hapto/core/Geometry.h"
 #include "hapto/core/ShapeGeometry.h"
+#include "hapto/scenes/Scene.h"
 #include "hapto/scenes/SceneObject.h"
 
 #include <cstdint>
@@ -18,17 +19,38 @@ namespace hapto {
 /// Which bounds place objects into cells: the tight oriented box, or the world AABB.
 enum class OverlapMode : std::uint8_t { Obb, Aabb };
 
-/// An object's bounds, prepared once for many cell tests.
+/// An index item's bounds (a box, a sphere or a mesh triangle), prepared once for many cell
+/// tests.
 struct OverlapShape {
-    Obb obb;             ///< A box's oriented box; a sphere's axis-aligned cube.
-    Aabb aabb;           ///< The tightest world AABB (m).
-    double radius = 0.0; ///< Sphere radius (m); 0 for a box.
-    double scale = 0.0;  ///< Largest |centre| coordinate plus largest half extent (m).
-    bool sphere = false; ///< True for a sphere (exact sphere/box test in Obb mode).
+    /// What the bounds are.
+    enum class Kind : std::uint8_t { Box, Sphere, Triangle };
 
-    /// Prepares an object's bounds. [any thread]
+    union {
+        Obb obb{};                ///< Box: its oriented box; sphere: its axis-aligned cube.
+        TriangleCorners triangle; ///< Triangle: its world corners (m).
+    };
+    Aabb aabb;             ///< The tightest world AABB (m).
+    double radius = 0.0;   ///< Sphere radius (m); 0 otherwise.
+    double scale = 0.0;    ///< Box, sphere: largest |centre| coordinate plus largest half
+                           ///< extent; triangle: aabbScale of its AABB (m).
+    Kind kind = Kind::Box; ///< Which member of the union holds the bounds.
+
+    /// Prepares a box's or sphere's bounds (not a mesh's: its triangles are the items).
+    /// [any thread]
     static OverlapShape of(const SceneObject& object);
+    /// Prepares a triangle's bounds from its world corners (m). [any thread]
+    static OverlapShape ofTriangle(const TriangleCorners& corners) noexcept;
+    /// Prepares an index item's bounds (Scene.h: an object slot or a triangle item); the item
+    /// must be indexed (scene.isIndexed). [any thread]
+    static OverlapShape of(const Scene& scene, std::uint32_t item);
 };
+static_assert(sizeof(OverlapShape) == 192, "per-item build memory; update estimateIndexBytes");
+
+/// An index item's tightest world AABB (m): a triangle item's corners' box, an object slot's
+/// SceneObject::aabb(). What a consumer of candidates tests first. [any thread]
+Aabb itemAabb(const Scene& scene, std::uint32_t item) noexcept;
+/// An index item's centre (m): a triangle's centroid, an object's centre. [any thread]
+Vec3 itemCenter(const Scene& scene, std::uint32_t item) noexcept;
 
 /// A cell prepared once for many object tests.
 struct OverlapCell {
@@ -42,9 +64,10 @@ struct OverlapCell {
 // The separating-axis tests themselves (overlapsObbObb, overlapsObbAabb, overlapsSphereAabb,
 // overlapsAabbAabb) and their tolerances live in hapto/core/ShapeGeometry.h.
 
-/// Whether an object's bounds overlap a cell. Aabb mode: its world AABB. Obb mode: its AABB
-/// and then its OBB (boxes) or exact sphere (spheres), so Obb mode never places an object in
-/// a cell that Aabb mode leaves out. [any thread]
+/// Whether an item's bounds overlap a cell. Aabb mode: its world AABB. Obb mode: its AABB
+/// and then its OBB (boxes), exact sphere (spheres) or exact triangle (the 13-axis test of
+/// overlapsTriangleAabb), so Obb mode never places an item in a cell that Aabb mode leaves
+/// out. [any thread]
 bool overlaps(const OverlapShape& shape, const Aabb& cell, OverlapMode mode) noexcept;
 /// The same, for a prepared cell. [any thread]
 bool overlaps(const OverlapShape& shape, const OverlapCell& cell, OverlapMode mode) noexcept;

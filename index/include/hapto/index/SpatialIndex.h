@@ -3,7 +3,8 @@
 ///
 /// An index is built once on a control thread and never changes afterwards: every query is
 /// `const`, allocates nothing, and is safe from any number of threads at once. Queries hand
-/// back candidate *slots* (positions in `scene.objects()`), never copies.
+/// back candidate *items* (Scene.h: the slot of a box or sphere, or `kTriangleItemBit | n` for
+/// a mesh triangle; `scene.objectSlotOf(item)` names the object), never copies.
 
 #include "hapto/index/IndexSpec.h"
 #include "hapto/index/IndexStats.h"
@@ -31,12 +32,12 @@ inline constexpr std::uint32_t kNoLeaf = 0xFFFFFFFFu;
 
 /// The answer to "which objects may touch this point".
 struct LocateResult {
-    std::span<const std::uint32_t> candidates; ///< Slots of the leaf's objects, ascending.
+    std::span<const std::uint32_t> candidates; ///< The leaf's items, ascending.
     std::uint32_t leaf = kNoLeaf;              ///< Octree node, grid cell, or 0 (brute force).
     std::uint32_t steps = 0; ///< Links followed (parent, child, neighbour) to get there.
     bool outside = true;     ///< The point is outside the bounds: the candidates are then the
-                             ///< objects that reach outside them (SpatialIndex::outsideObjects;
-                             ///< BruteForce: every object, as everywhere).
+                             ///< items that reach outside them (SpatialIndex::outsideObjects;
+                             ///< BruteForce: every item, as everywhere).
 };
 
 /// An index that would need more memory than its spec allows (IndexSpec::maxBytes). Bad input:
@@ -61,13 +62,14 @@ public:
     /// The partitioned box, closed: the scene bounds, upper faces moved out by at most a few
     /// ulps so that cell boundaries are exact (m). [any thread]
     const Aabb& bounds() const noexcept { return mBounds; }
-    /// Number of objects in the scene it was built for. [any thread]
-    std::uint32_t objectCount() const noexcept { return mObjectCount; }
+    /// Number of items it holds: the scene's indexed items (boxes, spheres and mesh triangles;
+    /// Scene::isIndexed) when it was built. [any thread]
+    std::uint32_t itemCount() const noexcept { return mItemCount; }
     /// True when the point lies in the closed bounds (false for NaN). [servo]
     bool inBounds(const Vec3& point) const noexcept;
-    /// The objects (slots, ascending) whose bounds reach outside the index's bounds, found at
-    /// build time: the candidates of every point outside the bounds, so a hand inside the part
-    /// of an object that sticks out still feels it. [servo]
+    /// The items (ascending) whose bounds reach outside the index's bounds, found at build
+    /// time: the candidates of every point outside the bounds, so a hand inside the part of an
+    /// object that sticks out still feels it. [servo]
     std::span<const std::uint32_t> outsideObjects() const noexcept { return mOutside; }
 
     /// The leaf holding the point, found from the root. [servo]
@@ -75,28 +77,29 @@ public:
     /// The leaf holding the point, found from a previous leaf with a strategy. [servo]
     virtual LocateResult locateFrom(std::uint32_t leaf, const Vec3& point,
                                     CursorStrategy strategy) const noexcept = 0;
-    /// The objects of a leaf (slots, ascending). [servo]
+    /// The items of a leaf, ascending. [servo]
     virtual std::span<const std::uint32_t> leafObjects(std::uint32_t leaf) const noexcept = 0;
     /// The closed box of a leaf (m). A point belongs to the leaf whose box holds it, with
     /// ties on shared faces going to the upper leaf. [servo]
     virtual Aabb leafBounds(std::uint32_t leaf) const noexcept = 0;
 
 protected:
-    /// Sets the spec, the bounds and the object count. [control]
-    SpatialIndex(const IndexSpec& spec, const Aabb& bounds, std::uint32_t objectCount);
+    /// Sets the spec, the bounds and the item count. [control]
+    SpatialIndex(const IndexSpec& spec, const Aabb& bounds, std::uint32_t itemCount);
 
-    /// Fills outsideObjects() from the scene (after the bounds are final). [control]
-    void recordOutsideObjects(const Scene& scene);
+    /// Fills outsideObjects() from the scene's indexed items (ascending), after the bounds
+    /// are final. [control]
+    void recordOutsideObjects(const Scene& scene, std::span<const std::uint32_t> items);
     /// The answer for a point outside the bounds: outsideObjects(), no leaf. [servo]
     LocateResult outsideResult() const noexcept { return {mOutside, kNoLeaf, 0, true}; }
 
     IndexStats mStats; ///< Filled by the builder.
 
 private:
-    std::vector<std::uint32_t> mOutside; // slots reaching outside the bounds, ascending
+    std::vector<std::uint32_t> mOutside; // items reaching outside the bounds, ascending
     IndexSpec mSpec;
     Aabb mBounds;
-    std::uint32_t mObjectCount;
+    std::uint32_t mItemCount;
 };
 
 /// Builds the index a spec asks for (in parallel, with TBB). Throws InputError for a spec
@@ -106,10 +109,11 @@ private:
 std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec);
 
 /// The memory a build of this index needs at its peak (bytes), estimated without building it:
-/// brute force exactly; the grid from its cells and, per object, the cells its AABB reaches
-/// (an upper bound on the object-cell pairs: the OBB test only removes some); the octree only
-/// its floor (the per-object arrays), since its node count is known only while it is built:
-/// Octree::build checks spec.maxBytes again before allocating each level. O(objects). [control]
+/// brute force exactly; the grid from its cells and, per item, the cells its AABB reaches
+/// (an upper bound on the item-cell pairs: the OBB and triangle tests only remove some); the
+/// octree only its floor (the per-item arrays), since its node count is known only while it is
+/// built: Octree::build checks spec.maxBytes again before allocating each level. O(items).
+/// [control]
 std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec);
 
 /// The bounds an index partitions: the scene's, each upper face moved out by the few ulps

@@ -1,5 +1,5 @@
 #pragma once
-/// The paper's uniform n x n x n grid (section 2.1): O(1) lookup, each cell's objects one run.
+/// The paper's uniform n x n x n grid (section 2.1): O(1) lookup, each cell's items one run.
 
 #include "hapto/index/SpatialIndex.h"
 
@@ -9,7 +9,8 @@
 
 namespace hapto {
 
-/// n^3 equal cells over the bounds; each object is listed in every cell its bounds overlap.
+/// n^3 equal cells over the bounds; each item (a box, a sphere or a mesh triangle) is listed in
+/// every cell its bounds overlap.
 /// Cell (ix, iy, iz) has id (iz * n + iy) * n + ix and spans [min + i * step, min + (i+1) *
 /// step] per axis, computed by that one formula everywhere, so shared faces are exact.
 class UniformGrid final : public SpatialIndex {
@@ -22,7 +23,7 @@ public:
     /// Same as locate (the grid needs no walk). [servo]
     LocateResult locateFrom(std::uint32_t leaf, const Vec3& point,
                             CursorStrategy strategy) const noexcept override;
-    /// The objects of a cell (slots, ascending). [servo]
+    /// The items of a cell, ascending. [servo]
     std::span<const std::uint32_t> leafObjects(std::uint32_t cell) const noexcept override;
     /// The closed box of a cell (m). [servo]
     Aabb leafBounds(std::uint32_t cell) const noexcept override;
@@ -39,7 +40,7 @@ public:
     std::uint32_t cellIndex(double v, int axis) const noexcept;
 
 private:
-    UniformGrid(const IndexSpec& spec, const Aabb& bounds, const Vec3& step, std::uint32_t objects);
+    UniformGrid(const IndexSpec& spec, const Aabb& bounds, const Vec3& step, std::uint32_t items);
     double coord(std::uint32_t i, int axis) const noexcept {
         return bounds().min[axis] + static_cast<double>(i) * mStep[axis];
     }
@@ -47,8 +48,8 @@ private:
     std::uint32_t mN;
     Vec3 mStep{0.0};
     Vec3 mInvStep{0.0};
-    std::vector<std::uint32_t> mCellStart; // n^3 + 1 offsets into mSlots (CSR)
-    std::vector<std::uint32_t> mSlots;
+    std::vector<std::uint32_t> mCellStart; // n^3 + 1 offsets into mItems (CSR)
+    std::vector<std::uint32_t> mItems;
 };
 
 } // namespace hapto

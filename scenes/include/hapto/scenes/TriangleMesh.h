@@ -29,10 +29,26 @@ struct MeshSource {
     double scale = 1.0; ///< The uniform scale applied to the file's or inline coordinates.
 };
 
+/// One node of a mesh's local BVH (32 bytes): float bounds rounded outwards, and either two
+/// children (the left one is the next node, depth first) or a run of triangles.
+struct MeshBvhNode {
+    std::array<float, 3> min{}; ///< Lower corner, local frame (m), rounded down.
+    std::array<float, 3> max{}; ///< Upper corner, local frame (m), rounded up.
+    std::uint32_t first = 0;    ///< Leaf: first position in the triangle order; inner: the
+                                ///< right child's node index.
+    std::uint32_t count = 0;    ///< Leaf: its triangles (>= 1); inner: 0.
+};
+static_assert(sizeof(MeshBvhNode) == 32, "BVH nodes are 32 bytes; update the design note");
+
 /// Immutable triangles in a local frame (m). Built once on a control thread, then read from
 /// any thread.
 class TriangleMesh {
 public:
+    /// The most triangles in a leaf of the local BVH.
+    static constexpr std::uint32_t kBvhLeafTriangles = 4;
+    /// The deepest the local BVH can be (root 0): log2(kMaxTriangles / leaf) + 1 = 23, with room.
+    static constexpr int kBvhMaxDepth = 32;
+
     /// The most triangles one mesh may have: 2^24 (16.7 million), above the 10^7 the
     /// experiments use. A bigger model is refused as bad input.
     static constexpr std::uint32_t kMaxTriangles = 1u << 24;
@@ -75,7 +91,27 @@ public:
     /// Where it came from. [any thread]
     const MeshSource& source() const noexcept { return mSource; }
 
+    /// Calls fn(t) for every triangle t whose local AABB overlaps the closed local box
+    /// `localBox` (m): exactly the triangles a linear scan with that test finds, in BVH order
+    /// (each once). Allocation-free and non-throwing (fn must not throw either). [servo]
+    template <class Fn> void forEachTriangleNear(const Aabb& localBox, Fn&& fn) const noexcept;
+    /// The same for the box around a local sphere (centre, radius in m). [servo]
+    template <class Fn>
+    void forEachTriangleNear(const Vec3& localCenter, double radius, Fn&& fn) const noexcept {
+        forEachTriangleNear(Aabb{localCenter - Vec3(radius), localCenter + Vec3(radius)},
+                            static_cast<Fn&&>(fn));
+    }
+    /// The BVH's nodes, depth first; node 0 is the root. [any thread]
+    std::span<const MeshBvhNode> bvhNodes() const noexcept { return mBvhNodes; }
+    /// The BVH's depth (a root-only tree has 0). [any thread]
+    int bvhDepth() const noexcept { return mBvhDepth; }
+    /// Memory of the local BVH (bytes): nodes and triangle order. [any thread]
+    std::size_t bvhBytes() const noexcept {
+        return mBvhNodes.size() * sizeof(MeshBvhNode) + mBvhOrder.size() * sizeof(std::uint32_t);
+    }
+
 private:
+    void buildBvh();
     TriangleMesh() = default;
 
     std::vector<Vec3> mVertices;
@@ -85,6 +121,46 @@ private:
     double mRadius = 0.0;
     std::uint64_t mDropped = 0;
     bool mClosed = false;
+    std::vector<MeshBvhNode> mBvhNodes;   // depth first
+    std::vector<std::uint32_t> mBvhOrder; // triangle numbers, each leaf one run
+    int mBvhDepth = 0;
 };
+
+template <class Fn> void TriangleMesh::forEachTriangleNear(const Aabb& q, Fn&& fn) const noexcept {
+    if (mBvhNodes.empty() || q.isEmpty()) {
+        return;
+    }
+    std::uint32_t stack[kBvhMaxDepth + 1];
+    int top = 0;
+    std::uint32_t node = 0;
+    for (;;) {
+        const MeshBvhNode& n = mBvhNodes[node];
+        const bool hit = n.min[0] <= q.max.x && n.max[0] >= q.min.x && n.min[1] <= q.max.y &&
+                         n.max[1] >= q.min.y && n.min[2] <= q.max.z && n.max[2] >= q.min.z;
+        if (hit && n.count == 0) {
+            stack[top++] = n.first; // the right child, after the left one (the next node)
+            ++node;
+            continue;
+        }
+        if (hit) {
+            for (std::uint32_t k = n.first; k < n.first + n.count; ++k) {
+                const std::uint32_t t = mBvhOrder[k];
+                const TriangleIndices& i = mTriangles[t];
+                const Vec3& a = mVertices[i[0]];
+                const Vec3& b = mVertices[i[1]];
+                const Vec3& c = mVertices[i[2]];
+                const Vec3 lo = glm::min(glm::min(a, b), c), hi = glm::max(glm::max(a, b), c);
+                if (lo.x <= q.max.x && hi.x >= q.min.x && lo.y <= q.max.y && hi.y >= q.min.y &&
+                    lo.z <= q.max.z && hi.z >= q.min.z) {
+                    fn(t);
+                }
+            }
+        }
+        if (top == 0) {
+            return;
+        }
+        node = stack[--top];
+    }
+}
 
 } // namespace hapto
