@@ -5,22 +5,160 @@
 
 #include "hapto/scenes/SceneFile.h"
 
+#include "hapto/core/Finite.h"
 #include "hapto/scenes/InputError.h"
 #include "hapto/scenes/JsonInput.h"
+#include "hapto/scenes/MeshFile.h"
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <span>
 #include <sstream>
+#include <tuple>
 
 namespace hapto {
 namespace {
 
 using namespace hapto::json;
 
-SceneObject parseObject(const Source& w, const Json& j, const Path& path) {
+/// What the loader keeps while it streams objects: where model files are found, the models
+/// read so far (a file placed twice at one scale is read once and shared), and the file's
+/// version once its "version" field has been read (0 before).
+struct LoadContext {
+    std::filesystem::path baseDir;
+    std::map<std::pair<std::string, double>, std::shared_ptr<const TriangleMesh>> models;
+    std::int64_t version = 0;
+    /// The inline "vertices" (unscaled) and "triangles" of the object being read, converted
+    /// element by element as the parser completes them, so a large inline mesh never sits in
+    /// the parser's DOM. A triangle's index too large for 32 bits is kept as kFarIndex, and
+    /// the first such is remembered (triangle, corner, value) for its message.
+    std::vector<Vec3> vertices;
+    std::vector<TriangleIndices> triangles;
+    std::optional<std::tuple<std::size_t, std::size_t, std::int64_t>> farIndex;
+    static constexpr std::uint32_t kFarIndex = 0xFFFFFFFFu; // > TriangleMesh::kMaxVertices
+
+    void startObject() {
+        vertices.clear();
+        triangles.clear();
+        farIndex.reset();
+    }
+};
+
+/// One element of an inline "vertices" array. [control]
+void streamVertex(const Source& w, const Json& j, const Path& vp, LoadContext& c) {
+    if (c.vertices.size() >= TriangleMesh::kMaxVertices) {
+        w.fail(vp, "more than " + std::to_string(TriangleMesh::kMaxVertices) +
+                       " vertices; a mesh may have at most that many");
+    }
+    c.vertices.push_back(vec3(w, j, vp[c.vertices.size()]));
+}
+
+/// One element of an inline "triangles" array; the index range is checked once the vertices
+/// are known (parseInlineMesh). [control]
+void streamTriangle(const Source& w, const Json& t, const Path& tp, LoadContext& c) {
+    const std::size_t i = c.triangles.size();
+    if (i >= TriangleMesh::kMaxTriangles) {
+        w.fail(tp, "more than " + std::to_string(TriangleMesh::kMaxTriangles) +
+                       " triangles; a mesh may have at most that many");
+    }
+    if (!t.is_array() || t.size() != 3) {
+        w.fail(tp[i], "expected [i, j, k], three vertex indices, got " +
+                          (t.is_array() ? "an array of " + std::to_string(t.size()) : typeName(t)));
+    }
+    TriangleIndices tri{};
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!t[k].is_number_integer()) {
+            w.fail(tp[i][k], "expected a vertex index (a whole number), got " + describe(t[k]));
+        }
+        const std::int64_t index = t[k].is_number_unsigned()
+                                       ? static_cast<std::int64_t>(std::min<std::uint64_t>(
+                                             t[k].get<std::uint64_t>(), std::uint64_t(1) << 62))
+                                       : t[k].get<std::int64_t>();
+        if (index < 0 || index >= static_cast<std::int64_t>(LoadContext::kFarIndex)) {
+            if (!c.farIndex) {
+                c.farIndex.emplace(i, k, index);
+            }
+            tri[k] = LoadContext::kFarIndex;
+        } else {
+            tri[k] = static_cast<std::uint32_t>(index);
+        }
+    }
+    c.triangles.push_back(tri);
+}
+
+/// An inline mesh: "vertices" [[x,y,z],...] (times `scale`) and "triangles" [[i,j,k],...],
+/// their elements already converted into `c` by parseScene's callback. [control]
+std::shared_ptr<const TriangleMesh>
+parseInlineMesh(const Source& w, const Json& j, const Path& path, double scale, LoadContext& c) {
+    const Path vp = path / "vertices";
+    const Path tp = path / "triangles";
+    const Json& vj = required(w, j, path, "vertices");
+    const Json& tj = required(w, j, path, "triangles");
+    if (!vj.is_array()) {
+        w.fail(vp, "expected an array of [x, y, z], got " + typeName(vj));
+    }
+    if (!tj.is_array()) {
+        w.fail(tp, "expected an array of [i, j, k], got " + typeName(tj));
+    }
+    std::vector<Vec3> vertices = std::move(c.vertices);
+    std::vector<TriangleIndices> triangles = std::move(c.triangles);
+    c.startObject();
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const Vec3 scaled = vertices[i] * scale;
+        if (!finite(scaled)) {
+            w.fail(vp[i], "the vertex times the scale " + show(scale) + " is not finite");
+        }
+        vertices[i] = scaled;
+    }
+    const std::size_t count = vertices.size();
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (triangles[i][k] >= count) {
+                const bool far = triangles[i][k] == LoadContext::kFarIndex;
+                const std::int64_t value = far ? std::get<2>(*c.farIndex) : triangles[i][k];
+                w.fail(tp[i][k], "vertex index " + std::to_string(value) +
+                                     " is out of range (the mesh has " + std::to_string(count) +
+                                     " vertices)");
+            }
+        }
+    }
+    // make() names the element of what it refuses ("no triangles left" when all are
+    // degenerate) after the file and the object.
+    return TriangleMesh::make(std::move(vertices), std::move(triangles), MeshSource{"", scale},
+                              std::string(w.name()) + ": " + path.str());
+}
+
+/// A mesh read from a model file, named relative to the scene file's folder.
+std::shared_ptr<const TriangleMesh> parseFileMesh(const Source& w, const Json& j, const Path& path,
+                                                  double scale, LoadContext& context) {
+    const Path fp = path / "file";
+    const std::string file = string(w, required(w, j, path, "file"), fp);
+    if (file.empty()) {
+        w.fail(fp, "expected the model file's path (relative to the scene file), got \"\"");
+    }
+    auto& cached = context.models[{file, scale}];
+    if (!cached) {
+        const std::filesystem::path where = std::filesystem::path(file).is_absolute()
+                                                ? std::filesystem::path(file)
+                                                : context.baseDir / file;
+        try {
+            cached = loadMeshFile(where, MeshSource{file, scale});
+        } catch (const InputError& e) {
+            w.fail(fp, e.what());
+        }
+    }
+    return cached;
+}
+
+void refuseMeshInVersion1(const Source& w, const Path& shapePath) {
+    w.fail(shapePath, "\"mesh\" needs \"version\": 2 (version 1 has boxes and spheres only)");
+}
+
+SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadContext& context) {
     object(w, j, path);
     SceneObject o;
     const Json& id = required(w, j, path, "id");
@@ -31,7 +169,8 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path) {
 
     const Json& shape = required(w, j, path, "shape");
     if (!shape.is_string()) {
-        w.fail(path / "shape", "expected a string (\"box\" or \"sphere\"), got " + typeName(shape));
+        w.fail(path / "shape",
+               "expected a string (\"box\", \"sphere\" or \"mesh\"), got " + typeName(shape));
     }
     const auto& shapeText = shape.get_ref<const std::string&>();
     if (shapeText == "box") {
@@ -50,16 +189,41 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path) {
                   {"id", "shape", "center", "radius", "rotation", "stiffness", "friction"});
         o.halfExtents = Vec3(ranged(w, required(w, j, path, "radius"), path / "radius", 0.0,
                                     kUnbounded, true, "the radius"));
+    } else if (shapeText == "mesh") {
+        if (context.version == 1) {
+            refuseMeshInVersion1(w, path / "shape");
+        }
+        o.shape = Shape::Mesh;
+        checkKeys(w, j, path,
+                  {"id", "shape", "center", "rotation", "scale", "file", "vertices", "triangles",
+                   "stiffness", "friction"});
+        double scale = 1.0;
+        if (const Json* v = optional(j, "scale")) {
+            scale = ranged(w, *v, path / "scale", 0.0, kUnbounded, true, "the scale");
+        }
+        const bool hasFile = optional(j, "file") != nullptr;
+        const bool hasInline = optional(j, "vertices") || optional(j, "triangles");
+        if (hasFile == hasInline) {
+            w.fail(path, hasFile ? "give either \"file\" or \"vertices\" and \"triangles\", "
+                                   "not both"
+                                 : "a mesh needs \"file\" (a model file) or \"vertices\" and "
+                                   "\"triangles\"");
+        }
+        o.mesh = hasFile ? parseFileMesh(w, j, path, scale, context)
+                         : parseInlineMesh(w, j, path, scale, context);
+        o.halfExtents = o.mesh->localBounds().halfExtents();
     } else {
         w.fail(path / "shape",
-               "unknown shape '" + shapeText + "' (expected \"box\" or \"sphere\")");
+               "unknown shape '" + shapeText + "' (expected \"box\", \"sphere\" or \"mesh\")");
     }
     o.center = vec3(w, required(w, j, path, "center"), path / "center");
     // The bounding box must be finite too: a box reaches at most the sum of its half extents
-    // from its centre along any axis, whatever its rotation. (Its size, and its distance from
-    // the bounds, are checked once the bounds are known: checkSpan.)
-    const double reach = o.shape == Shape::Sphere
-                             ? o.halfExtents.x
+    // from its centre along any axis, whatever its rotation, a mesh at most its bounding
+    // radius. (Its size, and its distance from the bounds, are checked once the bounds are
+    // known: checkSpan.)
+    const double reach = o.shape == Shape::Sphere ? o.halfExtents.x
+                         : o.shape == Shape::Mesh
+                             ? o.mesh->boundingRadius()
                              : o.halfExtents.x + o.halfExtents.y + o.halfExtents.z;
     for (int i = 0; i < 3; ++i) {
         if (!std::isfinite(std::abs(o.center[i]) + reach)) {
@@ -147,28 +311,85 @@ void appendVec(std::string& out, const double* v, int n) {
     out += ']';
 }
 
+/// A mesh's own fields: a file mesh by its file and scale; any other inline, its vertices as
+/// held (scale applied) with scale 1. Flushes through `flush` as it goes, so a large inline
+/// mesh never sits in one string either.
+template <class Flush> void appendMesh(std::string& out, const TriangleMesh& mesh, Flush& flush) {
+    if (!mesh.source().file.empty()) {
+        out += ", \"scale\": ";
+        appendNumber(out, mesh.source().scale);
+        out += ", \"file\": ";
+        out += Json(mesh.source().file).dump();
+        return;
+    }
+    out += ", \"scale\": 1, \"vertices\": [";
+    const auto vertices = mesh.vertices();
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        out += i ? ", " : "";
+        appendVec(out, &vertices[i].x, 3);
+        if (out.size() > (1u << 20)) {
+            flush();
+        }
+    }
+    out += "], \"triangles\": [";
+    const auto triangles = mesh.triangles();
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        out += i ? ", [" : "[";
+        for (int k = 0; k < 3; ++k) {
+            out += k ? ", " : "";
+            out += std::to_string(triangles[i][k]);
+        }
+        out += ']';
+        if (out.size() > (1u << 20)) {
+            flush();
+        }
+    }
+    out += ']';
+}
+
 } // namespace
 
-Scene parseScene(std::string_view text, std::string_view sourceName) {
+Scene parseScene(std::string_view text, std::string_view sourceName,
+                 const std::filesystem::path& baseDir) {
     const Source w(sourceName);
     const Path top;
     const Path objectsPath = top / "objects";
     std::vector<SceneObject> objects;
     std::string topKey;
     bool inObjects = false;
+    LoadContext context;
+    context.baseDir = baseDir;
 
     // Depth 0 is the top-level object; its keys are reported at depth 1, and elements of the
     // "objects" array end at depth 2: each is converted as soon as it is complete, then dropped.
+    // Inside an element of "objects", its keys are reported at depth 3, and the elements of
+    // its "vertices" or "triangles" array end at depth 4: each is converted into the context
+    // and dropped too (`objectKey` names the element's array being read, "" outside one).
+    std::string objectKey;
+    bool inMeshArray = false;
     auto callback = [&](int depth, Json::parse_event_t event, Json& parsed) -> bool {
         switch (event) {
         case Json::parse_event_t::key:
             if (depth == 1) {
                 topKey = parsed.get<std::string>();
+            } else if (depth == 3 && inObjects) {
+                objectKey = parsed.get<std::string>();
+            }
+            return true;
+        case Json::parse_event_t::object_start:
+            if (inObjects && depth == 2) {
+                context.startObject();
+                objectKey.clear();
             }
             return true;
         case Json::parse_event_t::array_start:
             if (depth == 1 && topKey == "objects") {
                 inObjects = true;
+            } else if (inObjects && depth == 2) {
+                context.startObject();
+                objectKey.clear();
+            } else if (inObjects && depth == 3) {
+                inMeshArray = objectKey == "vertices" || objectKey == "triangles";
             }
             return true;
         case Json::parse_event_t::array_end:
@@ -176,12 +397,28 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
                 inObjects = false;
                 return true;
             }
+            if (depth == 3) {
+                inMeshArray = false;
+                return true;
+            }
             [[fallthrough]]; // an array as an element of "objects": refused by parseObject
         case Json::parse_event_t::object_end:
         case Json::parse_event_t::value:
-            if (inObjects && depth == 2) {
-                objects.push_back(parseObject(w, parsed, objectsPath[objects.size()]));
+            if (inObjects && depth == 4 && inMeshArray) {
+                const Path element = objectsPath[objects.size()];
+                if (objectKey == "vertices") {
+                    streamVertex(w, parsed, element / "vertices", context);
+                } else {
+                    streamTriangle(w, parsed, element / "triangles", context);
+                }
                 return false;
+            }
+            if (inObjects && depth == 2) {
+                objects.push_back(parseObject(w, parsed, objectsPath[objects.size()], context));
+                return false;
+            }
+            if (depth == 1 && topKey == "version" && parsed.is_number_integer()) {
+                context.version = parsed.get<std::int64_t>(); // checked below, used by meshes
             }
             return true;
         default:
@@ -200,9 +437,19 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
         w.fail(top / "format", "expected \"hapto-scene\", got " + describe(format));
     }
     const Json& version = required(w, root, top, "version");
-    if (!version.is_number_integer() || version.get<std::int64_t>() != kSceneFormatVersion) {
-        w.fail(top / "version", "this build reads version " + std::to_string(kSceneFormatVersion) +
-                                    ", got " + describe(version));
+    if (!version.is_number_integer() || version.get<std::int64_t>() < 1 ||
+        version.get<std::int64_t>() > kSceneFormatVersion) {
+        w.fail(top / "version", "this build reads versions 1 to " +
+                                    std::to_string(kSceneFormatVersion) + ", got " +
+                                    describe(version));
+    }
+    if (version.get<std::int64_t>() == 1) {
+        // "version" may follow "objects" in the file: meshes read before it are refused here.
+        for (std::size_t i = 0; i < objects.size(); ++i) {
+            if (objects[i].shape == Shape::Mesh) {
+                refuseMeshInVersion1(w, objectsPath[i] / "shape");
+            }
+        }
     }
     const Json* objectsJson = optional(root, "objects");
     if (!objectsJson) {
@@ -250,7 +497,7 @@ Scene parseScene(std::string_view text, std::string_view sourceName) {
 
 Scene loadSceneFile(const std::filesystem::path& path) {
     const std::string text = readFile(path, "scene file");
-    return parseScene(text, path.string());
+    return parseScene(text, path.string(), path.parent_path());
 }
 
 namespace {
@@ -263,8 +510,11 @@ void writeSceneJson(const Scene& scene, std::ostream& os) {
         os.write(out.data(), static_cast<std::streamsize>(out.size()));
         out.clear();
     };
+    // A scene without meshes is written as version 1, byte for byte as before version 2 (a
+    // mesh has at least one triangle, so triangleCount() tells).
     out += "{\"format\": \"hapto-scene\", \"version\": ";
-    out += std::to_string(kSceneFormatVersion);
+    out += std::to_string(scene.triangleCount() > 0 ? kSceneFormatVersion
+                                                    : kSceneFormatVersionWithoutMeshes);
     out += ",\n \"bounds\": {\"min\": ";
     appendVec(out, &scene.bounds().min.x, 3);
     out += ", \"max\": ";
@@ -286,6 +536,11 @@ void writeSceneJson(const Scene& scene, std::ostream& os) {
             const double q[4] = {o.rotation.w, o.rotation.x, o.rotation.y, o.rotation.z};
             out += ", \"rotation\": ";
             appendVec(out, q, 4);
+        } else if (o.shape == Shape::Mesh) {
+            const double q[4] = {o.rotation.w, o.rotation.x, o.rotation.y, o.rotation.z};
+            out += ", \"rotation\": ";
+            appendVec(out, q, 4);
+            appendMesh(out, *o.mesh, flush);
         } else {
             out += ", \"radius\": ";
             appendNumber(out, o.halfExtents.x);

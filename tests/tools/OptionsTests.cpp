@@ -105,3 +105,25 @@ TEST_CASE("the realtime flag takes --realtime and --no-realtime") {
         CHECK(realtime == expected);
     }
 }
+
+TEST_CASE("a number list option takes exactly its count of finite numbers in range") {
+    const auto parseList = [](const std::string& value, std::vector<double>& v) -> std::string {
+        CLI::App app;
+        addNumberListOption(&app, "--center", v, 3, -10, 10, "x,y,z");
+        std::vector<std::string> args{value, "--center"}; // CLI11 takes them in reverse
+        try {
+            app.parse(args);
+        } catch (const CLI::ParseError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    std::vector<double> v{0, 0, 0};
+    CHECK(parseList("1,-2.5,3e0", v).empty());
+    CHECK(v == std::vector<double>{1, -2.5, 3});
+    for (const char* bad : {"1,2", "1,2,3,4", "1,nan,3", "1,inf,3", "1,x,3", "1,2,11"}) {
+        INFO(bad);
+        std::vector<double> w{0, 0, 0};
+        CHECK_THAT(parseList(bad, w), Catch::Contains("--center"));
+    }
+}

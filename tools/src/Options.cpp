@@ -56,6 +56,15 @@ CLI::Validator wholeNumber(double lo, double hi) {
         "whole number in [" + number(lo) + ", " + number(hi) + "]", "WHOLE_NUMBER");
 }
 
+CLI::Option* addNumberListOption(CLI::App* cmd, const std::string& name,
+                                 std::vector<double>& values, std::size_t count, double lo,
+                                 double hi, const std::string& help) {
+    return cmd->add_option(name, values, help)
+        ->delimiter(',')
+        ->expected(static_cast<int>(count))
+        ->check(finiteRange(lo, hi));
+}
+
 CLI::Option* addRealtimeFlag(CLI::App* cmd, bool& realtime, const std::string& what) {
     return cmd->add_flag("--realtime,!--no-realtime", realtime,
                          "Ask for SCHED_FIFO and CPU pinning (" + what +

@@ -3,8 +3,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace hapto::cli {
 
@@ -26,6 +28,13 @@ CLI::Validator finiteRange(double lo, double hi);
 /// option (or each item of a `,`-delimited list; CLI11 skips empty items). Refuses fractions,
 /// NaN, infinities and values out of range like finiteRange. [control]
 CLI::Validator wholeNumber(double lo, double hi);
+
+/// Adds an option taking exactly `count` numbers, comma-separated ("--center 0,0.1,0"), each
+/// finite and from `lo` to `hi` (finiteRange), read into `values`. A wrong count, NaN, text or a
+/// value out of range is refused naming the option (exit code 2). [control]
+CLI::Option* addNumberListOption(CLI::App* cmd, const std::string& name,
+                                 std::vector<double>& values, std::size_t count, double lo,
+                                 double hi, const std::string& help);
 
 /// The option conventions every command follows (README, "Commands"): durations in seconds
 /// (`--duration S`), one servo rate `--rate HZ`, several `--rates HZ,HZ`, lists

@@ -1,22 +1,22 @@
-// `hapto scene grid|random|cluster|default|info|mesh`.
+// `hapto scene grid|random|cluster|default|import|info|mesh`.
 
 #include "Commands.h"
 #include "Options.h"
 
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/MeshFile.h"
 #include "hapto/scenes/MeshGenerators.h"
 #include "hapto/scenes/OutputFile.h"
 #include "hapto/scenes/SceneFile.h"
 
-#include <nlohmann/json.hpp>
-
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
+#include <vector>
 
 namespace hapto::cli {
 
@@ -42,21 +42,50 @@ void writeScene(const Scene& scene, const std::string& out) {
     }
 }
 
+/// The most meshes `scene info` lists one by one (the totals count them all).
+constexpr std::size_t kMeshesListed = 20;
+
+void printMeshLine(const SceneObject& o) {
+    const TriangleMesh& m = *o.mesh;
+    std::printf("  mesh %u: %u triangles, %llu degenerate dropped, %s, %s\n", o.id,
+                m.triangleCount(), static_cast<unsigned long long>(m.droppedDegenerate()),
+                m.closed() ? "closed" : "open",
+                m.source().file.empty() ? "inline" : ("file " + m.source().file).c_str());
+}
+
 void printInfo(const Scene& scene, const std::string& source, double loadSeconds) {
-    std::size_t boxes = 0, rotated = 0;
+    std::size_t boxes = 0, rotated = 0, meshes = 0, closed = 0;
+    std::uint64_t dropped = 0;
     ObjectId minId = kMaxObjectId, maxId = 0;
     for (const SceneObject& o : scene.objects()) {
         boxes += o.shape == Shape::Box;
         rotated += o.shape == Shape::Box && o.rotation != Quat(1, 0, 0, 0);
+        if (o.shape == Shape::Mesh) {
+            ++meshes;
+            closed += o.mesh->closed();
+            dropped += o.mesh->droppedDegenerate();
+        }
         minId = std::min(minId, o.id);
         maxId = std::max(maxId, o.id);
     }
     const Aabb& b = scene.bounds();
     std::printf("scene:    %s\n", source.c_str());
-    std::printf("objects:  %u (%zu boxes, %zu of them rotated; %zu spheres)\n", scene.size(), boxes,
-                rotated, scene.size() - boxes);
+    std::printf("objects:  %u (%zu boxes, %zu of them rotated; %zu spheres; %zu meshes)\n",
+                scene.size(), boxes, rotated, scene.size() - boxes - meshes, meshes);
     if (scene.size() > 0) {
         std::printf("ids:      %u .. %u\n", minId, maxId);
+    }
+    std::printf("triangles: %u in %zu meshes (%zu closed, %zu open), %llu degenerate dropped\n",
+                scene.triangleCount(), meshes, closed, meshes - closed,
+                static_cast<unsigned long long>(dropped));
+    std::size_t listed = 0;
+    for (const SceneObject& o : scene.objects()) {
+        if (o.shape == Shape::Mesh && listed++ < kMeshesListed) {
+            printMeshLine(o);
+        }
+    }
+    if (listed > kMeshesListed) {
+        std::printf("  ... and %zu more meshes\n", listed - kMeshesListed);
     }
     std::printf("bounds:   [%.4f, %.4f, %.4f] .. [%.4f, %.4f, %.4f] m\n", b.min.x, b.min.y, b.min.z,
                 b.max.x, b.max.y, b.max.z);
@@ -77,44 +106,6 @@ std::filesystem::path meshFileFor(const std::filesystem::path& scene) {
     std::filesystem::path ply = scene;
     ply.replace_extension(".ply");
     return ply;
-}
-
-void appendShortest(std::string& out, double v) {
-    char buf[32];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v == 0.0 ? 0.0 : v);
-    out.append(buf, r.ptr);
-}
-
-void appendVec3(std::string& out, const Vec3& v) {
-    out += '[';
-    for (int a = 0; a < 3; ++a) {
-        if (a > 0) {
-            out += ", ";
-        }
-        appendShortest(out, v[a]);
-    }
-    out += ']';
-}
-
-/// The version 2 scene text for one mesh object read from `meshFile` (relative to the scene).
-std::string meshSceneJson(const Scene& scene, const std::string& meshFile) {
-    const SceneObject& o = scene.object(0);
-    std::string out = "{\"format\": \"hapto-scene\", \"version\": 2,\n \"bounds\": {\"min\": ";
-    appendVec3(out, scene.bounds().min);
-    out += ", \"max\": ";
-    appendVec3(out, scene.bounds().max);
-    out += "},\n \"objects\": [\n  {\"id\": 0, \"shape\": \"mesh\", \"file\": ";
-    out += nlohmann::json(meshFile).dump();
-    out += ", \"center\": ";
-    appendVec3(out, o.center);
-    out += ", \"rotation\": [1, 0, 0, 0], \"scale\": 1, \"stiffness\": ";
-    appendShortest(out, o.material.stiffness);
-    out += ", \"friction\": [";
-    appendShortest(out, o.material.staticFriction);
-    out += ", ";
-    appendShortest(out, o.material.dynamicFriction);
-    out += "]}]}\n";
-    return out;
 }
 
 void writeMeshScene(const MeshSceneArgs& args) {
@@ -140,10 +131,71 @@ void writeMeshScene(const MeshSceneArgs& args) {
         writeMeshPly(mesh, file.stream());
         file.commit();
     }
-    writeFileAtomically(out, meshSceneJson(scene, meshFile));
+    writeFileAtomically(out, sceneToJson(scene)); // names the mesh by its file
     std::cerr << "wrote a " << args.shape << " of " << mesh.triangleCount() << " triangles ("
               << mesh.vertices().size() << " vertices) to " << ply.string() << ", its scene to "
               << out.string() << "\n";
+}
+
+/// What `hapto scene import` takes.
+struct ImportOptions {
+    std::string model;
+    std::string out;
+    double scale = 1.0;
+    std::vector<double> center{0.0, 0.0, 0.0};
+    std::vector<double> rotation{1.0, 0.0, 0.0, 0.0};
+    double stiffness = Material::kDefaultStiffness;
+    std::vector<double> friction{0.0, 0.0};
+};
+
+/// The model as the output scene names it: relative to the scene's folder (the current folder
+/// for standard output), or absolute when no relative path leads there.
+std::string modelPathFromScene(const std::string& model, const std::string& out) {
+    namespace fs = std::filesystem;
+    const fs::path sceneDir =
+        out == "-" ? fs::current_path() : fs::absolute(fs::path(out)).parent_path();
+    std::error_code ec;
+    const fs::path relative = fs::relative(fs::absolute(model), sceneDir, ec);
+    return ec || relative.empty() ? fs::absolute(model).lexically_normal().string()
+                                  : relative.generic_string();
+}
+
+/// Wraps one model file in a scene: one mesh object, id 0, bounds around it. [control]
+void importModel(const ImportOptions& o) {
+    checkSceneOutput(o.out);
+    if (o.out != "-") {
+        refuseSameFile(o.out, "-o", o.model, "the model file");
+    }
+    if (!(o.scale > 0.0)) {
+        throw InputError("--scale: must be > 0, got " + std::to_string(o.scale));
+    }
+    if (!(o.stiffness > 0.0)) {
+        throw InputError("--stiffness: must be > 0 N/m, got " + std::to_string(o.stiffness));
+    }
+    if (o.friction[1] > o.friction[0]) {
+        throw InputError("--friction: the dynamic coefficient (second) must not exceed the "
+                         "static one (first)");
+    }
+    const Quat q(o.rotation[0], o.rotation[1], o.rotation[2], o.rotation[3]);
+    if (std::abs(glm::length(q) - 1.0) > 1e-3) {
+        throw InputError("--rotation: expected a unit quaternion w,x,y,z (length within 1e-3 of "
+                         "1), got length " +
+                         std::to_string(glm::length(q)));
+    }
+    auto mesh = loadMeshFile(o.model, MeshSource{modelPathFromScene(o.model, o.out), o.scale});
+    const Material material{o.stiffness, o.friction[0], o.friction[1]};
+    std::vector<SceneObject> objects{makeMesh(0, Vec3(o.center[0], o.center[1], o.center[2]), mesh,
+                                              glm::normalize(q), material)};
+    const Aabb bounds = Scene::defaultBounds(objects);
+    const Scene scene(bounds, std::move(objects));
+    if (o.out == "-") {
+        std::cout << sceneToJson(scene);
+    } else {
+        writeFileAtomically(o.out, sceneToJson(scene));
+    }
+    std::cerr << "wrote a scene with " << o.model << " (" << mesh->triangleCount() << " triangles, "
+              << mesh->droppedDegenerate() << " degenerate dropped, "
+              << (mesh->closed() ? "closed" : "open") << ") to " << o.out << "\n";
 }
 
 } // namespace
@@ -278,6 +330,31 @@ void addSceneCommands(CLI::App& app) {
         cmd->add_option("-o,--output", args->out, "Output scene file (the mesh goes to F.ply)")
             ->required();
         cmd->callback([args] { writeMeshScene(*args); });
+    }
+    // import
+    {
+        auto* cmd = scene->add_subcommand(
+            "import", "Wrap a model file (OBJ, STL or PLY) in a scene: one mesh object, id 0, "
+                      "which refers to the model by its path relative to the scene");
+        auto opt = std::make_shared<ImportOptions>();
+        cmd->add_option("model", opt->model, "The model file (.obj, .stl or .ply)")->required();
+        cmd->add_option("--scale", opt->scale,
+                        "Uniform scale: the model's units times it give metres (> 0)")
+            ->capture_default_str()
+            ->check(finiteRange(0, 1e6));
+        addNumberListOption(cmd, "--center", opt->center, 3, -1e6, 1e6,
+                            "Where the model's origin goes, x,y,z (m); default 0,0,0");
+        addNumberListOption(cmd, "--rotation", opt->rotation, 4, -1, 1,
+                            "Orientation, a unit quaternion w,x,y,z; default 1,0,0,0");
+        cmd->add_option("--stiffness", opt->stiffness, "Surface stiffness (N/m), > 0")
+            ->capture_default_str()
+            ->check(finiteRange(0, Material::kMaxStiffness));
+        addNumberListOption(cmd, "--friction", opt->friction, 2, 0, Material::kMaxFriction,
+                            "Coulomb coefficients static,dynamic (dynamic <= static); "
+                            "default 0,0");
+        cmd->add_option("-o,--output", opt->out, "Output scene file ('-' for standard output)")
+            ->required();
+        cmd->callback([opt] { importModel(*opt); });
     }
     // info
     {

@@ -9,18 +9,30 @@
 
 namespace hapto {
 
-/// The scene file format version this build reads and writes.
-inline constexpr int kSceneFormatVersion = 1;
+/// The newest scene file format version this build reads and writes: 2, which adds mesh
+/// objects (`"shape": "mesh"`). Version 1 files (boxes and spheres) still load unchanged.
+inline constexpr int kSceneFormatVersion = 2;
+/// The version a scene without meshes is written as, so its file is byte-identical to what
+/// builds before version 2 wrote.
+inline constexpr int kSceneFormatVersionWithoutMeshes = 1;
 
 /// Loads a scene file. Streams the objects, so 10^7 objects load in bounded extra memory.
+/// Model files named by mesh objects are read relative to the scene file's folder (MeshFile.h).
 /// Throws InputError naming the file and the JSON path (e.g. `objects[12].half_extents[1]`) on
-/// any bad input; never returns a partial scene. [control]
+/// any bad input, and for a bad model file the model file and its place too (`objects[3].file:
+/// m.obj:12: vertex index 9 is out of range ...`); never returns a partial scene. [control]
 Scene loadSceneFile(const std::filesystem::path& path);
 
-/// Parses scene JSON text; `sourceName` names it in messages. Throws InputError. [control]
-Scene parseScene(std::string_view text, std::string_view sourceName);
+/// Parses scene JSON text; `sourceName` names it in messages, and model files are read
+/// relative to `baseDir` (the current folder when empty). Throws InputError. [control]
+Scene parseScene(std::string_view text, std::string_view sourceName,
+                 const std::filesystem::path& baseDir = {});
 
-/// Writes the scene as JSON, every field explicit; the same scene gives the same bytes. [control]
+/// Writes the scene as JSON, every field explicit; the same scene gives the same bytes. A scene
+/// without meshes is written as version 1, one with meshes as version 2: a mesh from a model file
+/// by its file (as the scene that loaded it named it, so the scene must be written to the same
+/// folder or the path must be absolute) and scale; any other mesh inline, its vertices as held
+/// (scale applied) with scale 1. [control]
 void saveSceneFile(const Scene& scene, const std::filesystem::path& path);
 
 /// The JSON text `saveSceneFile` writes. [control]
