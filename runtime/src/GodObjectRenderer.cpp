@@ -1,4 +1,5 @@
-/// God-object proxy solver: point tool vs oriented boxes and spheres, with Coulomb friction.
+/// God-object proxy solver: point tool vs oriented boxes, spheres and mesh triangles, with
+/// Coulomb friction.
 ///
 /// Design note
 /// -----------
@@ -27,12 +28,23 @@
 /// moving object jumped onto it) is passed through until the proxy has left it, except that an
 /// object the proxy was touching pushes the proxy back out to its surface first.
 ///
+/// Triangles. A mesh is its triangles (index items; a moving mesh's object slot stands for its
+/// triangles near the path, found in the mesh's own frame). A triangle is entered only from its
+/// front: its skin slab is the plane kSkinM in front over the triangle grown by kSkinM across
+/// its edges (a box face's skin, so a flat mesh feels like the box face it replaces), and a
+/// path that really crosses the triangle is stopped too. At an edge or vertex the same mesh's
+/// triangles there that the goal is behind are added (Zilles & Salisbury); coplanar ones give
+/// the same plane, kept once, so shared edges do not snag. One-sidedness is also what frees a
+/// proxy inside a closed mesh: from inside, every path leaves through back faces.
+///
 /// Cost. One pass over the candidate spans per tick builds a deduplicated near list of the
 /// objects whose bounding sphere meets the ball around the goal that the proxy can reach this
-/// tick (every point the proxy visits is no farther from the goal than where it started).
+/// tick (every point the proxy visits is no farther from the goal than where it started),
+/// with a generous margin for objects and 1 µm for triangles (a fine mesh stays a few items).
 /// Each solver pass is one <= 3-plane solve (at most 8 tiny linear solves) plus one swept test
-/// per near object (slab clipping in the box frame, or a quadratic for a sphere). Worst case
-/// per tick: 2 solves x maxIterations x near objects; typically 2-3 passes over 1-5 objects.
+/// per near item (slab clipping in the box frame, a quadratic for a sphere, a plane crossing and
+/// three edge tests for a triangle). Worst case per tick: 2 solves x maxIterations x near
+/// items; typically 2-3 passes over 1-5 objects or a handful of triangles.
 /// No allocation: the near list and plane sets are fixed arrays.
 
 #include "hapto/runtime/GodObjectRenderer.h"
@@ -55,11 +67,12 @@ static_assert(alignof(GodObjectRenderer) == 64);
 namespace {
 
 constexpr double kSkinM = GodObjectRenderer::kSkinM;
-constexpr double kShrinkM = 1e-9;      ///< Swept tests use surfaces this far inside the skin (m).
-constexpr double kOnM = 2e-9;          ///< "On a plane / touching an object" tolerance (m).
-constexpr double kProbeM = 4e-9;       ///< Covered-face probe step (m), > kShrinkM.
-constexpr double kFeasibleM = 1e-12;   ///< Half-space feasibility slack (m).
-constexpr double kNearMarginM = 1e-3;  ///< Extra radius of the near ball (m).
+constexpr double kShrinkM = 1e-9;     ///< Swept tests use surfaces this far inside the skin (m).
+constexpr double kOnM = 2e-9;         ///< "On a plane / touching an object" tolerance (m).
+constexpr double kProbeM = 4e-9;      ///< Covered-face probe step (m), > kShrinkM.
+constexpr double kFeasibleM = 1e-12;  ///< Half-space feasibility slack (m).
+constexpr double kNearMarginM = 1e-3; ///< Extra radius of the near ball for objects (m).
+constexpr double kTriangleNearMarginM = 1e-6; ///< Extra radius of the near ball for triangles (m).
 constexpr double kFrictionCover = 1.0; ///< Near ball also covers a friction lag up to mu_d = 1.
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -181,6 +194,189 @@ Vec3 pushOut(const SceneObject& o, const Vec3& p) {
     return obb.center + obb.axes * l;
 }
 
+/// A triangle's plane: unit outward normal and offset (dot(normal, x) = offset on it).
+struct TrianglePlane {
+    Vec3 normal{0.0};
+    double offset = 0.0;
+    bool valid = false; ///< False for a triangle too thin to have a normal.
+};
+
+TrianglePlane trianglePlane(const std::array<Vec3, 3>& v) {
+    const Vec3 c = glm::cross(v[1] - v[0], v[2] - v[0]);
+    const double len = glm::length(c);
+    if (!(len > 0.0) || !std::isfinite(len)) {
+        return {};
+    }
+    const Vec3 n = c / len;
+    return {n, glm::dot(n, v[0]), true};
+}
+
+/// The point of triangle v closest to p (Ericson, Real-Time Collision Detection, 5.1.5).
+Vec3 closestOnTriangle(const Vec3& p, const std::array<Vec3, 3>& v) {
+    const Vec3& a = v[0];
+    const Vec3& b = v[1];
+    const Vec3& c = v[2];
+    const Vec3 ab = b - a;
+    const Vec3 ac = c - a;
+    const Vec3 ap = p - a;
+    const double d1 = glm::dot(ab, ap);
+    const double d2 = glm::dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) {
+        return a;
+    }
+    const Vec3 bp = p - b;
+    const double d3 = glm::dot(ab, bp);
+    const double d4 = glm::dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) {
+        return b;
+    }
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        return a + (d1 / (d1 - d3)) * ab;
+    }
+    const Vec3 cp = p - c;
+    const double d5 = glm::dot(ab, cp);
+    const double d6 = glm::dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) {
+        return c;
+    }
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        return a + (d2 / (d2 - d6)) * ac;
+    }
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+        return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+    }
+    const double denom = 1.0 / (va + vb + vc);
+    return a + (vb * denom) * ab + (vc * denom) * ac;
+}
+
+double triangleDistance2(const Vec3& p, const std::array<Vec3, 3>& v) {
+    return length2(p - closestOnTriangle(p, v));
+}
+
+/// How far (m) p's projection onto the plane of triangle v (unit normal n) lies outside the
+/// farthest of its three edge lines; <= 0 over the triangle.
+double outsideEdges(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n) {
+    double worst = -kInf;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 inward = glm::cross(n, v[(i + 1) % 3] - v[i]); // |inward| = the edge's length
+        worst = std::max(worst, -glm::dot(inward, p - v[i]) / glm::length(inward));
+    }
+    return worst;
+}
+
+/// True when p projects into triangle v grown by `margin` (m) across each edge, as a box face's
+/// skin grows across its edges (square corners), with a sliver's sharp corners cut at 1.5 x
+/// margin from the triangle.
+bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n, double margin) {
+    if (outsideEdges(p, v, n) > margin) {
+        return false;
+    }
+    const Vec3 onPlane = p - glm::dot(n, p - v[0]) * n;
+    return triangleDistance2(onPlane, v) <= 2.25 * margin * margin;
+}
+
+/// The swept test of one triangle, entered only from its front (outward) side. The path is
+/// stopped where it would enter the triangle's skin slab (the plane kSkinM in front, shrunk by
+/// kShrinkM) at a point over the triangle grown by kSkinM across its edges (so the skins of
+/// the triangles around a convex edge meet like a box's, and a flat mesh's skin is the box
+/// face's), or wherever it really crosses the triangle (so no path reaches behind a closed
+/// mesh, whatever its dihedral angles). A path that starts behind the triangle's plane, or
+/// does not go deeper, passes.
+Entry sweepTriangle(const std::array<Vec3, 3>& v, const Vec3& from, const Vec3& to) {
+    const TrianglePlane tp = trianglePlane(v);
+    if (!tp.valid) {
+        return {};
+    }
+    const double sf = glm::dot(tp.normal, from) - tp.offset; // heights over the plane (m)
+    const double st = glm::dot(tp.normal, to) - tp.offset;
+    if (!(sf >= 0.0) || !(st < sf)) {
+        return {}; // behind (one-sided), or not going deeper
+    }
+    const double h = kSkinM - kShrinkM;
+    double t = 0.0;
+    if (sf > h) {
+        if (st >= h) {
+            return {};
+        }
+        t = (sf - h) / (sf - st);
+    }
+    if (t >= 1.0) {
+        return {};
+    }
+    const Vec3 d = to - from;
+    bool over = overGrownTriangle(from + t * d, v, tp.normal, kSkinM);
+    if (!over && st < 0.0) {
+        over = overGrownTriangle(from + (sf / (sf - st)) * d, v, tp.normal, kOnM);
+    }
+    if (!over) {
+        return {};
+    }
+    Entry e;
+    e.found = true;
+    e.t = t;
+    e.tStop = sf > kSkinM ? std::clamp((sf - kSkinM) / (sf - st), 0.0, t) : 0.0;
+    return e;
+}
+
+/// A valid item of this scene: a box or sphere slot, or a triangle item.
+bool validItem(const Scene& scene, std::uint32_t item) {
+    if (isTriangleItem(item)) {
+        return (item & ~kTriangleItemBit) < scene.triangleCount();
+    }
+    return item < scene.size() && scene.object(item).shape != Shape::Mesh;
+}
+
+/// The item of a mesh object's first triangle: the scene numbers triangles mesh by mesh in
+/// slot order, so a binary search over the numbers finds it. O(log triangles x log meshes).
+std::uint32_t firstTriangleItem(const Scene& scene, std::uint32_t slot) {
+    std::uint32_t lo = 0;
+    std::uint32_t hi = scene.triangleCount();
+    while (lo < hi) {
+        const std::uint32_t mid = lo + (hi - lo) / 2;
+        if (scene.triangle(kTriangleItemBit | mid).objectSlot < slot) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    return kTriangleItemBit | lo;
+}
+
+/// Visits (calls fn(t) for) every triangle of `mesh` whose local bounds meet `localBox` (m,
+/// mesh frame), without allocating. A linear visit, to be replaced by the mesh's own
+/// local-frame index (TriangleMesh::forEachTriangleNear) when it lands: this is the one line
+/// to swap.
+template <class Fn>
+void visitMeshTrianglesNear(const TriangleMesh& mesh, const Aabb& localBox, Fn&& fn) {
+    const std::uint32_t n = mesh.triangleCount();
+    for (std::uint32_t t = 0; t < n; ++t) {
+        const std::array<Vec3, 3> c = mesh.corners(t);
+        const Aabb box{glm::min(glm::min(c[0], c[1]), c[2]), glm::max(glm::max(c[0], c[1]), c[2])};
+        if (box.overlaps(localBox)) {
+            fn(t);
+        }
+    }
+}
+
+/// Distance (m) from p to an item's skin, 0 inside. A triangle's skin, like a box face's: the
+/// points within kSkinM of its plane over the triangle grown by kSkinM across its edges.
+double itemDistanceToSkin(const Scene& scene, std::uint32_t item, const Vec3& p) {
+    if (isTriangleItem(item)) {
+        const std::array<Vec3, 3> v = scene.triangleCorners(item);
+        const TrianglePlane tp = trianglePlane(v);
+        if (!tp.valid) {
+            return kInf;
+        }
+        const double up = std::max(0.0, std::abs(glm::dot(tp.normal, p) - tp.offset) - kSkinM);
+        const double out = std::max(0.0, outsideEdges(p, v, tp.normal) - kSkinM);
+        return std::sqrt(up * up + out * out);
+    }
+    return distanceToSkin(scene.object(item), p);
+}
+
 } // namespace
 
 /// The first surface a swept path enters.
@@ -188,7 +384,7 @@ struct GodObjectRenderer::Hit {
     bool found = false;
     double t = kInf;
     double tStop = 0.0;
-    std::uint32_t slot = 0;
+    std::uint32_t item = 0; ///< A box or sphere slot, or a triangle item.
     int axis = -1;
     double sign = 0.0;
 };
@@ -278,6 +474,29 @@ void GodObjectRenderer::reset(const Vec3& devicePosition) noexcept {
     mNearRadius = -1.0;
     mNearCount = 0;
     mNearOverflow = false;
+    mNearTriangles = false;
+}
+
+template <class Fn>
+void GodObjectRenderer::forEachMeshTriangleNear(const Scene& scene, std::uint32_t slot,
+                                                const Vec3& center, double radius,
+                                                Fn&& fn) const noexcept {
+    const SceneObject& o = scene.object(slot);
+    if (!o.mesh) {
+        return;
+    }
+    // In the mesh's own frame: distances are the same there, and nothing is transformed but
+    // the one point.
+    const Vec3 local = glm::conjugate(o.rotation) * (center - o.center);
+    const double reach = radius + kSkinM;
+    const std::uint32_t first = firstTriangleItem(scene, slot);
+    const TriangleMesh& mesh = *o.mesh;
+    visitMeshTrianglesNear(mesh, Aabb{local - Vec3(reach), local + Vec3(reach)},
+                           [&](std::uint32_t t) {
+                               if (triangleDistance2(local, mesh.corners(t)) <= reach * reach) {
+                                   fn(first + t);
+                               }
+                           });
 }
 
 template <class Fn>
@@ -289,49 +508,88 @@ void GodObjectRenderer::forEachNear(const Scene& scene, const CandidateSet& cand
         }
         return;
     }
-    // Too many nearby objects for the scratch list: walk the spans (duplicates are harmless,
-    // they give the same answer twice).
+    // Too many nearby items for the scratch list: walk the spans (duplicates are harmless,
+    // they give the same answer twice). A mesh object's slot stands for its triangles within
+    // the near ball.
     const std::uint32_t n = scene.size();
     for (std::size_t s = 0; s < candidates.count && s < CandidateSet::kMaxSpans; ++s) {
-        for (const std::uint32_t slot : candidates.spans[s]) {
-            if (slot < n) {
-                fn(slot);
+        for (const std::uint32_t item : candidates.spans[s]) {
+            if (isTriangleItem(item)) {
+                if (validItem(scene, item)) {
+                    fn(item);
+                }
+            } else if (item < n && scene.object(item).shape == Shape::Mesh) {
+                forEachMeshTriangleNear(scene, item, mNearCenter, mNearRadius, fn);
+            } else if (item < n) {
+                fn(item);
             }
         }
     }
 }
 
+void GodObjectRenderer::addNear(std::uint32_t item) noexcept {
+    if (mNearOverflow) {
+        return;
+    }
+    for (std::uint32_t k = 0; k < mNearCount; ++k) {
+        if (mNear[k] == item) {
+            return;
+        }
+    }
+    if (mNearCount == kMaxNearObjects) {
+        mNearOverflow = true;
+        return;
+    }
+    mNear[mNearCount++] = item;
+}
+
 void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candidates,
-                                  const Vec3& center, double radius,
+                                  const Vec3& center, double reach,
                                   std::uint32_t& tested) noexcept {
     mNearCenter = center;
-    mNearRadius = radius;
+    mNearRadius = reach + kTriangleNearMarginM;
     mNearCount = 0;
     mNearOverflow = false;
+    mNearTriangles = false;
+    // Triangles get a tight ball (the reach plus 1 µm) so that a fine mesh adds only the few
+    // triangles the proxy can touch this tick; boxes and spheres keep a generous one (room for
+    // a friction lag up to mu_d = 1, plus 1 mm), as cheap as it is few.
+    const double radius = (1.0 + kFrictionCover) * reach + kNearMarginM;
+    const double triangleReach = mNearRadius + kSkinM;
     const std::uint32_t n = scene.size();
     for (std::size_t s = 0; s < candidates.count && s < CandidateSet::kMaxSpans; ++s) {
         tested += static_cast<std::uint32_t>(candidates.spans[s].size());
-        for (const std::uint32_t slot : candidates.spans[s]) {
-            if (slot >= n || mNearOverflow) {
+        for (const std::uint32_t item : candidates.spans[s]) {
+            if (mNearOverflow) {
+                break;
+            }
+            if (isTriangleItem(item)) {
+                if (validItem(scene, item)) {
+                    mNearTriangles = true;
+                    if (triangleDistance2(center, scene.triangleCorners(item)) <=
+                        triangleReach * triangleReach) {
+                        addNear(item);
+                    }
+                }
                 continue;
             }
-            const SceneObject& o = scene.object(slot);
+            if (item >= n) {
+                continue;
+            }
+            const SceneObject& o = scene.object(item);
             const double reach = radius + o.radius() + kSkinM;
             if (length2(o.center - center) > reach * reach) {
                 continue;
             }
-            bool seen = false;
-            for (std::uint32_t k = 0; k < mNearCount && !seen; ++k) {
-                seen = mNear[k] == slot;
-            }
-            if (seen) {
+            if (o.shape == Shape::Mesh) {
+                // A moving mesh (or an index that holds whole meshes): its triangles near the
+                // ball, from the mesh's own frame.
+                mNearTriangles = true;
+                forEachMeshTriangleNear(scene, item, center, mNearRadius,
+                                        [&](std::uint32_t t) { addNear(t); });
                 continue;
             }
-            if (mNearCount == kMaxNearObjects) {
-                mNearOverflow = true;
-                continue;
-            }
-            mNear[mNearCount++] = slot;
+            addNear(item);
         }
     }
 }
@@ -339,12 +597,17 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
 GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const CandidateSet& candidates,
                                                 const Vec3& from, const Vec3& to) const noexcept {
     Hit best;
-    forEachNear(scene, candidates, [&](std::uint32_t slot) {
-        const SceneObject& o = scene.object(slot);
-        const Entry e = o.shape == Shape::Sphere ? sweepSphere(o.center, o.halfExtents.x, from, to)
-                                                 : sweepBox(o.obb(), from, to);
+    forEachNear(scene, candidates, [&](std::uint32_t item) {
+        Entry e;
+        if (isTriangleItem(item)) {
+            e = sweepTriangle(scene.triangleCorners(item), from, to);
+        } else {
+            const SceneObject& o = scene.object(item);
+            e = o.shape == Shape::Sphere ? sweepSphere(o.center, o.halfExtents.x, from, to)
+                                         : sweepBox(o.obb(), from, to);
+        }
         if (e.found && e.t < best.t) {
-            best = {true, e.t, e.tStop, slot, e.axis, e.sign};
+            best = {true, e.t, e.tStop, item, e.axis, e.sign};
         }
     });
     return best;
@@ -353,9 +616,10 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
 bool GodObjectRenderer::covered(const Scene& scene, const CandidateSet& candidates,
                                 const Vec3& probe, std::uint32_t self) const noexcept {
     bool inside = false;
-    forEachNear(scene, candidates, [&](std::uint32_t slot) {
-        if (!inside && slot != self) {
-            inside = insideSkin(scene.object(slot), probe);
+    // Boxes and spheres only: flush meshes are not looked for (see DESIGN, "Triangles").
+    forEachNear(scene, candidates, [&](std::uint32_t item) {
+        if (!inside && item != self && !isTriangleItem(item)) {
+            inside = insideSkin(scene.object(item), probe);
         }
     });
     return inside;
@@ -404,12 +668,39 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
                 s.firstTouch = p;
             }
             pruneNonBinding(p);
-            const SceneObject& o = scene.object(hit.slot);
+            if (isTriangleItem(hit.item)) {
+                const TrianglePlane tp = trianglePlane(scene.triangleCorners(hit.item));
+                if (!addPlane({tp.normal, tp.offset + kSkinM, hit.item})) {
+                    break;
+                }
+                // On an edge or a vertex: every other triangle of the same mesh there (the
+                // proxy is on its skin plane, over it grown by the skin, as on a box's edge)
+                // that the goal is behind. Coplanar neighbours give the same plane, which
+                // addPlane keeps once.
+                const std::uint32_t mesh = scene.objectSlotOf(hit.item);
+                forEachNear(scene, candidates, [&](std::uint32_t other) {
+                    if (other == hit.item || !isTriangleItem(other) ||
+                        scene.objectSlotOf(other) != mesh) {
+                        return;
+                    }
+                    const std::array<Vec3, 3> w = scene.triangleCorners(other);
+                    const TrianglePlane op = trianglePlane(w);
+                    const double offset = op.offset + kSkinM;
+                    if (!op.valid || glm::dot(op.normal, goal) >= offset - kFeasibleM ||
+                        glm::dot(op.normal, p) < offset - kOnM ||
+                        !overGrownTriangle(p, w, op.normal, kSkinM + kOnM)) {
+                        return;
+                    }
+                    addPlane({op.normal, offset, other});
+                });
+                continue;
+            }
+            const SceneObject& o = scene.object(hit.item);
             if (o.shape == Shape::Sphere) {
                 Vec3 n = p - o.center;
                 const double len = glm::length(n);
                 n = len > 0.0 ? n / len : glm::normalize(p - target);
-                if (!addPlane({n, glm::dot(n, o.center) + o.halfExtents.x + kSkinM, hit.slot})) {
+                if (!addPlane({n, glm::dot(n, o.center) + o.halfExtents.x + kSkinM, hit.item})) {
                     break;
                 }
                 continue;
@@ -418,7 +709,7 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
             const Vec3 entered = hit.sign * obb.axes[hit.axis];
             if (!addPlane({entered,
                            glm::dot(entered, obb.center) + obb.halfExtents[hit.axis] + kSkinM,
-                           hit.slot})) {
+                           hit.item})) {
                 break;
             }
             // On an edge or a corner: every other face there that the goal is behind, unless
@@ -437,10 +728,10 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
                     if (glm::dot(n, goal) >= offset - kFeasibleM) {
                         continue;
                     }
-                    if (covered(scene, candidates, p + kProbeM * n - kProbeM * entered, hit.slot)) {
+                    if (covered(scene, candidates, p + kProbeM * n - kProbeM * entered, hit.item)) {
                         continue;
                     }
-                    addPlane({n, offset, hit.slot});
+                    addPlane({n, offset, hit.item});
                 }
             }
             continue;
@@ -453,7 +744,7 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
         // Drop planes whose object the proxy has slid off; then sweep on toward the goal.
         std::uint32_t kept = 0;
         for (std::uint32_t i = 0; i < s.planeCount; ++i) {
-            if (distanceToSkin(scene.object(s.planes[i].slot), p) <= kOnM) {
+            if (itemDistanceToSkin(scene, s.planes[i].item, p) <= kOnM) {
                 s.planes[kept++] = s.planes[i];
             }
         }
@@ -475,6 +766,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     mNearRadius = -1.0;
     mNearCount = 0;
     mNearOverflow = false;
+    mNearTriangles = false;
     if (!finite(devicePosition)) {
         out.status = RenderStatus::NonFiniteInput;
         out.proxy = mProxy;
@@ -502,31 +794,40 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     std::uint32_t tested = 0;
     // Every point the proxy visits while solving toward g lies within |start - g| of g.
     auto ensureNear = [&](const Vec3& g, double need) {
-        if (mNearRadius < 0.0 || glm::length(g - mNearCenter) + need > mNearRadius) {
-            buildNear(scene, candidates, g, need + kNearMarginM, tested);
+        const double covers =
+            mNearTriangles
+                ? mNearRadius
+                : (1.0 + kFrictionCover) * (mNearRadius - kTriangleNearMarginM) + kNearMarginM;
+        if (mNearRadius < 0.0 || glm::length(g - mNearCenter) + need > covers) {
+            buildNear(scene, candidates, g, need, tested);
         }
     };
-    ensureNear(goal, (1.0 + kFrictionCover) * glm::length(start - goal));
+    ensureNear(goal, glm::length(start - goal));
 
     // A touched object that moved carries the proxy with it: friction holds in the object's
     // frame, so an object that is pushed, carried or grasped takes its contact point along.
+    // A touched triangle carries the proxy with its mesh's pose.
     for (std::uint32_t i = 0; i < mContactCount; ++i) {
-        const std::uint32_t slot = mContactSlots[i];
+        const std::uint32_t item = mContactSlots[i];
         const ContactPose& was = mContactPoses[i];
-        if (slot >= scene.size() || scene.object(slot).id != was.id) {
-            continue; // the world was re-indexed and the slot now names another object
+        if (!validItem(scene, item) || scene.object(scene.objectSlotOf(item)).id != was.id) {
+            continue; // the world was re-indexed and the item now names another object
         }
-        const SceneObject& o = scene.object(slot);
+        const SceneObject& o = scene.object(scene.objectSlotOf(item));
         if (o.center != was.center || o.rotation != was.rotation) {
             start = o.center + o.rotation * (glm::conjugate(was.rotation) * (start - was.center));
-            ensureNear(goal, (1.0 + kFrictionCover) * glm::length(start - goal));
+            ensureNear(goal, glm::length(start - goal));
             break;
         }
     }
 
-    // A touched object that moved into the proxy pushes it back out to its surface.
+    // A touched object that moved into the proxy pushes it back out to its surface (a touched
+    // mesh has carried the proxy in its own frame above, so it stays on its skin).
     if (mContactCount > 0) {
         forEachNear(scene, candidates, [&](std::uint32_t slot) {
+            if (isTriangleItem(slot)) {
+                return;
+            }
             const SceneObject& o = scene.object(slot);
             if (std::find(mContactSlots.begin(), mContactSlots.begin() + mContactCount, slot) !=
                     mContactSlots.begin() + mContactCount &&
@@ -534,7 +835,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
                 start = pushOut(o, start);
             }
         });
-        ensureNear(goal, (1.0 + kFrictionCover) * glm::length(start - goal));
+        ensureNear(goal, glm::length(start - goal));
     }
 
     const Solve free = solve(scene, candidates, start, goal);
@@ -547,7 +848,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     std::uint32_t freeContacts = 0;
     for (std::uint32_t i = 0; i < free.planeCount; ++i) {
         if (glm::dot(free.planes[i].normal, goal) < free.planes[i].offset) {
-            const Material& m = scene.object(free.planes[i].slot).material;
+            const Material& m = scene.object(scene.objectSlotOf(free.planes[i].item)).material;
             muStatic = std::min(muStatic, m.staticFriction);
             muDynamic = std::min(muDynamic, m.dynamicFriction);
             ++freeContacts;
@@ -565,8 +866,8 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
         const double tangential = glm::length(rel - normal * n);
         // The anchor must still rest on something (an object may have moved away under it).
         bool anchorTouches = false;
-        forEachNear(scene, candidates, [&](std::uint32_t slot) {
-            anchorTouches = anchorTouches || distanceToSkin(scene.object(slot), anchor) <= kOnM;
+        forEachNear(scene, candidates, [&](std::uint32_t item) {
+            anchorTouches = anchorTouches || itemDistanceToSkin(scene, item, anchor) <= kOnM;
         });
         if (anchorTouches && normal > 0.0 && tangential <= mu * normal + 1e-12) {
             stuck = true;
@@ -597,8 +898,8 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
         if (depth <= 0.0 || !onPlane) {
             continue;
         }
-        const SceneObject& o = scene.object(pl.slot);
-        out.contacts[out.contactCount++] = {pl.slot, o.id, pl.normal, depth};
+        const SceneObject& o = scene.object(scene.objectSlotOf(pl.item));
+        out.contacts[out.contactCount++] = {pl.item, o.id, pl.normal, depth};
         stiffness = std::min(stiffness, o.material.stiffness);
     }
 
@@ -644,7 +945,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     mProxy = out.proxy;
     mContactCount = out.contactCount;
     for (std::uint32_t i = 0; i < out.contactCount; ++i) {
-        const SceneObject& o = scene.object(out.contacts[i].slot);
+        const SceneObject& o = scene.object(scene.objectSlotOf(out.contacts[i].slot));
         mContactSlots[i] = out.contacts[i].slot;
         mContactPoses[i] = {o.id, o.center, o.rotation};
     }

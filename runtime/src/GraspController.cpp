@@ -11,6 +11,13 @@
 // bounds' floor, and the World puts it back into the index once it has rested. A move that
 // would push the object into another is cut short (bisection on the straight path), so it
 // never passes through anything. Cost per step: O(N) over the scene for the collision checks.
+//
+// Meshes are grasped like boxes: the hands' contacts name the mesh's ObjectId (whichever of
+// its triangles they touch), the object moves by its pose (its triangles are never copied),
+// and the carry and fall checks use the mesh's OBB (its placed local bounds), a conservative
+// stand-in for its triangles: a carried torus keeps the clearance from its bounding box, not
+// from its tube. Its mass is density x the volume it encloses (a closed mesh) or x its OBB's
+// volume (an open one, which encloses none).
 
 #include "hapto/runtime/GraspController.h"
 
@@ -22,10 +29,28 @@
 
 namespace hapto {
 
+namespace {
+
+// The volume a closed mesh encloses (m^3): the sum of the signed tetrahedra from the local
+// origin to each outward triangle (the divergence theorem). O(triangles), once per grasp.
+double enclosedVolume(const TriangleMesh& mesh) {
+    double sixTimes = 0.0;
+    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
+        const auto c = mesh.corners(t);
+        sixTimes += glm::dot(c[0], glm::cross(c[1], c[2]));
+    }
+    return std::abs(sixTimes) / 6.0;
+}
+
+} // namespace
+
 double objectMassKg(const SceneObject& o, double density) {
-    const double volume = o.shape == Shape::Sphere
-                              ? 4.0 / 3.0 * std::numbers::pi * std::pow(o.halfExtents.x, 3)
-                              : 8.0 * o.halfExtents.x * o.halfExtents.y * o.halfExtents.z;
+    double volume = 8.0 * o.halfExtents.x * o.halfExtents.y * o.halfExtents.z;
+    if (o.shape == Shape::Sphere) {
+        volume = 4.0 / 3.0 * std::numbers::pi * std::pow(o.halfExtents.x, 3);
+    } else if (o.shape == Shape::Mesh && o.mesh && o.mesh->closed()) {
+        volume = enclosedVolume(*o.mesh);
+    }
     return density * volume;
 }
 

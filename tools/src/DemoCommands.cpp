@@ -167,7 +167,9 @@ int runDemo(const DemoArgs& a) {
         Cursor cursor(*s.index);
         const std::uint32_t slot = *s.scene->slotOf(a.object);
         const LocateResult r = cursor.locate(p);
-        return std::find(r.candidates.begin(), r.candidates.end(), slot) != r.candidates.end();
+        // A mesh is indexed by its triangles: any of them names it.
+        return std::any_of(r.candidates.begin(), r.candidates.end(),
+                           [&](std::uint32_t item) { return s.scene->objectSlotOf(item) == slot; });
     };
     const bool foundNew = foundAt(endPosition);
     const bool foundOld = glm::length(endPosition - startPosition) > 1e-6 && foundAt(startPosition);

@@ -1,5 +1,6 @@
 #pragma once
-/// God-object (proxy) haptic rendering of a point tool against oriented boxes and spheres.
+/// God-object (proxy) haptic rendering of a point tool against oriented boxes, spheres and
+/// triangle meshes.
 
 #include "hapto/runtime/CandidateSet.h"
 #include "hapto/scenes/Scene.h"
@@ -26,7 +27,7 @@ enum class RenderStatus : std::uint8_t {
     NonFiniteInput,    ///< Device position was NaN/inf: zero force, proxy kept.
     NonFiniteOutput,   ///< The computation produced NaN/inf (a broken scene?): zero force.
     CandidatesDropped, ///< The CandidateSet overflowed (a span was dropped); tick still ran.
-    NearListFull,      ///< More nearby objects than kMaxNearObjects: ran on the raw spans.
+    NearListFull,      ///< More nearby items than kMaxNearObjects: ran on the raw spans.
 };
 
 /// How often each fault happened in one renderer, as plain values.
@@ -40,8 +41,9 @@ struct RenderCounters {
 
 /// One active constraint plane of the proxy.
 struct Contact {
-    std::uint32_t slot = 0; ///< The touched object's slot in `scene.objects()`.
-    ObjectId id = 0;        ///< The touched object's id.
+    std::uint32_t slot = 0; ///< The touched item: a box's or sphere's slot in `scene.objects()`,
+                            ///< or a mesh triangle's item (isTriangleItem; Scene::triangle).
+    ObjectId id = 0;        ///< The touched object's id (a triangle's: its mesh's).
     Vec3 normal{0.0};       ///< Outward unit normal of the constraint plane (world).
     double depth = 0.0;     ///< How far the device point is behind that plane (m), > 0.
 };
@@ -68,7 +70,11 @@ class alignas(64) GodObjectRenderer {
 public:
     /// Constraint planes solved at once (a corner needs three).
     static constexpr std::size_t kMaxContacts = 3;
-    /// Nearby objects one tick can track; beyond this the tick runs on the raw candidate spans.
+    /// Nearby items (objects and triangles) one tick can track; beyond this the tick runs on
+    /// the raw candidate spans. Triangles enter the list only when they come within the reach
+    /// of this tick's proxy path plus 1 µm (not the objects' 1 mm margin), so a fine mesh under
+    /// a pressing tool adds the few triangles around the contact, not every triangle in a
+    /// millimetre.
     static constexpr std::size_t kMaxNearObjects = 256;
     /// Upper bound for RendererConfig::maxIterations.
     static constexpr std::uint32_t kMaxIterations = 32;
@@ -81,7 +87,9 @@ public:
     explicit GodObjectRenderer(const RendererConfig& config = {});
 
     /// Puts the proxy on the device point with no contact and no friction state. If that point
-    /// is inside an object, that object is ignored until the proxy has left it. [servo]
+    /// is inside an object, that object is ignored until the proxy has left it (a box or
+    /// sphere is passed through while it contains the proxy; a mesh triangle is entered only
+    /// from its front, so the inside of a closed mesh is left through its back faces). [servo]
     void reset(const Vec3& devicePosition) noexcept;
 
     /// One servo tick: moves the proxy toward `devicePosition` (m, world) without entering any
@@ -90,7 +98,12 @@ public:
     /// last position over `dtSeconds`. Only objects named in `candidates` are looked at (slots
     /// outside the scene are skipped). With several contacts the smallest stiffness and the
     /// smallest friction coefficients among the touched objects apply (conservative). Never
-    /// allocates, locks or throws. [servo]
+    /// allocates, locks or throws.
+    ///
+    /// Candidates are items (Scene items): box and sphere slots, mesh triangle items, and a
+    /// mesh object's own slot (a moving mesh, from the snapshot's moving list), for which the
+    /// renderer visits that mesh's triangles near the proxy path in the mesh's own frame.
+    /// Triangles are one-sided: a path entering one from behind passes through. [servo]
     RenderOutput update(const Scene& scene, const CandidateSet& candidates,
                         const Vec3& devicePosition, const Vec3& deviceVelocity,
                         double dtSeconds) noexcept;
@@ -105,11 +118,12 @@ public:
     const RendererConfig& config() const noexcept { return mConfig; }
 
 private:
-    /// A constraint half-space {x : dot(normal, x) >= offset}, from one object's face.
+    /// A constraint half-space {x : dot(normal, x) >= offset}, from one object's face or one
+    /// mesh triangle (`item`, as in Contact::slot).
     struct Plane {
         Vec3 normal{0.0};
         double offset = 0.0;
-        std::uint32_t slot = 0;
+        std::uint32_t item = 0;
     };
     /// Where a solve ended.
     struct Solve {
@@ -132,6 +146,10 @@ private:
                  std::uint32_t self) const noexcept;
     template <class Fn>
     void forEachNear(const Scene& scene, const CandidateSet& candidates, Fn&& fn) const noexcept;
+    template <class Fn>
+    void forEachMeshTriangleNear(const Scene& scene, std::uint32_t slot, const Vec3& center,
+                                 double radius, Fn&& fn) const noexcept;
+    void addNear(std::uint32_t item) noexcept;
 
     RendererConfig mConfig;
     RenderCounters mCounters;
@@ -140,7 +158,7 @@ private:
     bool mHasLastDevice = false;
     bool mSlipping = false; ///< Friction state: kinetic (true) or static (false).
     std::uint8_t mContactCount = 0;
-    std::array<std::uint32_t, kMaxContacts> mContactSlots{}; ///< Last tick's touched slots.
+    std::array<std::uint32_t, kMaxContacts> mContactSlots{}; ///< Last tick's touched items.
     /// Pose of a touched object at the end of the last tick, to carry the proxy when it moves.
     struct ContactPose {
         ObjectId id = 0;
@@ -151,8 +169,11 @@ private:
 
     // Per-tick scratch: the deduplicated candidates that can matter this tick.
     Vec3 mNearCenter{0.0};
-    double mNearRadius = -1.0; ///< < 0: no list built this tick.
+    /// The near ball's radius for triangles (m): the proxy's reach + 1 µm (objects get twice
+    /// the reach + 1 mm); < 0: no list built this tick.
+    double mNearRadius = -1.0;
     bool mNearOverflow = false;
+    bool mNearTriangles = false; ///< The list saw triangles: its triangle ball is the tight one.
     std::uint32_t mNearCount = 0;
     std::array<std::uint32_t, kMaxNearObjects> mNear{};
 };

@@ -94,7 +94,8 @@ private:
     bool mHaveLeft = false, mHaveRight = false;
 };
 
-/// Mass of an object at a density (kg). [any thread]
+/// Mass of an object at a density (kg): a closed mesh's enclosed volume (O(triangles)), an open
+/// mesh's OBB volume. [any thread]
 double objectMassKg(const SceneObject& object, double densityKgPerM3);
 
 } // namespace hapto
