@@ -18,6 +18,15 @@
 namespace hapto::experiments {
 namespace {
 
+/// What an index holds: every box and sphere, and every mesh triangle (not the mesh object).
+std::size_t indexedItems(const Scene& scene) {
+    std::size_t meshes = 0;
+    for (const SceneObject& o : scene.objects()) {
+        meshes += o.shape == Shape::Mesh;
+    }
+    return scene.size() - meshes + scene.triangleCount();
+}
+
 /// Objects the script plans against: those within this distance of the start (m). The free
 /// walk stays within 8 cm of its start, touch and slide use the nearest surface.
 constexpr double kPlanRadiusM = 0.15;
@@ -102,7 +111,7 @@ std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
                 base.renderer = r.name;
                 base.index = r.spec.toString();
                 base.size = step.size;
-                base.objects = scene.size();
+                base.objects = indexedItems(scene);
                 base.seed = sc.seed;
                 const auto skipAll = [&](const std::string& note) {
                     for (const double rate : rates) {

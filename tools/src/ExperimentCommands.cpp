@@ -1,5 +1,5 @@
-// `hapto experiment paper1|paper2|devices`: the paper's experiments and load scaling, measured
-// by the real Runtime, written as CSV, JSON, markdown and gnuplot figures.
+// `hapto experiment paper1|paper2|meshes|devices`: the paper's experiments and load scaling,
+// measured by the real Runtime, written as CSV, JSON, markdown and gnuplot figures.
 
 #include "Commands.h"
 #include "Options.h"
@@ -178,6 +178,64 @@ void addExperimentCommands(CLI::App& app) {
                 }
             }
             const int rc = runPaper2(*a);
+            if (rc != 0) {
+                std::exit(rc);
+            }
+        });
+    }
+    // meshes
+    {
+        auto a = std::make_shared<MeshesArgs>();
+        auto o = std::make_shared<CommonOptions>();
+        auto shape = std::make_shared<std::string>("sphere");
+        auto* cmd = exp->add_subcommand(
+            "meshes",
+            "Load against triangle count: one generated closed mesh (geodesic sphere or torus, "
+            "as `hapto scene mesh` makes) of 1e2, 3e2, 1e3, ... triangles up to --max-triangles; "
+            "renderers standard (brute force), a uniform grid and an octree over the triangles; "
+            "hands in the no touch / touch / sliding conditions pressing in from the mesh's +z "
+            "side. A renderer stops growing after its first unstable size (brute force does "
+            "long before 1e6)");
+        addCommon(cmd, a->common, *o, "meshes");
+        auto verdict = std::make_shared<std::string>("design");
+        addVerdict(cmd, *verdict);
+        addRates(cmd, a->ratesHz, "e.g. 1000,4000");
+        cmd->add_option("--shape", *shape, "sphere or torus")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"sphere", "torus"}));
+        cmd->add_option("--size", a->sizeM, "The mesh's extent along x (m)")
+            ->capture_default_str()
+            ->check(finiteRange(0.01, 10));
+        auto* maxTriangles =
+            cmd->add_option("--max-triangles", a->maxTriangles,
+                            "Largest triangle count (1e2 .. 1e7); e.g. 1e7 if memory allows "
+                            "(about 0.25 GB of mesh plus the index); --quick: 1000")
+                ->capture_default_str()
+                ->transform(wholeNumber(static_cast<double>(kMinGeneratedTriangles),
+                                        static_cast<double>(kMaxGeneratedTriangles)));
+        cmd->add_option("--grid-cells", a->gridCells, "The grid renderer's cells per side")
+            ->capture_default_str()
+            ->check(finiteRange(1, 1024));
+        cmd->add_option("--octree-max", a->octreeMaxItems, "The octree renderer's items per leaf")
+            ->capture_default_str()
+            ->check(finiteRange(1, 1000));
+        cmd->add_option("--octree-min-leaf", a->octreeMinLeafM,
+                        "The octree renderer's smallest leaf (m)")
+            ->capture_default_str()
+            ->check(finiteRange(1e-6, 1));
+        cmd->add_option("--max-index-mb", a->maxIndexMb,
+                        "Skip an index whose memory, extrapolated from the previous size, "
+                        "would pass this (MB)")
+            ->capture_default_str()
+            ->check(finiteRange(1e-3, 1e9));
+        cmd->callback([a, o, shape, maxTriangles, verdict] {
+            applyQuick(a->common, *o);
+            a->verdict = parseVerdict(*verdict, "--verdict");
+            a->shape = *parseMeshShape(*shape); // CLI11 checked the name
+            if (a->common.quick && maxTriangles->count() == 0) {
+                a->maxTriangles = 1000;
+            }
+            const int rc = runMeshes(*a);
             if (rc != 0) {
                 std::exit(rc);
             }

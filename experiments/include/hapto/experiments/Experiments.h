@@ -1,7 +1,9 @@
 #pragma once
-/// The three `hapto experiment` runs, as functions of their parsed arguments.
+/// The `hapto experiment` runs, as functions of their parsed arguments.
 
 #include "hapto/experiments/ExperimentSupport.h"
+
+#include "hapto/scenes/MeshGenerators.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -42,6 +44,23 @@ struct Paper2Args {
 };
 /// Runs experiment 2; returns the process exit code. [control]
 int runPaper2(const Paper2Args& args);
+
+/// `hapto experiment meshes`: load against the triangle count of one generated closed mesh.
+struct MeshesArgs {
+    CommonArgs common;
+    std::vector<double> ratesHz{1000.0};  ///< Servo rates (Hz).
+    MeshShape shape = MeshShape::Sphere;  ///< Sphere or torus (closed: the hands press into it).
+    double sizeM = 0.2;                   ///< The mesh's extent along x (m).
+    std::uint64_t seed = 1;               ///< Generator seed.
+    std::size_t maxTriangles = 1'000'000; ///< Largest triangle count (sizes 1, 3 per decade).
+    int gridCells = 32;                   ///< The grid renderer's cells per side.
+    int octreeMaxItems = 8;               ///< The octree renderer's items per leaf (M).
+    double octreeMinLeafM = 0.0005;       ///< The octree renderer's smallest leaf (m).
+    double maxIndexMb = 3000.0;           ///< Largest index the sweep builds (MB).
+    Verdict verdict = Verdict::Design;    ///< What stops a renderer's growth.
+};
+/// Runs the mesh experiment; returns the process exit code. [control]
+int runMeshes(const MeshesArgs& args);
 
 /// `hapto experiment devices`: load against device count, and cursor steps against N.
 struct DevicesArgs {

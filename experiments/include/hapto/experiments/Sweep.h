@@ -64,7 +64,7 @@ struct SweepRow {
     std::string index;       ///< IndexSpec text.
     double rateHz = 0;       ///< Servo rate (Hz).
     int size = 0;            ///< K or count.
-    std::size_t objects = 0; ///< Objects in the scene.
+    std::size_t objects = 0; ///< Items the index holds: boxes, spheres and mesh triangles.
     std::uint64_t seed = 0;  ///< Scene seed (paper2).
     Condition condition = Condition::NoTouch;
     LoadFigures median;            ///< Medians over the repeats.

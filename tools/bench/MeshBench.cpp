@@ -1,0 +1,393 @@
+// hapto_bench, mesh scenes: one generated geodesic sphere (`hapto scene mesh --shape sphere`) of
+// 10^3 .. 10^6 triangles, 20 cm across, and a hand sliding on it.
+//
+// Benchmarks, named mesh-KIND/sphere/N/STRUCTURE:
+//   mesh-near  "which triangles are near this point": one query per iteration along one loop
+//              (down onto the pole, a slide 1 mm inside the surface, back out; 0.5 mm
+//              steps), answered by
+//                hapto-octree / hapto-grid  the cursor's locate: the leaf's triangle items
+//                                           (what the servo path hands the renderer);
+//                bullet-bvh   btBvhTriangleMeshShape::processAllTriangles over the cube of
+//                             half-edge r = 2 mm around the point (triangles whose quantised
+//                             AABB overlaps it);
+//                fcl-obbrss   fcl::collide of BVHModel<OBBRSS> with a sphere of radius r
+//                             (triangles that really touch the sphere, up to 10^5 contacts).
+//              Counter: candidates per query (what each hands on).
+//   mesh-build one build per iteration (wall clock): hapto's index over the scene's triangle
+//              items (2 TBB threads), Bullet's BVH, FCL's OBBRSS tree; counters
+//              bytes_per_triangle (hapto: IndexStats bytes; the others: heap growth).
+//   mesh-tick  the servo path's full tick (HapticTick: locate, candidates, god-object render,
+//              safety) along the same loop; manual time per tick; counters p50_ns, p99_ns and
+//              contact (the share of ticks in contact).
+//
+//   hapto_bench --benchmark_filter='^mesh-' --benchmark_min_time=0.5
+
+#include "HeapUsage.h"
+
+#include "hapto/index/Cursor.h"
+#include "hapto/index/SpatialIndex.h"
+#include "hapto/runtime/HapticTick.h"
+#include "hapto/runtime/World.h"
+#include "hapto/scenes/MeshGenerators.h"
+
+#include <BulletCollision/CollisionShapes/btBvhTriangleMeshShape.h>
+#include <BulletCollision/CollisionShapes/btTriangleCallback.h>
+#include <BulletCollision/CollisionShapes/btTriangleIndexVertexArray.h>
+#include <benchmark/benchmark.h>
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/geometry/shape/sphere.h>
+#include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/collision_object.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
+namespace hapto::bench {
+namespace {
+
+constexpr double kSphereSizeM = 0.2; // diameter
+constexpr double kPressM = 0.001;    // the path runs this far inside the surface
+constexpr double kNearM = 0.002;     // r: "near" for the baselines
+constexpr double kStepM = 0.0005;    // path spacing: 0.5 m/s at 1 kHz
+constexpr std::size_t kPathPoints = 4096;
+
+/// The sphere scene of about n triangles, made once per n.
+const Scene& meshScene(std::size_t n) {
+    static std::map<std::size_t, Scene> scenes;
+    auto it = scenes.find(n);
+    if (it == scenes.end()) {
+        MeshOptions o;
+        o.shape = MeshShape::Sphere;
+        o.triangles = n;
+        o.size = kSphereSizeM;
+        it = scenes.emplace(n, makeMeshScene(o)).first;
+    }
+    return it->second;
+}
+
+/// A touch and slide on the sphere's top, as a loop: down the +z axis from 1 cm above the pole
+/// to kPressM inside, a slide along a wavy great circle through the pole (+-0.3 rad, back and
+/// forth) kPressM inside, and back out along the radius; kStepM apart.
+const std::vector<Vec3>& slidePath() {
+    static const std::vector<Vec3> path = [] {
+        std::vector<Vec3> p;
+        const double outside = 0.5 * kSphereSizeM + 0.01, inside = 0.5 * kSphereSizeM - kPressM;
+        const auto onRadius = [](double a, double r) {
+            return Vec3(r * std::sin(a), 0.3 * r * std::sin(2.0 * a), r * std::cos(a));
+        };
+        for (double r = outside; r > inside; r -= kStepM) {
+            p.push_back(onRadius(0.0, r));
+        }
+        const double dA = kStepM / inside;
+        double a = 0.0, dir = 1.0;
+        while (p.size() < kPathPoints) {
+            p.push_back(onRadius(a, inside));
+            a += dir * dA;
+            if (std::abs(a) > 0.3) {
+                dir = -dir;
+            }
+        }
+        for (double r = inside; r < outside; r += kStepM) {
+            p.push_back(onRadius(a, r));
+        }
+        return p;
+    }();
+    return path;
+}
+
+IndexSpec meshSpec(bool grid) {
+    return grid ? IndexSpec::grid(64) : IndexSpec::octree(8, 0.0005);
+}
+
+// ---- Bullet ----------------------------------------------------------------------------------
+
+std::vector<int> flatIndices(const TriangleMesh& mesh) {
+    std::vector<int> idx;
+    idx.reserve(mesh.triangles().size() * 3);
+    for (const TriangleIndices& t : mesh.triangles()) {
+        idx.insert(idx.end(),
+                   {static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2])});
+    }
+    return idx;
+}
+
+static_assert(sizeof(btScalar) == sizeof(double), "hapto_bench links Bullet's float64 build");
+
+/// Bullet's mesh over the TriangleMesh's own vertices (3 doubles each, no copy) and a copy of
+/// its indices as int; the BVH is quantised (Bullet's default for static meshes, up to 2^21
+/// triangles).
+struct BulletMesh {
+    explicit BulletMesh(const TriangleMesh& mesh)
+        : indices(flatIndices(mesh)),
+          array(static_cast<int>(mesh.triangleCount()), indices.data(), 3 * sizeof(int),
+                static_cast<int>(mesh.vertices().size()),
+                const_cast<btScalar*>(&mesh.vertices()[0].x), sizeof(Vec3)),
+          shape(&array, true, true) {}
+    std::vector<int> indices;
+    btTriangleIndexVertexArray array;
+    btBvhTriangleMeshShape shape;
+};
+
+struct CountTriangles final : btTriangleCallback {
+    void processTriangle(btVector3*, int, int triangle) override {
+        ++count;
+        if (ids) {
+            ids->push_back(static_cast<std::uint32_t>(triangle));
+        }
+    }
+    std::uint32_t count = 0;
+    std::vector<std::uint32_t>* ids = nullptr; // set while checking
+};
+
+/// The triangles whose exact AABB overlaps the cube of half-edge kNearM around p, sorted.
+std::vector<std::uint32_t> aabbNear(const TriangleMesh& mesh, const Vec3& p) {
+    const Aabb cube{p - Vec3(kNearM), p + Vec3(kNearM)};
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
+        Aabb b = Aabb::empty();
+        for (const Vec3& c : mesh.corners(t)) {
+            b.expand(c);
+        }
+        if (b.overlaps(cube)) {
+            out.push_back(t);
+        }
+    }
+    return out;
+}
+
+std::size_t gMeshFailures = 0; // mesh structures that disagreed with brute force
+std::size_t gMeshChecks = 0;   // mesh check points passed
+
+constexpr std::size_t kCheckPoints = 64; // path points checked against brute force, first call
+
+/// "" when every id of `need` is in `have` (both sorted), else what is missing.
+std::string missing(const std::vector<std::uint32_t>& have, const std::vector<std::uint32_t>& need,
+                    const char* what) {
+    return std::includes(have.begin(), have.end(), need.begin(), need.end()) ? std::string()
+                                                                             : std::string(what);
+}
+
+// ---- FCL -------------------------------------------------------------------------------------
+
+using FclModel = fcl::BVHModel<fcl::OBBRSSd>;
+
+std::shared_ptr<FclModel> makeFcl(const TriangleMesh& mesh) {
+    std::vector<fcl::Vector3d> v;
+    v.reserve(mesh.vertices().size());
+    for (const Vec3& p : mesh.vertices()) {
+        v.emplace_back(p.x, p.y, p.z);
+    }
+    std::vector<fcl::Triangle> t;
+    t.reserve(mesh.triangleCount());
+    for (const TriangleIndices& i : mesh.triangles()) {
+        t.emplace_back(i[0], i[1], i[2]);
+    }
+    auto model = std::make_shared<FclModel>();
+    model->beginModel(static_cast<int>(t.size()), static_cast<int>(v.size()));
+    model->addSubModel(v, t);
+    model->endModel();
+    return model;
+}
+
+// ---- benchmarks ------------------------------------------------------------------------------
+
+void nearHapto(benchmark::State& state, std::size_t n, bool grid) {
+    const Scene& scene = meshScene(n);
+    const std::shared_ptr<const SpatialIndex> index = buildIndex(scene, meshSpec(grid));
+    Cursor cursor(*index, CursorStrategy::NeighbourLinks);
+    const std::vector<Vec3>& path = slidePath();
+    std::size_t i = 0;
+    double candidates = 0;
+    for (auto _ : state) {
+        const LocateResult r = cursor.locate(path[i]);
+        benchmark::DoNotOptimize(r.candidates.data());
+        candidates += static_cast<double>(r.candidates.size());
+        i = (i + 1) % path.size();
+    }
+    state.counters["candidates"] =
+        benchmark::Counter(candidates, benchmark::Counter::kAvgIterations);
+    state.counters["triangles"] = scene.triangleCount();
+}
+
+void nearBullet(benchmark::State& state, std::size_t n) {
+    const Scene& scene = meshScene(n);
+    const TriangleMesh& mesh = *scene.object(0).mesh;
+    const auto bullet = std::make_unique<BulletMesh>(mesh);
+    const std::vector<Vec3>& path = slidePath();
+    // Check: Bullet returns at least every triangle whose AABB overlaps the query cube.
+    for (std::size_t k = 0; k < kCheckPoints; ++k) {
+        const Vec3& p = path[k * path.size() / kCheckPoints];
+        std::vector<std::uint32_t> ids;
+        CountTriangles callback;
+        callback.ids = &ids;
+        bullet->shape.processAllTriangles(&callback,
+                                          btVector3(p.x - kNearM, p.y - kNearM, p.z - kNearM),
+                                          btVector3(p.x + kNearM, p.y + kNearM, p.z + kNearM));
+        std::sort(ids.begin(), ids.end());
+        const std::string error = missing(ids, aabbNear(mesh, p), "bullet-bvh missed a triangle");
+        if (!error.empty()) {
+            ++gMeshFailures;
+            state.SkipWithError(error.c_str());
+            return;
+        }
+        ++gMeshChecks;
+    }
+    std::size_t i = 0;
+    double candidates = 0;
+    for (auto _ : state) {
+        const Vec3& p = path[i];
+        CountTriangles callback;
+        bullet->shape.processAllTriangles(&callback,
+                                          btVector3(p.x - kNearM, p.y - kNearM, p.z - kNearM),
+                                          btVector3(p.x + kNearM, p.y + kNearM, p.z + kNearM));
+        candidates += callback.count;
+        i = (i + 1) % path.size();
+    }
+    state.counters["candidates"] =
+        benchmark::Counter(candidates, benchmark::Counter::kAvgIterations);
+    state.counters["triangles"] = scene.triangleCount();
+}
+
+void nearFcl(benchmark::State& state, std::size_t n) {
+    const Scene& scene = meshScene(n);
+    fcl::CollisionObjectd meshObject(makeFcl(*scene.object(0).mesh));
+    fcl::CollisionObjectd probe(std::make_shared<fcl::Sphered>(kNearM));
+    fcl::CollisionRequestd request(100000, false);
+    fcl::CollisionResultd result;
+    const std::vector<Vec3>& path = slidePath();
+    // Check: FCL's triangles touch the sphere, so their AABBs overlap the cube around it.
+    for (std::size_t k = 0; k < kCheckPoints; ++k) {
+        const Vec3& p = path[k * path.size() / kCheckPoints];
+        probe.setTranslation(fcl::Vector3d(p.x, p.y, p.z));
+        probe.computeAABB();
+        result.clear();
+        fcl::collide(&meshObject, &probe, request, result);
+        std::vector<std::uint32_t> ids;
+        for (std::size_t c = 0; c < result.numContacts(); ++c) {
+            ids.push_back(static_cast<std::uint32_t>(result.getContact(c).b1));
+        }
+        std::sort(ids.begin(), ids.end());
+        ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+        const std::string error =
+            missing(aabbNear(*scene.object(0).mesh, p), ids, "fcl-obbrss returned a far triangle");
+        if (!error.empty()) {
+            ++gMeshFailures;
+            state.SkipWithError(error.c_str());
+            return;
+        }
+        ++gMeshChecks;
+    }
+    std::size_t i = 0;
+    double candidates = 0;
+    for (auto _ : state) {
+        const Vec3& p = path[i];
+        probe.setTranslation(fcl::Vector3d(p.x, p.y, p.z));
+        probe.computeAABB();
+        result.clear();
+        fcl::collide(&meshObject, &probe, request, result);
+        candidates += static_cast<double>(result.numContacts());
+        i = (i + 1) % path.size();
+    }
+    state.counters["candidates"] =
+        benchmark::Counter(candidates, benchmark::Counter::kAvgIterations);
+    state.counters["triangles"] = scene.triangleCount();
+}
+
+void buildMesh(benchmark::State& state, std::size_t n, int which) {
+    const Scene& scene = meshScene(n);
+    const TriangleMesh& mesh = *scene.object(0).mesh;
+    double bytes = 0;
+    for (auto _ : state) {
+        const std::size_t before = heapBytesInUse();
+        if (which == 0 || which == 1) {
+            const auto index = buildIndex(scene, meshSpec(which == 1));
+            bytes = static_cast<double>(index->stats().bytes);
+            benchmark::DoNotOptimize(index.get());
+        } else if (which == 2) {
+            const auto bullet = std::make_unique<BulletMesh>(mesh);
+            bytes = static_cast<double>(heapBytesInUse() - before);
+            benchmark::DoNotOptimize(bullet.get());
+        } else {
+            const auto fcl = makeFcl(mesh);
+            bytes = static_cast<double>(heapBytesInUse() - before);
+            benchmark::DoNotOptimize(fcl.get());
+        }
+    }
+    state.counters["bytes_per_triangle"] = bytes / scene.triangleCount();
+    state.counters["triangles"] = scene.triangleCount();
+}
+
+void tickMesh(benchmark::State& state, std::size_t n, bool grid) {
+    World world(meshScene(n), meshSpec(grid));
+    HapticTick tick;
+    const std::vector<Vec3>& path = slidePath();
+    std::vector<double> ns;
+    ns.reserve(1 << 20);
+    std::size_t i = 0;
+    double contacts = 0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const TickOutput out = tick.tick(world.current(), path[i], Vec3(0.0), 1e-3, Vec3(0.0));
+        const auto t1 = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(out.forceN);
+        const double s = std::chrono::duration<double>(t1 - t0).count();
+        state.SetIterationTime(s);
+        if (ns.size() < ns.capacity()) {
+            ns.push_back(1e9 * s);
+        }
+        contacts += out.render.contactCount > 0;
+        i = (i + 1) % path.size();
+    }
+    std::sort(ns.begin(), ns.end());
+    const auto pct = [&](double q) {
+        return ns.empty() ? 0.0
+                          : ns[static_cast<std::size_t>(q * static_cast<double>(ns.size() - 1))];
+    };
+    state.counters["p50_ns"] = pct(0.5);
+    state.counters["p99_ns"] = pct(0.99);
+    state.counters["contact"] = benchmark::Counter(contacts, benchmark::Counter::kAvgIterations);
+    state.counters["triangles"] = meshScene(n).triangleCount();
+}
+
+} // namespace
+
+std::size_t meshCheckFailures() {
+    return gMeshFailures;
+}
+
+std::size_t meshChecksPassed() {
+    return gMeshChecks;
+}
+
+void registerMeshBenchmarks() {
+    using benchmark::RegisterBenchmark;
+    for (const std::size_t n : {1000, 10000, 100000, 1000000}) {
+        const std::string sn = "sphere/" + std::to_string(n) + "/";
+        RegisterBenchmark(("mesh-build/" + sn + "hapto-octree").c_str(), buildMesh, n, 0)
+            ->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
+        RegisterBenchmark(("mesh-build/" + sn + "hapto-grid").c_str(), buildMesh, n, 1)
+            ->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
+        RegisterBenchmark(("mesh-build/" + sn + "bullet-bvh").c_str(), buildMesh, n, 2)
+            ->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
+        RegisterBenchmark(("mesh-build/" + sn + "fcl-obbrss").c_str(), buildMesh, n, 3)
+            ->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
+        RegisterBenchmark(("mesh-near/" + sn + "hapto-octree").c_str(), nearHapto, n, false);
+        RegisterBenchmark(("mesh-near/" + sn + "hapto-grid").c_str(), nearHapto, n, true);
+        RegisterBenchmark(("mesh-near/" + sn + "bullet-bvh").c_str(), nearBullet, n);
+        RegisterBenchmark(("mesh-near/" + sn + "fcl-obbrss").c_str(), nearFcl, n);
+        RegisterBenchmark(("mesh-tick/" + sn + "hapto-octree").c_str(), tickMesh, n, false)
+            ->UseManualTime();
+    }
+}
+
+} // namespace hapto::bench
