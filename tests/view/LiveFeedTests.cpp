@@ -15,21 +15,42 @@
 
 using namespace hapto;
 
-TEST_CASE("a live frame carries each device's ticks, misses, load, point, force and contacts, "
-          "and the poses of moved objects") {
+namespace {
+
+/// The two default hands over the default scene in step mode, with a feed (never started).
+struct Session {
+    explicit Session(const char* index)
+        : world(scene, IndexSpec::parse(index)), runtime(makeRuntime()), feed(runtime, server) {}
+
+    Runtime makeRuntime() {
+        world.useClock(clock);
+        std::vector<RuntimeDevice> devices;
+        for (DeviceConfig c : defaultDeviceConfigs()) {
+            devices.push_back({makeDevice(c, scene), c, nullptr});
+        }
+        RuntimeOptions options;
+        options.realtime = false;
+        return Runtime(world, std::move(devices), options);
+    }
+
     const Scene scene = makeDefaultScene();
     ManualClock clock;
-    World world(scene, IndexSpec::parse("octree:2:0.005"));
-    world.useClock(clock);
-    std::vector<RuntimeDevice> devices;
-    for (DeviceConfig c : defaultDeviceConfigs()) {
-        devices.push_back({makeDevice(c, scene), c, nullptr});
-    }
-    RuntimeOptions options;
-    options.realtime = false;
-    Runtime runtime(world, std::move(devices), options);
+    World world;
+    Runtime runtime;
     ViewServer server;
-    LiveFeed feed(runtime, server);
+    LiveFeed feed;
+};
+
+} // namespace
+
+TEST_CASE("a live frame carries each device's ticks, misses, load, point, force and contacts, "
+          "and the poses of moved objects") {
+    Session session("octree:2:0.005");
+    const Scene& scene = session.scene;
+    ManualClock& clock = session.clock;
+    World& world = session.world;
+    Runtime& runtime = session.runtime;
+    LiveFeed& feed = session.feed;
     REQUIRE(feed.devices().size() == 2);
     CHECK(feed.devices()[0].name == runtime.report().devices[0].name);
 
@@ -84,19 +105,11 @@ TEST_CASE("a live frame carries each device's ticks, misses, load, point, force 
 
 TEST_CASE("a live frame shows each device's cursor leaf: the box holding its point and the "
           "objects the leaf lists, as a fresh locate in the same snapshot gives them") {
-    const Scene scene = makeDefaultScene();
-    ManualClock clock;
-    World world(scene, IndexSpec::parse("octree:4:0.005"));
-    world.useClock(clock);
-    std::vector<RuntimeDevice> devices;
-    for (DeviceConfig c : defaultDeviceConfigs()) {
-        devices.push_back({makeDevice(c, scene), c, nullptr});
-    }
-    RuntimeOptions options;
-    options.realtime = false;
-    Runtime runtime(world, std::move(devices), options);
-    ViewServer server;
-    LiveFeed feed(runtime, server);
+    Session session("octree:4:0.005");
+    ManualClock& clock = session.clock;
+    World& world = session.world;
+    Runtime& runtime = session.runtime;
+    LiveFeed& feed = session.feed;
     const std::uint64_t t0 = clock.nowNs();
     REQUIRE(runtime.startStepped(clock) == 2);
     int checked = 0;
