@@ -2,10 +2,57 @@
 
 #include "hapto/core/Finite.h"
 
+#include <algorithm>
+#include <array>
+
 namespace hapto {
 
 static_assert(sizeof(HapticTick) == 3072, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
+
+namespace {
+
+/// The first leaf that the segment a -> b passes through and that is not in `listed`, walking
+/// from a leaf to the next at the point the segment leaves each box; kNoLeaf when there is
+/// none (or the walk leaves the bounds, or takes more than 64 leaves). [servo]
+LocateResult firstUnlistedLeaf(const SpatialIndex& index, const Vec3& a, const Vec3& b,
+                               std::span<const std::uint32_t> listed) noexcept {
+    const Vec3 d = b - a;
+    const double length = glm::length(d);
+    double t = 0.0;
+    for (int walked = 0; walked < 64; ++walked) {
+        const LocateResult at = index.locate(a + t * d);
+        if (at.outside) {
+            return {};
+        }
+        if (std::find(listed.begin(), listed.end(), at.leaf) == listed.end()) {
+            return at;
+        }
+        if (!(length > 0.0)) {
+            return {};
+        }
+        // Where the segment leaves this leaf's box: the nearest exit over the three slabs.
+        const Aabb box = index.leafBounds(at.leaf);
+        double exit = 1.0;
+        for (int i = 0; i < 3; ++i) {
+            if (d[i] > 0.0) {
+                exit = std::min(exit, (box.max[i] - a[i]) / d[i]);
+            } else if (d[i] < 0.0) {
+                exit = std::min(exit, (box.min[i] - a[i]) / d[i]);
+            }
+        }
+        if (exit >= 1.0) {
+            return {};
+        }
+        t = std::max(exit, t) + 1e-9 / length; // a nanometre past the face
+        if (t > 1.0) {
+            return {};
+        }
+    }
+    return {};
+}
+
+} // namespace
 
 HapticTick::HapticTick(const RendererConfig& renderer, const SafetyConfig& safety)
     : mRenderer(renderer), mSafety(safety) {}
@@ -54,8 +101,45 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     out.outside = atDevice.outside;
     out.deviceLeaf = atDevice.leaf;
 
-    // 3. Render.
+    // 3. Render. The candidates cover where the device and the proxy are, not every place the
+    // proxy visits this tick: a proxy sliding over fine triangles (a mesh whose leaves are
+    // smaller than one tick's motion, with the device in an empty leaf under the surface)
+    // can slide off the triangles it knows, over a leaf nobody listed, and through the
+    // surface. So the ways the proxy can have gone are walked leaf by leaf: from its start
+    // along last tick's contact plane to the device point's projection on it (a slide), and
+    // from there and from the start to where it ended; at the first leaf that was not a
+    // candidate the tick is solved again from the same start with that leaf's items too, up
+    // to kExtraLeaves times.
+    const Vec3 from = mRenderer.proxy();
+    const Vec3 slide =
+        mRenderer.inContact() ? p - glm::dot(p - from, mSlideNormal) * mSlideNormal : from;
+    const GodObjectRenderer start = mRenderer; // a plain copy: no allocation
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
+    std::array<std::uint32_t, 2 + kExtraLeaves> listed{atDevice.leaf, atProxy.leaf};
+    std::size_t listedCount = 2;
+    std::uint32_t tested = out.render.objectsTested;
+    while (listedCount < listed.size()) {
+        const std::span<const std::uint32_t> known(listed.data(), listedCount);
+        LocateResult missed = firstUnlistedLeaf(*index, from, slide, known);
+        if (missed.leaf == kNoLeaf) {
+            missed = firstUnlistedLeaf(*index, slide, out.render.proxy, known);
+        }
+        if (missed.leaf == kNoLeaf) {
+            missed = firstUnlistedLeaf(*index, from, out.render.proxy, known);
+        }
+        if (missed.leaf == kNoLeaf || !mCandidates.add(missed.candidates)) {
+            break;
+        }
+        listed[listedCount++] = missed.leaf;
+        mRenderer = start;
+        out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
+        tested += out.render.objectsTested;
+        ++out.extraLeaves;
+    }
+    out.render.objectsTested = tested;
+    if (out.render.contactCount > 0) {
+        mSlideNormal = out.render.contacts[0].normal;
+    }
 
     // 4. Force effects at the device point, then the hook, and the external force. A hook
     // that returns NaN or infinity adds nothing (counted), like a renderer's non-finite output.

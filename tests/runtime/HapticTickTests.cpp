@@ -1,5 +1,6 @@
 // HapticTick, the one haptic tick: locate, candidates, render, effects, safety.
 
+#include "TestMeshes.h"
 #include "hapto/runtime/HapticTick.h"
 #include "hapto/scenes/Generators.h"
 
@@ -199,4 +200,54 @@ TEST_CASE("the tick adds its effects and its hook to the render force, each repo
     CHECK(bad.hookNonFinite);
     CHECK(bad.hookN == Vec3(0.0));
     CHECK(bad.forceN == Vec3(0.2, 0, 0));
+}
+
+TEST_CASE("a hand sliding over a fine mesh whose leaves are smaller than one tick's motion stays "
+          "on the surface: the leaves the proxy slides over are rendered too") {
+    // An icosphere of 327 680 triangles (edges about 0.45 mm) in an octree of 0.5 mm leaves,
+    // and a device 1 mm inside it sliding 0.5 mm per tick over its top: every few ticks the
+    // proxy slides into a leaf that neither the device's nor its own old leaf lists.
+    const double r = 0.05;
+    const int subdiv = GENERATE(3, 7);
+    INFO("subdivisions " << subdiv);
+    const Scene scene(Aabb{Vec3(-0.06), Vec3(0.06)},
+                      {makeMesh(1, Vec3(0.0), test::makeIcosphere(subdiv, r))});
+    const char* spec = GENERATE("grid:64", "octree:8:0.0005");
+    INFO(spec);
+    World world(scene, IndexSpec::parse(spec));
+    HapticTick tick;
+    int touching = 0;
+    int ticks = 0;
+    double deepest = 0.0;
+    const double polar = 0.3; // rad from the pole: a circle of about 1.5 cm radius
+    const auto along = [&](double a) {
+        return Vec3(std::sin(polar) * std::cos(a), std::cos(polar), std::sin(polar) * std::sin(a));
+    };
+    for (int i = 0; i <= 700; ++i) {
+        // In along a radius for 100 ticks to 1 mm inside the surface, then round the circle at
+        // 0.5 mm per tick, 1 mm inside.
+        const double u = std::min(1.0, i / 100.0);
+        const double depth = r + 0.01 - u * 0.011;
+        const double a = i > 100 ? (i - 100) * 0.0005 / ((r - 0.001) * std::sin(polar)) : 0.0;
+        const Vec3 p = depth * along(a);
+        const TickOutput out = tick.tick(world.current(), p, Vec3(NAN), 1e-3, Vec3(0.0));
+        if (i > 110) {
+            ++ticks;
+            touching += out.render.contactCount > 0 ? 1 : 0;
+            deepest = std::max(deepest, r - glm::length(out.render.proxy));
+        }
+    }
+    // The facets lie inside the sphere: the deepest the proxy may rest is the nearest facet
+    // plane's distance below r.
+    double nearestPlane = r;
+    const TriangleMesh& mesh = *scene.object(0).mesh;
+    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
+        const auto [v0, v1, v2] = mesh.corners(t);
+        nearestPlane =
+            std::min(nearestPlane, glm::dot(glm::normalize(glm::cross(v1 - v0, v2 - v0)), v0));
+    }
+    INFO("ticks in contact " << touching << " of " << ticks << ", deepest proxy " << deepest
+                             << ", facet sag " << r - nearestPlane);
+    CHECK(touching == ticks);                 // the device 1 mm inside is always held
+    CHECK(deepest < r - nearestPlane + 1e-6); // the proxy never sinks below the facets
 }

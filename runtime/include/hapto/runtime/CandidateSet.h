@@ -8,20 +8,21 @@
 
 namespace hapto {
 
-/// Up to four spans of candidate object slots (dense positions into `scene.objects()`): the
-/// device point's leaf, the proxy's leaf, the snapshot's moving objects, and a spare. The spans
+/// Up to six spans of candidate items (object slots and triangle items of `scene`): the device
+/// point's leaf, the proxy's leaf, the snapshot's moving objects, and up to three leaves the
+/// proxy slid into during the tick (HapticTick solves again with each). The spans
 /// are views; whoever fills the set keeps the storage alive for the tick. Slots may repeat
 /// across (and within) spans: the renderer treats duplicates as one object.
 struct CandidateSet {
     /// How many spans fit.
-    static constexpr std::size_t kMaxSpans = 4;
+    static constexpr std::size_t kMaxSpans = 6;
 
     std::array<std::span<const std::uint32_t>, kMaxSpans>
         spans{};             ///< The spans; first `count` used.
     std::uint8_t count = 0;  ///< Spans in use.
     bool overflowed = false; ///< True when add() was called on a full set (that span was dropped).
 
-    /// Appends a span; returns false (and sets `overflowed`) when all four are in use. Empty
+    /// Appends a span; returns false (and sets `overflowed`) when all of them are in use. Empty
     /// spans are accepted and cost nothing. [servo]
     bool add(std::span<const std::uint32_t> slots) noexcept {
         if (count >= kMaxSpans) {

@@ -29,6 +29,8 @@ struct TickOutput {
     std::uint32_t locateSteps = 0;          ///< Cursor steps, both cursors.
     bool outside = false;                   ///< The device point is outside the index's bounds.
     std::uint32_t deviceLeaf = 0xFFFFFFFFu; ///< The device point's leaf (kNoLeaf outside).
+    std::uint8_t extraLeaves = 0; ///< Leaves the proxy slid into and the tick was solved again
+                                  ///< with (HapticTick::kExtraLeaves at most).
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
 };
 
@@ -53,6 +55,10 @@ struct TickOutput {
 /// which 1408 are the renderer and 1288 the effect set (8 effects of 160 bytes).
 class alignas(64) HapticTick {
 public:
+    /// Leaves the proxy may slide into in one tick, each solved again with its items
+    /// (CandidateSet has a span for each: device, proxy, moving, and these).
+    static constexpr std::size_t kExtraLeaves = CandidateSet::kMaxSpans - 3;
+
     /// Checks both configurations; throws std::invalid_argument when one is invalid. [control]
     explicit HapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
 
@@ -104,8 +110,9 @@ private:
     EffectSet mEffects;                        ///< Springs, dampers, constant forces.
     TickHook mHook;                            ///< The application's per-tick hook, or none.
     const SpatialIndex* mBoundIndex = nullptr; ///< The index the cursors are bound to.
-    std::uint64_t mBoundVersion = 0;           ///< The snapshot version they were bound for.
-    bool mFresh = true;                        ///< The next tick starts afresh (reset()).
+    Vec3 mSlideNormal{0.0}; ///< The last contact's first normal: the plane a proxy slides on.
+    std::uint64_t mBoundVersion = 0; ///< The snapshot version they were bound for.
+    bool mFresh = true;              ///< The next tick starts afresh (reset()).
 };
 
 } // namespace hapto
