@@ -211,3 +211,126 @@ TEST_CASE("hapto render refuses bad input with exit code 2, says where, and writ
         CHECK(entry.path().filename().string().find(".tmp-") == std::string::npos);
     }
 }
+
+namespace {
+
+/// Runs `hapto render` over a scene text and a path, and returns its rows.
+std::vector<Row> renderRows(const TempDir& dir, const std::string& name, const std::string& scene,
+                            const std::vector<std::array<double, 3>>& points) {
+    writeFile(dir / (name + ".json"), scene);
+    writeFile(dir / (name + ".csv"), pathCsv(points));
+    const CommandResult r = runHapto("render --scene " + (dir / (name + ".json")).string() +
+                                     " --path " + (dir / (name + ".csv")).string());
+    INFO(r.output.substr(0, 2000));
+    REQUIRE(r.exitCode == 0);
+    std::vector<Row> rows = parse(r.output);
+    REQUIRE(rows.size() == points.size());
+    return rows;
+}
+
+/// A version 2 scene with one inline mesh object (id 4) of stiffness k at `center`.
+std::string meshScene(double k, const std::string& center, const std::string& vertices,
+                      const std::string& triangles) {
+    std::ostringstream s;
+    s.precision(17);
+    s << R"({"format": "hapto-scene", "version": 2, "objects": [)"
+      << R"({"id": 4, "shape": "mesh", "center": )" << center << R"(, "vertices": )" << vertices
+      << R"(, "triangles": )" << triangles << R"(, "stiffness": )" << k << "}]}";
+    return s.str();
+}
+
+} // namespace
+
+TEST_CASE("hapto render: a flat two-triangle mesh square feels like the box face it replaces, "
+          "within 1e-9 N along the same path") {
+    const double k = GENERATE(300.0, 2500.0);
+    INFO("k " << k);
+    TempDir dir;
+    // The cube's top face (y = 0.025, x and z in [-0.025, 0.025]) as two triangles, CCW seen from
+    // +y, sharing the diagonal x = z; an open, one-sided mesh.
+    const std::string square = meshScene(
+        k, "[0, 0.025, 0]",
+        "[[-0.025, 0, -0.025], [-0.025, 0, 0.025], [0.025, 0, 0.025], [0.025, 0, -0.025]]",
+        "[[0, 1, 2], [0, 2, 3]]");
+    // Down from 1 cm above the face to 2 mm deep, a slide across the shared diagonal at that
+    // depth, then 3 mm deep and held: all well inside the face.
+    std::vector<std::array<double, 3>> points;
+    for (int i = 0; i <= 48; ++i) {
+        points.push_back({-0.012, 0.025 + std::max(-0.002, 0.01 - 0.00025 * i), -0.006});
+    }
+    for (int i = 1; i <= 120; ++i) {
+        const double u = i / 120.0;
+        points.push_back(
+            {-0.012 + 0.026 * u, 0.023 - 0.0005 * std::sin(6.0 * u), -0.006 + 0.014 * u});
+    }
+    for (int i = 1; i <= 30; ++i) {
+        points.push_back({0.014, 0.025 - 0.002 - 0.001 * std::min(1.0, i / 10.0), 0.008});
+    }
+    const std::vector<Row> box = renderRows(dir, "box", cubeScene(k), points);
+    const std::vector<Row> mesh = renderRows(dir, "square", square, points);
+    int pressed = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        INFO("tick " << i);
+        CHECK(mesh[i].contacts == box[i].contacts);
+        for (int a = 0; a < 3; ++a) {
+            CHECK(mesh[i].force[a] == Approx(box[i].force[a]).margin(1e-9));
+            CHECK(mesh[i].proxy[a] == Approx(box[i].proxy[a]).margin(1e-12));
+        }
+        if (box[i].contacts > 0) {
+            ++pressed;
+            const double depth = 0.025 - points[i][1];
+            CHECK(mesh[i].force[1] == Approx(k * (depth + kSkinM)).margin(1e-9 * k));
+        }
+    }
+    CHECK(pressed > 150); // the slide and the hold, not only a few ticks
+}
+
+TEST_CASE("hapto render: a closed cube mesh pressed into an edge holds: no pop-through, the "
+          "force is k times the depth along the path, pointing back out of the edge") {
+    const double k = GENERATE(500.0, 2000.0);
+    INFO("k " << k);
+    TempDir dir;
+    // A 5 cm cube at the origin as 12 triangles, CCW seen from outside.
+    const std::string cube =
+        meshScene(k, "[0, 0, 0]",
+                  "[[-0.025, -0.025, -0.025], [0.025, -0.025, -0.025], [0.025, 0.025, -0.025], "
+                  "[-0.025, 0.025, -0.025], [-0.025, -0.025, 0.025], [0.025, -0.025, 0.025], "
+                  "[0.025, 0.025, 0.025], [-0.025, 0.025, 0.025]]",
+                  "[[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [3, 7, 6], "
+                  "[3, 6, 2], [0, 4, 7], [0, 7, 3], [1, 2, 6], [1, 6, 5]]");
+    // Along the bisector of the edge between the +x and +y faces, at z = 0.004: from 2 cm out
+    // to 8 mm in (s < 0 is inside), 0.25 mm per tick, then held for 40 ticks.
+    const double r2 = std::sqrt(0.5);
+    std::vector<std::array<double, 3>> points;
+    std::vector<double> along;
+    for (int i = 0; i <= 112 + 40; ++i) {
+        const double s = std::max(-0.008, 0.02 - 0.00025 * i);
+        points.push_back({0.025 + r2 * s, 0.025 + r2 * s, 0.004});
+        along.push_back(s);
+    }
+    const std::vector<Row> rows = renderRows(dir, "cube", cube, points);
+    int held = 0;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        INFO("tick " << i << " s " << along[i]);
+        const Row& row = rows[i];
+        const double magnitude =
+            std::sqrt(row.force[0] * row.force[0] + row.force[1] * row.force[1] +
+                      row.force[2] * row.force[2]);
+        if (along[i] > 1e-6) {
+            CHECK(row.contacts == 0);
+            CHECK(magnitude == 0.0);
+        } else if (along[i] < -1e-6) {
+            ++held;
+            CHECK(row.contacts >= 1);
+            // k times the depth past the edge (the skin adds at most 2e-8 m), out along the
+            // bisector: the proxy stays on the edge, not pushed through either face.
+            CHECK(magnitude == Approx(k * -along[i]).margin(3e-8 * k));
+            CHECK(row.force[0] == Approx(r2 * magnitude).margin(3e-8 * k));
+            CHECK(row.force[1] == Approx(r2 * magnitude).margin(3e-8 * k));
+            CHECK(row.force[2] == Approx(0.0).margin(1e-9 * k));
+            CHECK(row.proxy[0] == Approx(0.025).margin(3e-8));
+            CHECK(row.proxy[1] == Approx(0.025).margin(3e-8));
+        }
+    }
+    CHECK(held > 60);
+}

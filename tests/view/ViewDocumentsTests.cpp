@@ -5,6 +5,8 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 using namespace hapto;
 
 TEST_CASE("the scene document carries every object's shape, centre, size and rotation") {
@@ -71,4 +73,99 @@ TEST_CASE("the trace document: world-frame points and forces, contacts, frames a
     CHECK(frames[25]["forceN"] == 1.0); // t = 0.5 s
     CHECK(frames[25]["force"][2] == -1.0);
     CHECK(frames[10]["loadP50"].get<double>() == Approx(0.1).epsilon(0.04));
+}
+
+namespace {
+
+/// A tetrahedron of 4 triangles (CCW from outside), `size` m along each axis.
+std::shared_ptr<const TriangleMesh> tetrahedron(double size) {
+    return TriangleMesh::make({Vec3(0), Vec3(size, 0, 0), Vec3(0, size, 0), Vec3(0, 0, size)},
+                              {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}, MeshSource{}, "test");
+}
+
+} // namespace
+
+TEST_CASE("the scene document carries each mesh's own vertices and triangles, placed by its pose; "
+          "past the triangle cap a mesh comes as its local bounds") {
+    const Quat turn = glm::angleAxis(0.7, Vec3(1, 0, 0));
+    const auto small = tetrahedron(0.02);
+    const Scene scene(Aabb{Vec3(-1.0), Vec3(1.0)},
+                      {makeBox(1, Vec3(0.3, 0, 0), Vec3(0.01)),
+                       makeMesh(5, Vec3(0.1, 0.2, 0.3), small, turn),
+                       makeMesh(6, Vec3(-0.1, 0, 0), tetrahedron(0.04))});
+    const auto doc = nlohmann::json::parse(viewSceneJson(scene, {}, ViewMode::Live));
+    REQUIRE(doc["objects"].size() == 3);
+    CHECK_FALSE(doc["objects"][0].contains("vertices")); // a box has none
+    const auto& mesh = doc["objects"][1];
+    CHECK(mesh["id"] == 5);
+    CHECK(mesh["shape"] == "mesh");
+    CHECK(mesh["center"] == nlohmann::json::array({0.1, 0.2, 0.3}));
+    CHECK(mesh["rotation"][0].get<double>() == Approx(turn.w));
+    CHECK(mesh["rotation"][1].get<double>() == Approx(turn.x));
+    CHECK(mesh["triangleCount"] == 4);
+    // Flat, in the mesh's own frame, exactly as held.
+    REQUIRE(mesh["vertices"].size() == 3 * small->vertices().size());
+    for (std::size_t i = 0; i < small->vertices().size(); ++i) {
+        for (int a = 0; a < 3; ++a) {
+            CHECK(mesh["vertices"][3 * i + a].get<double>() == small->vertices()[i][a]);
+        }
+    }
+    REQUIRE(mesh["triangles"].size() == 3 * small->triangles().size());
+    for (std::size_t t = 0; t < small->triangles().size(); ++t) {
+        for (int c = 0; c < 3; ++c) {
+            CHECK(mesh["triangles"][3 * t + c].get<std::uint32_t>() == small->triangles()[t][c]);
+        }
+    }
+    CHECK(doc["meshes"]["trianglesSent"] == 8);
+    CHECK(doc["meshes"]["boxed"].empty());
+
+    // A cap of 6 triangles: the first mesh (4) fits, the second (4 more) comes as its bounds.
+    const auto capped = nlohmann::json::parse(viewSceneJson(scene, {}, ViewMode::Live, 6));
+    CHECK(capped["objects"][1].contains("vertices"));
+    const auto& boxed = capped["objects"][2];
+    CHECK_FALSE(boxed.contains("vertices"));
+    CHECK_FALSE(boxed.contains("triangles"));
+    CHECK(boxed["triangleCount"] == 4);
+    CHECK(boxed["localBounds"]["min"] == nlohmann::json::array({0.0, 0.0, 0.0}));
+    CHECK(boxed["localBounds"]["max"] == nlohmann::json::array({0.04, 0.04, 0.04}));
+    CHECK(capped["meshes"]["maxTriangles"] == 6);
+    CHECK(capped["meshes"]["trianglesSent"] == 4);
+    CHECK(capped["meshes"]["boxed"] == nlohmann::json::array({6}));
+    CHECK(kViewMaxMeshTriangles == 200'000);
+}
+
+TEST_CASE("the trace document shows a version 2 trace's proxies in the world frame; a version 1 "
+          "trace has none") {
+    const Scene scene(Aabb{Vec3(-1.0), Vec3(1.0)}, {makeBox(3, Vec3(0.0), Vec3(0.01))});
+    ViewTrace t;
+    t.header.name = "right";
+    t.header.rateHz = 1000;
+    t.transform.translation = Vec3(0.0, 0.0, -0.05);
+    // The point presses along z into the box's -z face (world z = -0.01); the proxy stays on it.
+    for (std::uint64_t i = 0; i < 100; ++i) {
+        TraceSample s;
+        s.tick = i;
+        s.timeNs = i * 1'000'000;
+        s.positionM = Vec3(0.001, 0, 0.0006 * static_cast<double>(i));
+        s.proxyM = Vec3(0.001, 0, std::min(s.positionM.z, 0.04));
+        t.samples.push_back(s);
+    }
+    const auto doc = nlohmann::json::parse(viewTraceJson(scene, {t}, 100.0));
+    const auto& frames = doc["devices"][0]["frames"];
+    REQUIRE(frames.size() == 10);
+    bool apart = false;
+    for (const auto& f : frames) {
+        REQUIRE(f.contains("proxy"));
+        const double z = f["point"][2];
+        CHECK(f["proxy"][0].get<double>() == Approx(0.001));
+        CHECK(f["proxy"][2].get<double>() == Approx(std::min(z, -0.01)).margin(1e-12));
+        apart = apart || f["proxy"][2].get<double>() < z - 1e-3;
+    }
+    CHECK(apart); // the proxy held back on the face while the point went in
+
+    t.header.version = 1;
+    const auto old = nlohmann::json::parse(viewTraceJson(scene, {t}, 100.0));
+    for (const auto& f : old["devices"][0]["frames"]) {
+        CHECK_FALSE(f.contains("proxy"));
+    }
 }

@@ -43,6 +43,14 @@ function setupScene(scene) {
     if (mesh) { world.add(mesh); view.objects.set(o.id, mesh); }
   }
   scene.devices.forEach((d, i) => view.devices.push(makeDevice(world, d, i)));
+  const boxed = (scene.meshes && scene.meshes.boxed) || [];
+  if (boxed.length) {
+    const note = document.getElementById('meshnote');
+    note.textContent = 'mesh #' + boxed.join(', #') + ' drawn as its bounding box: over ' +
+      scene.meshes.maxTriangles + ' triangles per scene';
+    note.dataset.boxed = boxed.join(',');
+    note.style.display = 'block';
+  }
 
   window.addEventListener('resize', () => {
     camera.aspect = host.clientWidth / host.clientHeight;
@@ -63,12 +71,22 @@ function makeObject(o) {
   } else if (o.shape === 'sphere') {
     geometry = new THREE.SphereBufferGeometry(o.halfExtents[0], 24, 16);
   } else if (o.shape === 'mesh' && o.vertices && o.triangles) {
-    // The hook for meshes: vertices [[x,y,z],...] and triangles [[a,b,c],...] in the
-    // object's frame, placed by centre and rotation like the other shapes.
+    // Vertices x y z ... and triangles a b c ... (flat) in the object's frame, placed by
+    // centre and rotation like the other shapes, so a carried mesh moves with its pose.
     geometry = new THREE.BufferGeometry();
     geometry.setAttribute('position', new THREE.Float32BufferAttribute(o.vertices.flat(), 3));
     geometry.setIndex(o.triangles.flat());
     geometry.computeVertexNormals();
+  } else if (o.shape === 'mesh' && o.localBounds) {
+    // Over the page's triangle cap: its bounding box in its own frame, as a wireframe.
+    const lo = v3(o.localBounds.min), hi = v3(o.localBounds.max);
+    const size = hi.clone().sub(lo), mid = lo.clone().add(hi).multiplyScalar(0.5);
+    const box = new THREE.BoxBufferGeometry(size.x, size.y, size.z);
+    box.translate(mid.x, mid.y, mid.z);
+    const wire = new THREE.LineSegments(new THREE.EdgesGeometry(box),
+                                        new THREE.LineBasicMaterial({ color: OBJECT_COLOR }));
+    placeObject(wire, o.center, o.rotation);
+    return wire;
   } else {
     return null;
   }

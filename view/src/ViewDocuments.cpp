@@ -2,11 +2,13 @@
 
 #include "hapto/view/ViewDocuments.h"
 
+#include "hapto/scenes/TriangleMesh.h"
 #include "hapto/view/LoadWindow.h"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <vector>
 
 namespace hapto {
 namespace {
@@ -34,15 +36,43 @@ nlohmann::json containing(const Scene& scene, const Vec3& p) {
 
 } // namespace
 
-std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& devices,
-                          ViewMode mode) {
+std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& devices, ViewMode mode,
+                          std::uint64_t maxMeshTriangles) {
     nlohmann::json objects = nlohmann::json::array();
+    nlohmann::json boxed = nlohmann::json::array();
+    std::uint64_t sent = 0; // mesh triangles sent so far, in slot order
     for (const SceneObject& o : scene.objects()) {
-        objects.push_back({{"id", o.id},
-                           {"shape", std::string(shapeName(o.shape))},
-                           {"center", vec(o.center)},
-                           {"halfExtents", vec(o.halfExtents)},
-                           {"rotation", quat(o.rotation)}});
+        nlohmann::json object{{"id", o.id},
+                              {"shape", std::string(shapeName(o.shape))},
+                              {"center", vec(o.center)},
+                              {"halfExtents", vec(o.halfExtents)},
+                              {"rotation", quat(o.rotation)}};
+        if (o.shape == Shape::Mesh && o.mesh) {
+            const TriangleMesh& mesh = *o.mesh;
+            object["triangleCount"] = mesh.triangleCount();
+            if (sent + mesh.triangleCount() <= maxMeshTriangles) {
+                sent += mesh.triangleCount();
+                // Flat, in the object's own frame: x y z x y z ... and a b c a b c ...
+                std::vector<double> vertices;
+                vertices.reserve(3 * mesh.vertices().size());
+                for (const Vec3& v : mesh.vertices()) {
+                    vertices.insert(vertices.end(), {v.x, v.y, v.z});
+                }
+                std::vector<std::uint32_t> triangles;
+                triangles.reserve(3 * mesh.triangles().size());
+                for (const TriangleIndices& t : mesh.triangles()) {
+                    triangles.insert(triangles.end(), t.begin(), t.end());
+                }
+                object["vertices"] = std::move(vertices);
+                object["triangles"] = std::move(triangles);
+            } else {
+                // Over the cap: its local bounding box, drawn as a wireframe.
+                object["localBounds"] = {{"min", vec(mesh.localBounds().min)},
+                                         {"max", vec(mesh.localBounds().max)}};
+                boxed.push_back(o.id);
+            }
+        }
+        objects.push_back(std::move(object));
     }
     nlohmann::json devs = nlohmann::json::array();
     for (const ViewDevice& d : devices) {
@@ -52,6 +82,7 @@ std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& dev
         {"mode", mode == ViewMode::Live ? "live" : "trace"},
         {"bounds", {{"min", vec(scene.bounds().min)}, {"max", vec(scene.bounds().max)}}},
         {"objects", objects},
+        {"meshes", {{"maxTriangles", maxMeshTriangles}, {"trianglesSent", sent}, {"boxed", boxed}}},
         {"devices", devs}};
     return doc.dump();
 }
@@ -84,15 +115,20 @@ std::string viewTraceJson(const Scene& scene, const std::vector<ViewTrace>& trac
             const WindowLoad load = window.sample(compute, s.timeNs);
             const Vec3 point = trace.transform.positionToWorld(s.positionM);
             const Vec3 force = trace.transform.forceToWorld(s.forceN);
-            frames.push_back({{"t", static_cast<double>(s.timeNs) * 1e-9},
-                              {"point", vec(point)},
-                              {"force", vec(force)},
-                              {"forceN", glm::length(force)},
-                              {"contacts", containing(scene, point)},
-                              {"ticks", s.tick + 1},
-                              {"misses", misses},
-                              {"loadP50", load.p50},
-                              {"loadP999", load.p999}});
+            nlohmann::json frame{{"t", static_cast<double>(s.timeNs) * 1e-9},
+                                 {"point", vec(point)},
+                                 {"force", vec(force)},
+                                 {"forceN", glm::length(force)},
+                                 {"contacts", containing(scene, point)},
+                                 {"ticks", s.tick + 1},
+                                 {"misses", misses},
+                                 {"loadP50", load.p50},
+                                 {"loadP999", load.p999}};
+            if (trace.header.version >= 2) {
+                // Version 2 records the god-object proxy (device frame); version 1 has none.
+                frame["proxy"] = vec(trace.transform.positionToWorld(s.proxyM));
+            }
+            frames.push_back(std::move(frame));
             durationS = std::max(durationS, static_cast<double>(s.timeNs) * 1e-9);
         }
         devices.push_back(

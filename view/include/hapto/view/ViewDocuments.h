@@ -20,12 +20,18 @@ struct ViewDevice {
     double rateHz = 0; ///< Servo rate (Hz).
 };
 
-/// The scene for the page: bounds, every object (box or sphere: centre, half extents,
-/// rotation (w, x, y, z)), the devices and the mode. A `"mesh"` shape with `vertices` and
-/// `triangles` is drawn by the page when a scene carries one (the hook for meshes; hapto's
-/// scenes have none yet). [control]
-std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& devices,
-                          ViewMode mode);
+/// At most this many mesh triangles per scene go to the page (about 10 MB of JSON); a mesh
+/// beyond it is drawn as its bounding box.
+inline constexpr std::uint64_t kViewMaxMeshTriangles = 200'000;
+
+/// The scene for the page: bounds, every object (centre, half extents, rotation (w, x, y, z))
+/// and the devices and the mode. A mesh object also carries `triangleCount` and, while the
+/// scene's running total (in slot order) stays within `maxMeshTriangles`, its `vertices` (flat
+/// x y z ..., m, in its own frame) and `triangles` (flat a b c ..., CCW from outside); a mesh
+/// beyond the cap carries its `localBounds` (min, max) instead and is listed in
+/// `meshes.boxed`. [control]
+std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& devices, ViewMode mode,
+                          std::uint64_t maxMeshTriangles = kViewMaxMeshTriangles);
 
 /// One recorded device for the offline player.
 struct ViewTrace {
@@ -35,7 +41,8 @@ struct ViewTrace {
 };
 
 /// The recording as frames at `frameHz` (at most one per frame time per device): time (s),
-/// device point and force in the world frame, the objects whose solid holds the point (a
+/// device point, force and (version 2 traces) the god-object proxy in the world frame, the
+/// objects whose solid holds the point (a
 /// god-object device point is inside what it touches), and the load over the last second
 /// (p50, p99.9 of compute time over the period) and the misses so far (a force written after
 /// the next deadline: lateness plus compute beyond one period). [control]
