@@ -65,7 +65,7 @@ TEST_CASE("the README dual-device example loads with its values") {
     CHECK(std::get<SimConfig>(configs[1].params).seed == 2);
 }
 
-TEST_CASE("the README hardware example loads; relative traces resolve against the file") {
+TEST_CASE("the README hardware example loads, relative traces resolve against the file") {
     test::TempDir dir;
     test::writeFile(dir / "d.json", readmeExample(1));
     const auto configs = loadDeviceConfigFile(dir / "d.json");
@@ -492,7 +492,7 @@ TEST_CASE("device kinds and hand scripts: parsed once, printed back the same") {
     CHECK_FALSE(parseHandScript("dance").has_value());
 }
 
-TEST_CASE("tool_tip, a sim stylus and the replay's own settings parse; bad ones name their path") {
+TEST_CASE("tool_tip, a sim stylus and the replay's own settings parse, bad ones name their path") {
     const auto configs = parseDeviceConfig(withDevice(R"("tool_tip": [0, 0, -0.04],
                       "sim": {"orientation": [0, 1, 0, 0], "spin_rad_per_s": [0, 0.5, 0]})"),
                                            "tip.json");

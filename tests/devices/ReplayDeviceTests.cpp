@@ -130,7 +130,7 @@ TEST_CASE("replay: a missing or corrupt trace is refused when the device is made
                       Catch::Contains("no samples"));
 }
 
-TEST_CASE("replay: a replay configuration takes its trace's rate; other kinds keep theirs") {
+TEST_CASE("replay: a replay configuration takes its trace's rate, other kinds keep theirs") {
     test::TempDir dir;
     {
         TraceHeader h;

@@ -394,7 +394,7 @@ TEST_CASE("sim: any number of devices run side by side without sharing state") {
     }
 }
 
-TEST_CASE("sim: a scripted stylus reports its orientation turning at the given rate; without "
+TEST_CASE("sim: a scripted stylus reports its orientation turning at the given rate, without "
           "one it reports none") {
     const Scene scene = makeDefaultScene();
     DeviceConfig c = simConfig("free", 1);

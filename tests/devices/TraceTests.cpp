@@ -354,7 +354,7 @@ std::vector<std::string> namesIn(const std::filesystem::path& dir) {
 
 } // namespace
 
-TEST_CASE("trace recorder: the trace appears whole at close; until then the old file stays") {
+TEST_CASE("trace recorder: the trace appears whole at close, until then the old file stays") {
     test::TempDir dir;
     const auto p = dir / "t.trace";
     const auto first = randomSamples(5, 6);

@@ -57,7 +57,7 @@ TEST_CASE("medianOf takes each figure's median, the first fault, and realtime on
     CHECK_FALSE(m.stable()); // a fault is never stable
 }
 
-TEST_CASE("verdicts: p99.9 < 100 % (and <= 0.1 % missed for DESIGN); quick runs read p99") {
+TEST_CASE("verdicts: p99.9 < 100 % (and <= 0.1 % missed for DESIGN), quick runs read p99") {
     LoadFigures f = figures(10, 60, 120);
     CHECK_FALSE(f.loadStable()); // p99.9 over the period
     f.tail = Tail::P99;

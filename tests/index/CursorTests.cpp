@@ -43,7 +43,7 @@ std::vector<Vec3> randomWalk(const Aabb& b, std::uint64_t seed, int steps, doubl
 
 } // namespace
 
-TEST_CASE("a cursor on a long hand-speed walk lands where a fresh locate does; links never "
+TEST_CASE("a cursor on a long hand-speed walk lands where a fresh locate does, links never "
           "take more steps than climbing") {
     for (const auto& [name, scene] : testScenes()) {
         for (const IndexSpec& spec :

@@ -183,7 +183,7 @@ TEST_CASE("OBB placement never gives more object-cell pairs than AABB placement"
           buildIndex(s, IndexSpec::grid(16, OverlapMode::Aabb))->stats().objectCellPairs);
 }
 
-TEST_CASE("stats add up; brute force lists everything; an empty scene works") {
+TEST_CASE("stats add up, brute force lists everything, an empty scene works") {
     const Scene scene = makeDegenerateScene();
     const auto brute = buildIndex(scene, IndexSpec::brute());
     CHECK(brute->stats().leaves == 1);

@@ -54,7 +54,7 @@ TEST_CASE("SAT: boxes separated only along a cross-product axis") {
     }
 }
 
-TEST_CASE("SAT: touching faces and corners count as overlap; a hair apart does not") {
+TEST_CASE("SAT: touching faces and corners count as overlap, a hair apart does not") {
     const Aabb cell{Vec3(0.0), Vec3(1.0)};
     CHECK(overlapsObbAabb(box({1.5, 0.5, 0.5}, Vec3(0.5)), cell));
     CHECK(overlapsObbAabb(box({1.5, 1.5, 1.5}, Vec3(0.5)), cell)); // corner to corner
@@ -104,7 +104,7 @@ TEST_CASE("SAT: degenerate boxes (zero thickness, a point) still overlap what th
     CHECK(overlapsObbAabb(box(Vec3(0.5), {5.0, 0.0, 0.0}, diag), cell));
 }
 
-TEST_CASE("spheres: exact distance test; AABB mode keeps the cube's corners") {
+TEST_CASE("spheres: exact distance test, AABB mode keeps the cube's corners") {
     const Aabb cell{Vec3(0.0), Vec3(1.0)};
     const double a = 0.1, r = std::sqrt(3.0) * a;
     CHECK(overlapsSphereAabb(Vec3(1 + a), r, cell));

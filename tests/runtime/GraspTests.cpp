@@ -128,7 +128,7 @@ struct GraspRig {
 
 } // namespace
 
-TEST_CASE("two hands lift, carry and put down the cube; the index then finds it at its new place") {
+TEST_CASE("two hands lift, carry and put down the cube, the index then finds it at its new place") {
     const Vec3 start(-0.05, -0.075, 0);
     // Lift 5 cm, carry 10 cm along +x, lower 5 cm, then open the hands 3 cm each.
     GraspRig rig(makeGraspScene(),
@@ -211,7 +211,7 @@ TEST_CASE("a carried cube never passes through another object: it comes to rest 
     CHECK(rig.object().center.x == Approx(0.05).margin(0.004));
 }
 
-TEST_CASE("two hands lift, carry and put down a torus mesh; the index then finds it at its new "
+TEST_CASE("two hands lift, carry and put down a torus mesh, the index then finds it at its new "
           "place") {
     // The grasp scene with its cube (id 0) replaced by a closed torus standing in the x-y plane,
     // as wide as the cube (ring 19 mm + tube 6 mm = 25 mm), resting on the floor: the hands

@@ -117,7 +117,7 @@ TEST_CASE("reset() starts afresh and zeroForce() makes the force grow from zero 
     }
 }
 
-TEST_CASE("a new snapshot re-binds the cursors and is reported once; moving objects are "
+TEST_CASE("a new snapshot re-binds the cursors and is reported once, moving objects are "
           "candidates") {
     World world(boxScene(800.0), IndexSpec::parse("octree:2:0.005"));
     HapticTick tick;

@@ -356,8 +356,8 @@ TEST_CASE("step mode: after K missed deadlines in a row the device gets zero for
     CHECK_FALSE(rig.runtime->report().devices[0].stable);
 }
 
-TEST_CASE("step mode: a wake-up K periods late commands zero for that tick; a later one is "
-          "counted late and sends force; one past the watchdog faults") {
+TEST_CASE("step mode: a wake-up K periods late commands zero for that tick, a later one is "
+          "counted late and sends force, one past the watchdog faults") {
     Rig rig(1, 1000.0);
     rig.start();
     rig.runTo(100.0);
@@ -509,7 +509,7 @@ TEST_CASE("step mode: a moved object is felt at the next tick and goes back into
     CHECK(rig.world.retiredCount() == 0);
 }
 
-TEST_CASE("step mode: an added object is felt at once by brute force; a removed one vanishes when "
+TEST_CASE("step mode: an added object is felt at once by brute force, a removed one vanishes when "
           "its rebuild is published") {
     Rig rig(1, 1000.0, [](int, ScriptedDevice& d) { d.setPath(test::pressIntoCube(0.06)); });
     rig.world.setRestDelay(std::chrono::milliseconds(20));

@@ -50,7 +50,7 @@ TEST_CASE("a moved object is on the brute-force path at once and back in the ind
     CHECK(world.buildsPublished() == 2);
 }
 
-TEST_CASE("added objects are felt at once; removed ones vanish with their rebuild") {
+TEST_CASE("added objects are felt at once, removed ones vanish with their rebuild") {
     World world(twoBoxes(), IndexSpec::parse("grid:4"));
     world.setRestDelay(std::chrono::nanoseconds(0));
     world.addObject(makeSphere(30, Vec3(0, 0.05, 0), 0.01));

@@ -44,7 +44,7 @@ TEST_CASE("random scenes keep the centre clear and stay inside the work cube") {
     }
 }
 
-TEST_CASE("generators are deterministic: same arguments, same bytes; another seed differs") {
+TEST_CASE("generators are deterministic: same arguments, same bytes, another seed differs") {
     RandomOptions a;
     a.count = 300;
     a.seed = 42;

@@ -66,7 +66,7 @@ TEST_CASE("generated meshes have about N triangles: within 1.5x from 100, 1.15x 
     }
 }
 
-TEST_CASE("the sphere and the torus are closed and face outward; the terrain is open and faces up",
+TEST_CASE("the sphere and the torus are closed and face outward, the terrain is open and faces up",
           "[meshgen]") {
     MeshOptions o;
     o.triangles = 5000;
@@ -114,7 +114,7 @@ TEST_CASE("the sphere and the torus are closed and face outward; the terrain is 
     CHECK(b.max.y - b.min.y > 0.002); // not flat
 }
 
-TEST_CASE("generated meshes are byte-identical per seed; the terrain changes with the seed",
+TEST_CASE("generated meshes are byte-identical per seed, the terrain changes with the seed",
           "[meshgen]") {
     for (const MeshShape shape : kShapes) {
         CAPTURE(meshShapeName(shape));

@@ -75,7 +75,7 @@ std::vector<Row> parse(const std::string& csv) {
 } // namespace
 
 TEST_CASE("hapto render: pressing d into a box face of stiffness k gives k d along the face "
-          "normal; outside, zero force and the proxy on the point") {
+          "normal, outside, zero force and the proxy on the point") {
     const double k = GENERATE(300.0, 800.0, 2500.0);
     const int axis = GENERATE(0, 1, 2);
     const double sign = GENERATE(-1.0, 1.0);

@@ -85,7 +85,7 @@ std::shared_ptr<const TriangleMesh> tetrahedron(double size) {
 
 } // namespace
 
-TEST_CASE("the scene document carries each mesh's own vertices and triangles, placed by its pose; "
+TEST_CASE("the scene document carries each mesh's own vertices and triangles, placed by its pose, "
           "past the triangle cap a mesh comes as its local bounds") {
     const Quat turn = glm::angleAxis(0.7, Vec3(1, 0, 0));
     const auto small = tetrahedron(0.02);
@@ -134,7 +134,7 @@ TEST_CASE("the scene document carries each mesh's own vertices and triangles, pl
     CHECK(kViewMaxMeshTriangles == 200'000);
 }
 
-TEST_CASE("the trace document shows a version 2 trace's proxies in the world frame; a version 1 "
+TEST_CASE("the trace document shows a version 2 trace's proxies in the world frame, a version 1 "
           "trace has none") {
     const Scene scene(Aabb{Vec3(-1.0), Vec3(1.0)}, {makeBox(3, Vec3(0.0), Vec3(0.01))});
     ViewTrace t;

@@ -178,7 +178,7 @@ TEST_CASE("a stream from another origin, or a loopback view under another host n
     CHECK(got.find(R"(data: {"t":1})") != std::string::npos);
 }
 
-TEST_CASE("the view serves at most its limit of streams; a closed one frees its place") {
+TEST_CASE("the view serves at most its limit of streams, a closed one frees its place") {
     ViewServerOptions options;
     options.maxStreamClients = 2;
     ViewServer server(options);
@@ -213,7 +213,7 @@ TEST_CASE("the view serves at most its limit of streams; a closed one frees its 
     CHECK(statusOf(d.readUntil("\n\n")) == 200);
 }
 
-TEST_CASE("a viewer that stalls costs the publisher nothing and is dropped") {
+TEST_CASE("a viewer that stalls costs the publisher nothing and is dropped", "[realtime]") {
     ViewServerOptions options;
     options.writeTimeout = std::chrono::milliseconds(200);
     ViewServer server(options);
