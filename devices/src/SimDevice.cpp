@@ -76,6 +76,7 @@ DeviceStatus SimDevice::open() {
     mTargetWorld = mConfig.transform.positionToWorld(mSim.start);
     mPhase = mScript->keyframes().size() > 1 ? mScript->keyframes()[1].phase
                                              : mScript->keyframes()[0].phase;
+    mPublishedPhase.store(mPhase, std::memory_order_relaxed);
     mError.clear();
     mOpen = true;
     return DeviceStatus::Ok;
@@ -92,6 +93,7 @@ DeviceStatus SimDevice::read(DeviceState& state) noexcept {
     }
     ++mTick;
     mTargetWorld = mScript->targetAt(timeS(), mCursor, mPhase);
+    mPublishedPhase.store(mPhase, std::memory_order_relaxed);
     mHand.step(mConfig.transform.positionToDevice(mTargetWorld), mForceN, mDtS);
     const Vec3& p = mHand.position();
     for (int i = 0; i < 3; ++i) {

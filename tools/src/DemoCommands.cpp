@@ -146,8 +146,10 @@ int runDemo(const DemoArgs& a) {
                 }
             }
         }
-        const bool scriptsDone = sims[0] && sims[1] && sims[0]->phase() == ScriptPhase::Done &&
-                                 sims[1]->phase() == ScriptPhase::Done;
+        // The servo threads own the scripts: read the phase they publish.
+        const bool scriptsDone = sims[0] && sims[1] &&
+                                 sims[0]->publishedPhase() == ScriptPhase::Done &&
+                                 sims[1]->publishedPhase() == ScriptPhase::Done;
         if ((scriptsDone && grasp.state() == GraspState::Idle && t > 1.0) || t > 12.0 ||
             !runtime.anyRunning() || signals.requested()) {
             break;

@@ -8,6 +8,7 @@
 #include "hapto/scenes/Random.h"
 #include "hapto/scenes/Scene.h"
 
+#include <atomic>
 #include <optional>
 #include <string>
 
@@ -45,6 +46,12 @@ public:
 
     /// The script's current phase. [servo]
     ScriptPhase phase() const { return mPhase; }
+    /// The phase as of the last read(), published for another thread (a relaxed atomic the
+    /// servo stores every tick): a control loop waiting for the script to end reads this.
+    /// [any thread]
+    ScriptPhase publishedPhase() const noexcept {
+        return mPublishedPhase.load(std::memory_order_relaxed);
+    }
     /// The script's current target, world frame (m). [servo]
     const Vec3& targetWorld() const { return mTargetWorld; }
     /// The hand's exact position (before noise and quantisation), device frame (m). [servo]
@@ -76,6 +83,7 @@ private:
     Vec3 mForceN{0.0};
     Vec3 mTargetWorld{0.0};
     ScriptPhase mPhase = ScriptPhase::Move;
+    std::atomic<ScriptPhase> mPublishedPhase{ScriptPhase::Move};
     bool mOpen = false;
     std::string mError;
 };
