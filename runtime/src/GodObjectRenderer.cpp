@@ -43,9 +43,10 @@
 /// with a generous margin for objects and 1 µm for triangles (a fine mesh stays a few items).
 /// Each solver pass is one <= 3-plane solve (at most 8 tiny linear solves) plus one swept test
 /// per near item (slab clipping in the box frame, a quadratic for a sphere, a plane crossing and
-/// three edge tests for a triangle). Worst case per tick: 2 solves x maxIterations x near
-/// items; typically 2-3 passes over 1-5 objects or a handful of triangles.
-/// No allocation: the near list and plane sets are fixed arrays.
+/// three edge tests for a triangle, after a plane test that rejects most; every pose, matrix,
+/// radius and triangle plane comes precomputed from the scene's render copy). Worst case per tick:
+/// 2 solves x maxIterations x near items; typically 2-3 passes over 1-5 objects or a handful of
+/// triangles. No allocation: the near list and plane sets are fixed arrays.
 
 #include "hapto/runtime/GodObjectRenderer.h"
 
@@ -90,16 +91,17 @@ struct Entry {
     double sign = 0;  ///< Box: the entered face's side (+1 or -1 along the axis).
 };
 
-Entry sweepBox(const Obb& obb, const Vec3& from, const Vec3& to) {
-    const Vec3 a = obb.toLocal(from);
-    const Vec3 d = obb.toLocal(to) - a;
+/// The slab test of a box (in its own frame; an axis-aligned box's frame is a translation).
+Entry sweepBox(const RenderBody& box, const Vec3& from, const Vec3& to) {
+    const Vec3 a = box.toLocal(from);
+    const Vec3 d = box.toLocal(to) - a;
     double tIn = -kInf;
     double tOut = kInf;
     double sIn = -kInf;
     Entry e;
     for (int i = 0; i < 3; ++i) {
-        const double h = obb.halfExtents[i] + kSkinM - kShrinkM;
-        const double hs = obb.halfExtents[i] + kSkinM;
+        const double h = box.halfExtents[i] + kSkinM - kShrinkM;
+        const double hs = box.halfExtents[i] + kSkinM;
         if (std::abs(d[i]) < 1e-18) {
             if (std::abs(a[i]) >= h) {
                 return {};
@@ -166,49 +168,31 @@ Entry sweepSphere(const Vec3& center, double radius, const Vec3& from, const Vec
 }
 
 /// True when p is inside the object's shrunk skin (strictly).
-bool insideSkin(const SceneObject& o, const Vec3& p) {
+bool insideSkin(const RenderBody& o, const Vec3& p) {
     return o.shape == Shape::Sphere
                ? sphereStrictlyContains(o.center, o.halfExtents.x + kSkinM - kShrinkM, p)
                : boxStrictlyContains(o.obb(), p, kSkinM - kShrinkM);
 }
 
 /// Distance (m) from p to the object's skin, 0 inside.
-double distanceToSkin(const SceneObject& o, const Vec3& p) {
+double distanceToSkin(const RenderBody& o, const Vec3& p) {
     return o.shape == Shape::Sphere
                ? std::max(0.0, sphereSignedDistance(o.center, o.halfExtents.x + kSkinM, p))
                : boxDistanceOutside(o.obb(), p, kSkinM);
 }
 
 /// The nearest point on the object's skin to an inside point p.
-Vec3 pushOut(const SceneObject& o, const Vec3& p) {
+Vec3 pushOut(const RenderBody& o, const Vec3& p) {
     if (o.shape == Shape::Sphere) {
         const Vec3 d = p - o.center;
         const double len = glm::length(d);
         const Vec3 n = len > 0.0 ? d / len : Vec3(0, 0, 1);
         return o.center + (o.halfExtents.x + kSkinM) * n;
     }
-    const Obb obb = o.obb();
-    Vec3 l = obb.toLocal(p);
-    const int best = dominantFaceAxis(l, obb.halfExtents + Vec3(kSkinM)); // the nearest face
-    l[best] = (l[best] < 0.0 ? -1.0 : 1.0) * (obb.halfExtents[best] + kSkinM);
-    return obb.center + obb.axes * l;
-}
-
-/// A triangle's plane: unit outward normal and offset (dot(normal, x) = offset on it).
-struct TrianglePlane {
-    Vec3 normal{0.0};
-    double offset = 0.0;
-    bool valid = false; ///< False for a triangle too thin to have a normal.
-};
-
-TrianglePlane trianglePlane(const std::array<Vec3, 3>& v) {
-    const Vec3 c = glm::cross(v[1] - v[0], v[2] - v[0]);
-    const double len = glm::length(c);
-    if (!(len > 0.0) || !std::isfinite(len)) {
-        return {};
-    }
-    const Vec3 n = c / len;
-    return {n, glm::dot(n, v[0]), true};
+    Vec3 l = o.toLocal(p);
+    const int best = dominantFaceAxis(l, o.halfExtents + Vec3(kSkinM)); // the nearest face
+    l[best] = (l[best] < 0.0 ? -1.0 : 1.0) * (o.halfExtents[best] + kSkinM);
+    return o.toWorld(l);
 }
 
 /// The point of triangle v closest to p (Ericson, Real-Time Collision Detection, 5.1.5).
@@ -270,9 +254,21 @@ double outsideEdges(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n) 
 /// True when p projects into triangle v grown by `margin` (m) across each edge, as a box face's
 /// skin grows across its edges (square corners), with a sliver's sharp corners cut at 1.5 x
 /// margin from the triangle.
+/// outsideEdges without its square roots: each edge compares squares.
 bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n, double margin) {
-    if (outsideEdges(p, v, n) > margin) {
-        return false;
+    bool over = true; // p projects into the triangle itself
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 inward = glm::cross(n, v[(i + 1) % 3] - v[i]);
+        const double out = -glm::dot(inward, p - v[i]); // distance outside x |inward|
+        if (out > 0.0) {
+            if (out * out > margin * margin * glm::dot(inward, inward)) {
+                return false;
+            }
+            over = false;
+        }
+    }
+    if (over) {
+        return true;
     }
     const Vec3 onPlane = p - glm::dot(n, p - v[0]) * n;
     return triangleDistance2(onPlane, v) <= 2.25 * margin * margin;
@@ -285,9 +281,12 @@ bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& 
 /// face's), or wherever it really crosses the triangle (so no path reaches behind a closed
 /// mesh, whatever its dihedral angles). A path that starts behind the triangle's plane, or
 /// does not go deeper, passes.
-Entry sweepTriangle(const std::array<Vec3, 3>& v, const Vec3& from, const Vec3& to) {
-    const TrianglePlane tp = trianglePlane(v);
-    if (!tp.valid) {
+///
+/// The plane comes first (two dot products reject most triangles); the corners are fetched
+/// only for a path that reaches the skin slab.
+Entry sweepTriangle(const Scene& scene, std::uint32_t item, const Vec3& from, const Vec3& to) {
+    const WorldFace tp = scene.triangleFace(item);
+    if (tp.normal == Vec3(0.0)) {
         return {};
     }
     const double sf = glm::dot(tp.normal, from) - tp.offset; // heights over the plane (m)
@@ -307,6 +306,7 @@ Entry sweepTriangle(const std::array<Vec3, 3>& v, const Vec3& from, const Vec3& 
         return {};
     }
     const Vec3 d = to - from;
+    const std::array<Vec3, 3> v = scene.triangleCorners(item);
     bool over = overGrownTriangle(from + t * d, v, tp.normal, kSkinM);
     if (!over && st < 0.0) {
         over = overGrownTriangle(from + (sf / (sf - st)) * d, v, tp.normal, kOnM);
@@ -356,16 +356,16 @@ void visitMeshTrianglesNear(const TriangleMesh& mesh, const Aabb& localBox, Fn&&
 /// points within kSkinM of its plane over the triangle grown by kSkinM across its edges.
 double itemDistanceToSkin(const Scene& scene, std::uint32_t item, const Vec3& p) {
     if (isTriangleItem(item)) {
-        const std::array<Vec3, 3> v = scene.triangleCorners(item);
-        const TrianglePlane tp = trianglePlane(v);
-        if (!tp.valid) {
+        const WorldFace tp = scene.triangleFace(item);
+        if (tp.normal == Vec3(0.0)) {
             return kInf;
         }
         const double up = std::max(0.0, std::abs(glm::dot(tp.normal, p) - tp.offset) - kSkinM);
-        const double out = std::max(0.0, outsideEdges(p, v, tp.normal) - kSkinM);
+        const double out =
+            std::max(0.0, outsideEdges(p, scene.triangleCorners(item), tp.normal) - kSkinM);
         return std::sqrt(up * up + out * out);
     }
-    return distanceToSkin(scene.object(item), p);
+    return distanceToSkin(scene.body(item), p);
 }
 
 } // namespace
@@ -478,7 +478,7 @@ void GodObjectRenderer::forEachMeshTriangleNear(const Scene& scene, std::uint32_
     }
     // In the mesh's own frame: distances are the same there, and nothing is transformed but
     // the one point.
-    const Vec3 local = glm::conjugate(o.rotation) * (center - o.center);
+    const Vec3 local = scene.body(slot).toLocal(center);
     const double reach = radius + kSkinM;
     const std::uint32_t first = firstTriangleItem(scene, slot);
     const TriangleMesh& mesh = *o.mesh;
@@ -557,8 +557,12 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
             if (isTriangleItem(item)) {
                 if (validItem(scene, item)) {
                     mNearTriangles = true;
-                    if (triangleDistance2(center, scene.triangleCorners(item)) <=
-                        triangleReach * triangleReach) {
+                    // The distance to the plane bounds the distance to the triangle: most
+                    // candidates end at one dot product.
+                    const WorldFace f = scene.triangleFace(item);
+                    if (std::abs(glm::dot(f.normal, center) - f.offset) <= triangleReach &&
+                        triangleDistance2(center, scene.triangleCorners(item)) <=
+                            triangleReach * triangleReach) {
                         addNear(item);
                     }
                 }
@@ -567,8 +571,8 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
             if (item >= n) {
                 continue;
             }
-            const SceneObject& o = scene.object(item);
-            const double reach = radius + o.radius() + kSkinM;
+            const RenderBody& o = scene.body(item);
+            const double reach = radius + o.radius + kSkinM;
             if (length2(o.center - center) > reach * reach) {
                 continue;
             }
@@ -591,11 +595,11 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
     forEachNear(scene, candidates, [&](std::uint32_t item) {
         Entry e;
         if (isTriangleItem(item)) {
-            e = sweepTriangle(scene.triangleCorners(item), from, to);
+            e = sweepTriangle(scene, item, from, to);
         } else {
-            const SceneObject& o = scene.object(item);
+            const RenderBody& o = scene.body(item);
             e = o.shape == Shape::Sphere ? sweepSphere(o.center, o.halfExtents.x, from, to)
-                                         : sweepBox(o.obb(), from, to);
+                                         : sweepBox(o, from, to);
         }
         if (e.found && e.t < best.t) {
             best = {true, e.t, e.tStop, item, e.axis, e.sign};
@@ -610,7 +614,7 @@ bool GodObjectRenderer::covered(const Scene& scene, const CandidateSet& candidat
     // Boxes and spheres only: flush meshes are not looked for (see DESIGN, "Triangles").
     forEachNear(scene, candidates, [&](std::uint32_t item) {
         if (!inside && item != self && !isTriangleItem(item)) {
-            inside = insideSkin(scene.object(item), probe);
+            inside = insideSkin(scene.body(item), probe);
         }
     });
     return inside;
@@ -660,7 +664,7 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
             }
             pruneNonBinding(p);
             if (isTriangleItem(hit.item)) {
-                const TrianglePlane tp = trianglePlane(scene.triangleCorners(hit.item));
+                const WorldFace tp = scene.triangleFace(hit.item);
                 if (!addPlane({tp.normal, tp.offset + kSkinM, hit.item})) {
                     break;
                 }
@@ -674,19 +678,20 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
                         scene.objectSlotOf(other) != mesh) {
                         return;
                     }
-                    const std::array<Vec3, 3> w = scene.triangleCorners(other);
-                    const TrianglePlane op = trianglePlane(w);
+                    const WorldFace op = scene.triangleFace(other);
                     const double offset = op.offset + kSkinM;
-                    if (!op.valid || glm::dot(op.normal, goal) >= offset - kFeasibleM ||
+                    if (op.normal == Vec3(0.0) ||
+                        glm::dot(op.normal, goal) >= offset - kFeasibleM ||
                         glm::dot(op.normal, p) < offset - kOnM ||
-                        !overGrownTriangle(p, w, op.normal, kSkinM + kOnM)) {
+                        !overGrownTriangle(p, scene.triangleCorners(other), op.normal,
+                                           kSkinM + kOnM)) {
                         return;
                     }
                     addPlane({op.normal, offset, other});
                 });
                 continue;
             }
-            const SceneObject& o = scene.object(hit.item);
+            const RenderBody& o = scene.body(hit.item);
             if (o.shape == Shape::Sphere) {
                 Vec3 n = p - o.center;
                 const double len = glm::length(n);
@@ -696,26 +701,24 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
                 }
                 continue;
             }
-            const Obb obb = o.obb();
-            const Vec3 entered = hit.sign * obb.axes[hit.axis];
-            if (!addPlane({entered,
-                           glm::dot(entered, obb.center) + obb.halfExtents[hit.axis] + kSkinM,
+            const Vec3 entered = hit.sign * o.axes[hit.axis];
+            if (!addPlane({entered, glm::dot(entered, o.center) + o.halfExtents[hit.axis] + kSkinM,
                            hit.item})) {
                 break;
             }
             // On an edge or a corner: every other face there that the goal is behind, unless
             // another object covers it (flush neighbours make internal faces).
-            const Vec3 l = obb.toLocal(p);
+            const Vec3 l = o.toLocal(p);
             for (int j = 0; j < 3; ++j) {
                 if (j == hit.axis) {
                     continue;
                 }
                 for (const double side : {-1.0, 1.0}) {
-                    if (side * l[j] < obb.halfExtents[j] + kSkinM - kOnM) {
+                    if (side * l[j] < o.halfExtents[j] + kSkinM - kOnM) {
                         continue;
                     }
-                    const Vec3 n = side * obb.axes[j];
-                    const double offset = glm::dot(n, obb.center) + obb.halfExtents[j] + kSkinM;
+                    const Vec3 n = side * o.axes[j];
+                    const double offset = glm::dot(n, o.center) + o.halfExtents[j] + kSkinM;
                     if (glm::dot(n, goal) >= offset - kFeasibleM) {
                         continue;
                     }
@@ -819,7 +822,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
             if (isTriangleItem(slot)) {
                 return;
             }
-            const SceneObject& o = scene.object(slot);
+            const RenderBody& o = scene.body(slot);
             if (std::find(mContactSlots.begin(), mContactSlots.begin() + mContactCount, slot) !=
                     mContactSlots.begin() + mContactCount &&
                 insideSkin(o, start)) {

@@ -14,14 +14,17 @@ namespace {
 
 /// The first leaf that the segment a -> b passes through and that is not in `listed`, walking
 /// from a leaf to the next at the point the segment leaves each box; kNoLeaf when there is
-/// none (or the walk leaves the bounds, or takes more than 64 leaves). [servo]
-LocateResult firstUnlistedLeaf(const SpatialIndex& index, const Vec3& a, const Vec3& b,
+/// none (or the walk leaves the bounds, or takes more than 64 leaves). `walker` is a copy of a
+/// cursor near a (the proxy's): each step crosses to the next leaf by its links, not from the
+/// root. [servo]
+LocateResult firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
                                std::span<const std::uint32_t> listed) noexcept {
+    const SpatialIndex& index = *walker.index();
     const Vec3 d = b - a;
     const double length = glm::length(d);
     double t = 0.0;
     for (int walked = 0; walked < 64; ++walked) {
-        const LocateResult at = index.locate(a + t * d);
+        const LocateResult at = walker.locate(a + t * d);
         if (at.outside) {
             return {};
         }
@@ -109,23 +112,33 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     // along last tick's contact plane to the device point's projection on it (a slide), and
     // from there and from the start to where it ended; at the first leaf that was not a
     // candidate the tick is solved again from the same start with that leaf's items too, up
-    // to kExtraLeaves times.
+    // to kExtraLeaves times. The slide is known before solving, so its leaves are listed
+    // first: a slide over small leaves usually solves once.
     const Vec3 from = mRenderer.proxy();
     const Vec3 slide =
         mRenderer.inContact() ? p - glm::dot(p - from, mSlideNormal) * mSlideNormal : from;
-    const GodObjectRenderer start = mRenderer; // a plain copy: no allocation
-    out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
     std::array<std::uint32_t, 2 + kExtraLeaves> listed{atDevice.leaf, atProxy.leaf};
     std::size_t listedCount = 2;
+    while (listedCount < listed.size() && mRenderer.inContact()) {
+        const LocateResult missed = firstUnlistedLeaf(
+            mProxyCursor, from, slide, std::span<const std::uint32_t>(listed.data(), listedCount));
+        if (missed.leaf == kNoLeaf || !mCandidates.add(missed.candidates)) {
+            break;
+        }
+        listed[listedCount++] = missed.leaf;
+        ++out.extraLeaves;
+    }
+    const GodObjectRenderer start = mRenderer; // a plain copy: no allocation
+    out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
     std::uint32_t tested = out.render.objectsTested;
     while (listedCount < listed.size()) {
         const std::span<const std::uint32_t> known(listed.data(), listedCount);
-        LocateResult missed = firstUnlistedLeaf(*index, from, slide, known);
+        LocateResult missed = firstUnlistedLeaf(mProxyCursor, from, slide, known);
         if (missed.leaf == kNoLeaf) {
-            missed = firstUnlistedLeaf(*index, slide, out.render.proxy, known);
+            missed = firstUnlistedLeaf(mProxyCursor, slide, out.render.proxy, known);
         }
         if (missed.leaf == kNoLeaf) {
-            missed = firstUnlistedLeaf(*index, from, out.render.proxy, known);
+            missed = firstUnlistedLeaf(mProxyCursor, from, out.render.proxy, known);
         }
         if (missed.leaf == kNoLeaf || !mCandidates.add(missed.candidates)) {
             break;

@@ -42,6 +42,10 @@ Scene::Scene(Aabb bounds, std::vector<SceneObject> objects)
         }
     }
     mTriangleCount = static_cast<std::uint32_t>(triangles);
+    mBodies.reserve(mObjects.size());
+    for (const SceneObject& o : mObjects) {
+        mBodies.push_back(bodyOf(o));
+    }
     if (std::uint64_t(mObjects.size()) + triangles >= std::numeric_limits<std::uint32_t>::max()) {
         throw std::invalid_argument("a scene holds at most 2^32 - 1 objects and triangles");
     }
@@ -75,17 +79,26 @@ TriangleRef Scene::triangle(std::uint32_t item) const noexcept {
     return {m.objectSlot, n - m.firstTriangle};
 }
 
-std::array<Vec3, 3> Scene::triangleCorners(std::uint32_t item) const noexcept {
-    const TriangleRef ref = triangle(item);
-    const SceneObject& o = mObjects[ref.objectSlot];
-    const Mat3 r = glm::mat3_cast(o.rotation);
-    const auto [a, b, c] = o.mesh->corners(ref.triangle);
-    return {o.center + r * a, o.center + r * b, o.center + r * c};
+RenderBody Scene::bodyOf(const SceneObject& o) {
+    RenderBody b;
+    b.center = o.center;
+    b.shape = o.shape;
+    b.radius = o.radius();
+    if (o.shape != Shape::Mesh) {
+        b.halfExtents = o.halfExtents;
+    }
+    if (o.shape != Shape::Sphere) {
+        b.axes = glm::mat3_cast(o.rotation);
+    }
+    b.axisAligned = b.axes == Mat3(1.0);
+    return b;
 }
 
 void Scene::setPose(std::uint32_t slot, const Vec3& center, const Quat& rotation) {
-    mObjects.at(slot).center = center;
-    mObjects.at(slot).rotation = glm::normalize(rotation);
+    SceneObject& o = mObjects.at(slot);
+    o.center = center;
+    o.rotation = glm::normalize(rotation);
+    mBodies[slot] = bodyOf(o);
 }
 
 Aabb Scene::defaultBounds(std::span<const SceneObject> objects) {

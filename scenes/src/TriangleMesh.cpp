@@ -111,6 +111,15 @@ std::shared_ptr<const TriangleMesh> TriangleMesh::make(std::vector<Vec3> vertice
     mesh->mTriangles = std::move(triangles);
     mesh->mVertices.shrink_to_fit();
     mesh->mTriangles.shrink_to_fit();
+    mesh->mFaces.resize(mesh->mTriangles.size());
+    for (std::uint32_t t = 0; t < mesh->mTriangles.size(); ++t) {
+        const auto [a, b, c] = mesh->corners(t);
+        const Vec3 n = glm::cross(b - a, c - a);
+        const double len = glm::length(n);
+        if (len > 0.0 && std::isfinite(len)) {
+            mesh->mFaces[t] = {n / len, glm::dot(n / len, a)};
+        }
+    }
     mesh->buildBvh();
     return mesh;
 }

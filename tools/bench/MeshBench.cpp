@@ -17,8 +17,10 @@
 //              items (2 TBB threads), Bullet's BVH, FCL's OBBRSS tree; counters
 //              bytes_per_triangle (hapto: IndexStats bytes; the others: heap growth).
 //   mesh-tick  the servo path's full tick (HapticTick: locate, candidates, god-object render,
-//              safety) along the same loop; manual time per tick; counters p50_ns, p99_ns and
-//              contact (the share of ticks in contact).
+//              safety) along the same loop; manual time per tick; counters p50_ns, p99_ns,
+//              contact (the share of ticks in contact), and per tick: tested (candidate items
+//              examined), passes (solver passes) and extra_leaves (leaves listed beyond the
+//              device's and the proxy's).
 //
 //   hapto_bench --benchmark_filter='^mesh-' --benchmark_min_time=0.5
 
@@ -331,6 +333,9 @@ void tickMesh(benchmark::State& state, std::size_t n, bool grid) {
     ns.reserve(1 << 20);
     std::size_t i = 0;
     double contacts = 0;
+    double tested = 0;
+    double passes = 0;
+    double extra = 0;
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
         const TickOutput out = tick.tick(world.current(), path[i], Vec3(0.0), 1e-3, Vec3(0.0));
@@ -342,6 +347,9 @@ void tickMesh(benchmark::State& state, std::size_t n, bool grid) {
             ns.push_back(1e9 * s);
         }
         contacts += out.render.contactCount > 0;
+        tested += out.render.objectsTested;
+        passes += out.render.iterations;
+        extra += out.extraLeaves;
         i = (i + 1) % path.size();
     }
     std::sort(ns.begin(), ns.end());
@@ -352,6 +360,9 @@ void tickMesh(benchmark::State& state, std::size_t n, bool grid) {
     state.counters["p50_ns"] = pct(0.5);
     state.counters["p99_ns"] = pct(0.99);
     state.counters["contact"] = benchmark::Counter(contacts, benchmark::Counter::kAvgIterations);
+    state.counters["tested"] = benchmark::Counter(tested, benchmark::Counter::kAvgIterations);
+    state.counters["passes"] = benchmark::Counter(passes, benchmark::Counter::kAvgIterations);
+    state.counters["extra_leaves"] = benchmark::Counter(extra, benchmark::Counter::kAvgIterations);
     state.counters["triangles"] = meshScene(n).triangleCount();
 }
 

@@ -29,8 +29,10 @@ struct TickOutput {
     std::uint32_t locateSteps = 0;          ///< Cursor steps, both cursors.
     bool outside = false;                   ///< The device point is outside the index's bounds.
     std::uint32_t deviceLeaf = 0xFFFFFFFFu; ///< The device point's leaf (kNoLeaf outside).
-    std::uint8_t extraLeaves = 0; ///< Leaves the proxy slid into and the tick was solved again
-                                  ///< with (HapticTick::kExtraLeaves at most).
+    std::uint8_t extraLeaves = 0; ///< Leaves beyond the device's and the proxy's that the tick
+                                  ///< listed: the slide's, before solving, and those the
+                                  ///< solved proxy reached, each solved again
+                                  ///< (HapticTick::kExtraLeaves at most).
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
 };
 

@@ -28,6 +28,39 @@ struct TriangleRef {
     std::uint32_t triangle = 0;   ///< The triangle's number in that object's TriangleMesh.
 };
 
+/// The render copy of one object: its pose and size as the servo path uses them, computed when
+/// the scene is made or the object moves (on the control thread, never in a tick), so that no
+/// tick turns a quaternion into a matrix or recomputes a bounding radius. 128 bytes.
+struct RenderBody {
+    Vec3 center{0.0};      ///< Box, sphere: the centre; mesh: its local origin (m, world).
+    Vec3 halfExtents{0.0}; ///< Box: half size per own axis; sphere: the radius, thrice; mesh:
+                           ///< unused (zero) (m).
+    Mat3 axes{1.0};        ///< The rotation as a matrix: column i is own axis i (world). A
+                           ///< sphere's is the identity.
+    double radius = 0.0;   ///< Bounding sphere about `center` (m): SceneObject::radius().
+    Shape shape = Shape::Box;
+    bool axisAligned = true; ///< `axes` is exactly the identity: local = p - center, no product.
+
+    /// A box's or sphere's oriented box (SceneObject::obb(), bit for bit). [any thread]
+    Obb obb() const noexcept { return {center, halfExtents, axes}; }
+    /// A world point in the object's own frame (m). [any thread]
+    Vec3 toLocal(const Vec3& p) const noexcept {
+        return axisAligned ? p - center : glm::transpose(axes) * (p - center);
+    }
+    /// A local point (or, with `center` left out, a direction) in world coordinates. [any thread]
+    Vec3 toWorld(const Vec3& local) const noexcept {
+        return axisAligned ? center + local : center + axes * local;
+    }
+    /// A local direction in world coordinates. [any thread]
+    Vec3 rotate(const Vec3& local) const noexcept { return axisAligned ? local : axes * local; }
+};
+
+/// A triangle item's plane in world coordinates: {x : dot(normal, x) = offset}.
+struct WorldFace {
+    Vec3 normal{0.0};    ///< Outward unit normal; zero for a triangle with none (never touched).
+    double offset = 0.0; ///< (m).
+};
+
 /// Bounds and objects. Objects are addressed by a dense 32-bit slot (their position in
 /// `objects()`) and named by their `ObjectId` in every output.
 ///
@@ -78,7 +111,22 @@ public:
     }
     /// A triangle item's corners in world coordinates (m), at its mesh's current pose. [any
     /// thread]
-    std::array<Vec3, 3> triangleCorners(std::uint32_t item) const noexcept;
+    std::array<Vec3, 3> triangleCorners(std::uint32_t item) const noexcept {
+        const TriangleRef ref = triangle(item);
+        const RenderBody& b = mBodies[ref.objectSlot];
+        const auto [p, q, r] = mObjects[ref.objectSlot].mesh->corners(ref.triangle);
+        return {b.toWorld(p), b.toWorld(q), b.toWorld(r)};
+    }
+    /// A triangle item's plane in world coordinates, at its mesh's current pose. [any thread]
+    WorldFace triangleFace(std::uint32_t item) const noexcept {
+        const TriangleRef ref = triangle(item);
+        const RenderBody& b = mBodies[ref.objectSlot];
+        const TriangleFace& f = mObjects[ref.objectSlot].mesh->face(ref.triangle);
+        const Vec3 n = b.rotate(f.normal);
+        return {n, f.offset + glm::dot(n, b.center)};
+    }
+    /// The render copy of the object in slot i. [any thread]
+    const RenderBody& body(std::uint32_t slot) const noexcept { return mBodies[slot]; }
 
     /// Moves one object (m, unit quaternion); the caller owns this copy of the scene. [control]
     void setPose(std::uint32_t slot, const Vec3& center, const Quat& rotation);
@@ -93,6 +141,8 @@ public:
     }
 
 private:
+    static RenderBody bodyOf(const SceneObject& o);
+
     /// Where each mesh's triangles start in the scene's triangle numbering.
     struct MeshRange {
         std::uint32_t firstTriangle;
@@ -101,7 +151,8 @@ private:
 
     Aabb mBounds;
     std::vector<SceneObject> mObjects;
-    std::vector<MeshRange> mMeshes; // by firstTriangle, ascending
+    std::vector<RenderBody> mBodies; // by slot: the render copy
+    std::vector<MeshRange> mMeshes;  // by firstTriangle, ascending
     std::uint32_t mTriangleCount = 0;
     std::vector<std::pair<ObjectId, std::uint32_t>> mSlotById; // sorted by id
 };

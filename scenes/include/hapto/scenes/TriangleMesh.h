@@ -5,7 +5,9 @@
 /// file's uniform scale already applied (m), and shared (immutable, by shared_ptr) by every
 /// scene copy and snapshot that places the object. Moving a mesh changes only its object's
 /// pose: nothing here is copied or transformed. World-frame vertices are computed where they
-/// are needed (index builds, the renderer's few nearby triangles) from the object's pose.
+/// are needed (index builds, the renderer's few nearby triangles) from the object's pose
+/// (Scene's render copy keeps it as a matrix). Each triangle's plane is kept beside it, in the
+/// local frame (TriangleFace, 32 B), so the renderer rejects a triangle with two dot products.
 
 #include "hapto/core/Geometry.h"
 
@@ -27,6 +29,15 @@ struct MeshSource {
     std::string file;   ///< The model file as the scene names it (relative to the scene file);
                         ///< empty for inline vertices and triangles, or a generated mesh.
     double scale = 1.0; ///< The uniform scale applied to the file's or inline coordinates.
+};
+
+/// A triangle's plane in its mesh's frame: {x : dot(normal, x) = offset}, the unit normal
+/// pointing out (the side its corners turn counter-clockwise). Computed once with the mesh, so
+/// the servo path never takes a cross product and a square root to learn it.
+struct TriangleFace {
+    Vec3 normal{0.0};    ///< Outward unit normal (local frame); zero for a triangle too thin to
+                         ///< have one (such a triangle is never touched).
+    double offset = 0.0; ///< dot(normal, corner 0) (m, local frame).
 };
 
 /// One node of a mesh's local BVH (32 bytes): float bounds rounded outwards, and either two
@@ -78,6 +89,10 @@ public:
         const TriangleIndices& i = mTriangles[t];
         return {mVertices[i[0]], mVertices[i[1]], mVertices[i[2]]};
     }
+    /// The plane of triangle t, local frame. [any thread]
+    const TriangleFace& face(std::uint32_t t) const noexcept { return mFaces[t]; }
+    /// Memory of the precomputed planes (bytes): 32 per triangle. [any thread]
+    std::size_t faceBytes() const noexcept { return mFaces.size() * sizeof(TriangleFace); }
     /// Degenerate triangles dropped when the mesh was made. [any thread]
     std::uint64_t droppedDegenerate() const noexcept { return mDropped; }
     /// The tightest local AABB of the vertices used by triangles (m). [any thread]
@@ -116,6 +131,7 @@ private:
 
     std::vector<Vec3> mVertices;
     std::vector<TriangleIndices> mTriangles;
+    std::vector<TriangleFace> mFaces; // by triangle
     MeshSource mSource;
     Aabb mBounds = Aabb::empty();
     double mRadius = 0.0;
