@@ -80,8 +80,10 @@ const std::vector<Vec3>& slidePath() {
     static const std::vector<Vec3> path = [] {
         std::vector<Vec3> p;
         const double outside = 0.5 * kSphereSizeM + 0.01, inside = 0.5 * kSphereSizeM - kPressM;
+        // A wavy line over the sphere, every point at distance r from its centre (kPressM
+        // inside the sphere, deeper than the flat facets of the coarsest mesh sit below it).
         const auto onRadius = [](double a, double r) {
-            return Vec3(r * std::sin(a), 0.3 * r * std::sin(2.0 * a), r * std::cos(a));
+            return r * glm::normalize(Vec3(std::sin(a), 0.3 * std::sin(2.0 * a), std::cos(a)));
         };
         for (double r = outside; r > inside; r -= kStepM) {
             p.push_back(onRadius(0.0, r));
