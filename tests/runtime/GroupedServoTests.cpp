@@ -164,7 +164,7 @@ TEST_CASE("a member that faulted is reopened and ticks again inside its group") 
     CHECK(rig.report(0).faults == 0);
 }
 
-TEST_CASE("a stalled group zeroes every one of its devices; one device stalled alone zeroes "
+TEST_CASE("a stalled group zeroes every one of its devices, one device stalled alone zeroes "
           "only itself") {
     // Device 0's read 100 takes 300 ms: longer than the watchdog's 50 ms.
     const auto stallFirst = [](int i, ScriptedDevice& d) {
