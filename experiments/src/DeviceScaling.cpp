@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 namespace hapto::experiments {
 namespace {
@@ -242,7 +243,9 @@ int runDevices(const DevicesArgs& args) {
     IndexSpec cursorSpec = spec.kind == IndexSpec::Kind::Octree
                                ? spec
                                : IndexSpec::octree(2, 0.005).withMaxMegabytes(args.maxIndexMb);
-    const Scene scene = args.scene.empty() ? makeDefaultScene() : loadSceneFile(args.scene);
+    const auto shared = std::make_shared<const Scene>(
+        args.scene.empty() ? makeDefaultScene() : loadSceneFile(args.scene));
+    const Scene& scene = *shared; // the world shares it: one copy
     const std::vector<int> counts = deviceCounts(args.maxDevices);
 
     Progress progress("devices", args.ratesHz.size() * counts.size() *
@@ -250,7 +253,7 @@ int runDevices(const DevicesArgs& args) {
                                      (args.cursor ? args.cursorObjects.size() : 0));
     progress.show("building " + spec.toString() + " over " + std::to_string(scene.size()) +
                   " objects");
-    World world(scene, spec);
+    World world(shared, spec);
     const std::vector<Vec3> starts = clearStarts(scene, *world.current().index, args.maxDevices);
 
     ServoSettings servo;

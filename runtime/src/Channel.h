@@ -70,6 +70,7 @@ struct ChannelRecord {
     RuntimeDevice rd;  ///< The device (owned), its configuration, its recorder.
     EffectSet effects; ///< The effects as the control thread last set them.
     int cpu = -1;      ///< The core its servo thread is pinned to, or -1.
+    int group = -1;    ///< The servo group whose thread runs it (GroupedServo.cpp), or -1.
     std::thread thread;
     bool opened = false; ///< open() succeeded at start(); control thread only.
     std::string openError;
@@ -101,6 +102,17 @@ struct alignas(64) Runtime::Channel {
     ChannelRecord record;                           ///< Cold.
 
     Channel(RuntimeDevice d, const RuntimeOptions& o);
+};
+
+/// Several simulated devices on one servo thread (RuntimeOptions::devicesPerThread). The
+/// members' channels stay where they are; the group holds pointers to them, and `due` is the
+/// tick's scratch list, sized at construction so a tick never allocates.
+struct Runtime::Group {
+    std::vector<Channel*> members; ///< In device order; fixed from construction.
+    std::vector<Channel*> due;     ///< [servo] The members due at this wake-up, by deadline.
+    int cpu = -1;                  ///< The core its thread is pinned to, or -1.
+    std::thread thread;
+    std::atomic<bool> stop{false}; ///< The thread leaves its loop (each member at zero force).
 };
 
 /// Stores a vector into three relaxed atomics. [servo]

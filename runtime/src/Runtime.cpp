@@ -81,6 +81,7 @@ Runtime::Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOption
         ch->record.cpu = mOptions.realtime ? static_cast<int>(i % cores) : -1;
         mChannels.push_back(std::move(ch));
     }
+    makeGroups();
 }
 
 Runtime::~Runtime() {
@@ -128,7 +129,17 @@ std::size_t Runtime::start() {
     const std::size_t started = openAll();
     for (auto& chp : mChannels) {
         if (chp->record.opened) {
-            startThread(*chp);
+            if (chp->record.group < 0) {
+                startThread(*chp);
+            } else {
+                startServo(*chp, now()); // its group's thread runs it
+            }
+        }
+    }
+    for (auto& g : mGroups) {
+        if (std::any_of(g->members.begin(), g->members.end(),
+                        [](const Channel* ch) { return ch->record.opened; })) {
+            g->thread = std::thread([this, &group = *g] { groupMain(group); });
         }
     }
     mSupervisor = std::thread([this] { superviseMain(); });
@@ -171,6 +182,7 @@ void Runtime::stop() {
             chp->record.worker.join(); // returns at once, or when a reopen in progress returns
         }
     }
+    stopGroups(); // no worker restarts a member now
     for (auto& chp : mChannels) {
         Channel& ch = *chp;
         ChannelRecord& c = ch.record;
@@ -204,6 +216,9 @@ void Runtime::emergencyStop(std::uint64_t waitNs) noexcept {
     mStopping.store(true, std::memory_order_release);
     for (auto& ch : mChannels) {
         ch->servo.stop.store(true, std::memory_order_release);
+    }
+    for (auto& g : mGroups) {
+        g->stop.store(true, std::memory_order_release); // each member commands zero as it leaves
     }
     if (mClock) {
         for (auto& chp : mChannels) {

@@ -264,8 +264,11 @@ bool Runtime::step(std::size_t i, std::uint64_t nowNs) {
 void Runtime::stepAll(std::uint64_t nowNs) {
     requireStepped("stepAll");
     for (std::size_t i = 0; i < mChannels.size(); ++i) {
-        (void)step(i, nowNs);
+        if (mChannels[i]->record.group < 0) {
+            (void)step(i, nowNs);
+        }
     }
+    stepGroups(nowNs); // GroupedServo.cpp: each group's members in deadline order
     supervise(nowNs);
 }
 

@@ -178,7 +178,7 @@ void Runtime::recoverMain(Channel& ch) {
             break; // opened while stopping: close below
         }
         markReopened(ch, back);
-        startThread(ch);
+        restartServo(ch); // its own thread, or its group's
         c.recovering.store(false, std::memory_order_release);
         return;
     }

@@ -4,15 +4,21 @@
 #include "hapto/scenes/InputError.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 
 namespace hapto {
 
-World::World(Scene scene, IndexSpec spec) : mSpec(spec) {
-    auto shared = std::make_shared<const Scene>(std::move(scene));
-    std::shared_ptr<const SpatialIndex> index = buildIndex(*shared, mSpec);
+World::World(Scene scene, IndexSpec spec)
+    : World(std::make_shared<const Scene>(std::move(scene)), spec) {}
+
+World::World(std::shared_ptr<const Scene> scene, IndexSpec spec) : mSpec(spec) {
+    if (!scene) {
+        throw std::invalid_argument("World: no scene");
+    }
+    std::shared_ptr<const SpatialIndex> index = buildIndex(*scene, mSpec);
     ++mBuildsPublished;
-    publish(std::move(shared), std::move(index));
+    publish(std::move(scene), std::move(index));
 }
 
 World::~World() {

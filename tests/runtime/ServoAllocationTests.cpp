@@ -247,6 +247,110 @@ TEST_CASE("servo threads make no heap allocation while running, across snapshot 
     CHECK(gServoAllocations.load() == servoBefore);
 }
 
+namespace {
+
+/// Five simulated hands with every effect (the default pair, then three more walking).
+std::vector<DeviceConfig> fiveHands() {
+    std::vector<DeviceConfig> configs = defaultDeviceConfigs();
+    for (int i = 0; i < 3; ++i) {
+        DeviceConfig c = configs[static_cast<std::size_t>(i % 2)];
+        c.name = "walk" + std::to_string(i);
+        c.transform.translation = Vec3(0.01 * (i - 1), 0.0, 0.01);
+        std::get<SimConfig>(c.params).script = HandScript::Walk;
+        std::get<SimConfig>(c.params).seed = 10 + static_cast<std::uint64_t>(i);
+        configs.push_back(c);
+    }
+    for (DeviceConfig& c : configs) {
+        c.rateHz = 2000;
+        c.effects = everyEffect(20.0);
+    }
+    return configs;
+}
+
+} // namespace
+
+TEST_CASE("grouped servos make no heap allocation, across snapshot updates (step mode)") {
+    const Scene scene = makeDefaultScene();
+    ManualClock clock;
+    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    world.useClock(clock);
+    world.setRestDelay(std::chrono::milliseconds(5));
+    std::vector<RuntimeDevice> devices;
+    for (const DeviceConfig& c : fiveHands()) {
+        devices.push_back({makeDevice(c, scene), c, nullptr});
+    }
+    RuntimeOptions opt;
+    opt.realtime = false;
+    opt.devicesPerThread = 3; // a group of three and a group of two
+    Runtime runtime(world, std::move(devices), opt);
+    const std::uint64_t before = gAllAllocations.load();
+    const std::uint64_t servoBefore = gServoAllocations.load();
+    const std::uint64_t t0 = clock.nowNs();
+    REQUIRE(runtime.startStepped(clock) == 5);
+    for (int i = 1; i <= 300; ++i) {
+        if (i % 20 == 0) {
+            world.moveObject(scene.object(0).id, scene.object(0).center + Vec3(0, 0.0001 * i, 0),
+                             Quat(1, 0, 0, 0));
+        }
+        if (i % 7 == 0) {
+            runtime.setEffects(static_cast<std::size_t>(i % 5), everyEffect(10.0 + i % 30));
+        }
+        runtime.runUntil(t0 + static_cast<std::uint64_t>(i) * 1'000'000);
+        runtime.maintain();
+    }
+    runtime.stop();
+    for (const DeviceReport& d : runtime.report().devices) {
+        CHECK(d.ticks == 600);
+        CHECK(d.fault.empty());
+        CHECK(d.snapshotsSeen >= 10);
+    }
+    CHECK(gAllAllocations.load() > before); // the counter is live: the control side allocates
+    CHECK(gServoAllocations.load() == servoBefore);
+}
+
+TEST_CASE("grouped servo threads make no heap allocation while running", "[realtime]") {
+    const Scene scene = makeDefaultScene();
+    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    world.setRestDelay(std::chrono::milliseconds(5));
+    std::vector<RuntimeDevice> devices;
+    for (const DeviceConfig& c : fiveHands()) {
+        devices.push_back({makeDevice(c, scene), c, nullptr});
+    }
+    RuntimeOptions opt;
+    opt.realtime = false;
+    opt.devicesPerThread = 3;
+    Runtime runtime(world, std::move(devices), opt);
+    const std::uint64_t before = gAllAllocations.load();
+    const std::uint64_t servoBefore = gServoAllocations.load();
+    REQUIRE(runtime.start() == 5);
+    const auto seenEnough = [&runtime] {
+        for (std::size_t i = 0; i < runtime.deviceCount(); ++i) {
+            if (runtime.metrics(i).snapshotsSeen.load() < 5) {
+                return false;
+            }
+        }
+        return true;
+    };
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    for (int i = 0; std::chrono::steady_clock::now() < until && !seenEnough(); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        if (i % 10 == 0) {
+            world.moveObject(scene.object(0).id, scene.object(0).center + Vec3(0, 0.0001 * i, 0),
+                             Quat(1, 0, 0, 0));
+        }
+        runtime.setEffects(static_cast<std::size_t>(i % 5), everyEffect(10.0 + i % 30));
+        runtime.maintain();
+    }
+    runtime.stop();
+    for (const DeviceReport& d : runtime.report().devices) {
+        CHECK(d.ticks > 0);
+        CHECK(d.fault.empty());
+        CHECK(d.snapshotsSeen >= 5);
+    }
+    CHECK(gAllAllocations.load() > before);
+    CHECK(gServoAllocations.load() == servoBefore);
+}
+
 TEST_CASE("the renderer makes no heap allocation with mesh candidates: triangle items, a moving "
           "mesh's slot, friction, the carry and a full near list") {
     Material m;

@@ -117,6 +117,31 @@ TEST_CASE("hapto run drives devices at 20 kHz") {
     }
 }
 
+TEST_CASE("hapto run --devices-per-thread drives simulated hands in groups, each reported") {
+    TempDir dir;
+    json devices{{"format", "hapto-devices"}, {"version", 1}, {"devices", json::array()}};
+    for (int i = 0; i < 5; ++i) {
+        devices["devices"].push_back({{"name", "h" + std::to_string(i)},
+                                      {"kind", "sim"},
+                                      {"transform", {{"translation", {0.005 * (i - 2), 0.0, 0.0}}}},
+                                      {"sim", {{"script", "walk"}, {"seed", i + 1}}}});
+    }
+    writeFile(dir / "d.json", devices.dump());
+    const CommandResult r = runHapto("run --devices " + (dir / "d.json").string() +
+                                     " --devices-per-thread 2 --duration 0.5 --no-realtime "
+                                     "--quiet --report " +
+                                     (dir / "r.json").string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    const json j = json::parse(readFile(dir / "r.json"));
+    REQUIRE(j["devices"].size() == 5);
+    for (const json& d : j["devices"]) {
+        CHECK(d["ticks"].get<int>() > 0);
+        CHECK(d["faults"] == 0);
+        CHECK(d["fault"] == "");
+    }
+}
+
 TEST_CASE("hapto run refuses bad input with exit code 2 and says where") {
     TempDir dir;
     writeFile(dir / "d.json", R"({"format": "hapto-devices", "version": 1, "devices": [)"

@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <thread>
 
 namespace hapto::cli {
@@ -70,7 +71,10 @@ struct Felt {
 
 int runDemo(const DemoArgs& a) {
     StopSignals signals; // before any thread starts; see `hapto run`
-    const Scene scene = a.scene.empty() ? makeGraspScene() : loadSceneOrDefault(a.scene);
+    // One copy of the scene: the world's first snapshot shares it with the hands and the view.
+    const auto shared = std::make_shared<const Scene>(
+        a.scene.empty() ? makeGraspScene() : loadSceneOrDefault(a.scene));
+    const Scene& scene = *shared;
     if (!scene.slotOf(a.object)) {
         throw InputError("--object: the scene has no object with id " + std::to_string(a.object));
     }
@@ -83,7 +87,7 @@ int runDemo(const DemoArgs& a) {
     }
     useTraceSettings(configs);
     checkSessionFiles({a.scene, a.devices, a.report, ""}, configs);
-    World world(scene, IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb));
+    World world(shared, IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb));
     std::vector<RuntimeDevice> devices;
     std::vector<SimDevice*> sims;
     for (const DeviceConfig& c : configs) {

@@ -34,8 +34,13 @@ LiveLines::LiveLines(const Runtime* runtime) : mShared(std::make_shared<Shared>(
                 drew = false; // messages go above the live lines; redraw them below
             }
             const bool quit = shared->quit;
-            if (!quit && runtime && std::chrono::steady_clock::now() >= nextDraw) {
+            // The deadline moves on with or without a runtime to draw: a deadline left in the
+            // past made this loop spin (a whole core under --quiet or without a terminal).
+            const bool due = std::chrono::steady_clock::now() >= nextDraw;
+            if (due) {
                 nextDraw += std::chrono::milliseconds(250);
+            }
+            if (!quit && runtime && due) {
                 if (drew) {
                     text += "\x1b[" + std::to_string(runtime->deviceCount()) + "A";
                 }

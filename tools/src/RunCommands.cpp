@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <thread>
 #include <unistd.h>
 
@@ -41,6 +42,7 @@ struct RunArgs {
     bool realtime = true;
     double spinUs = 0;
     int missLimit = 3;
+    std::size_t devicesPerThread = 1;
     double reopenMs = 1000;
     bool quiet = false;
     ViewArgs view;
@@ -79,13 +81,26 @@ void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
     checkDeviceCount(configs.size(), a.devices);
     checkSpinAgainstRates(a.spinUs, configs);
     checkSessionFiles({a.scene, a.devices, a.report, a.record}, configs);
+    if (a.devicesPerThread > 1) {
+        for (const DeviceConfig& c : configs) {
+            if (c.kind != DeviceKind::Sim) {
+                throw InputError("--devices-per-thread " + std::to_string(a.devicesPerThread) +
+                                 ": device '" + c.name + "' in " + a.devices + " is " +
+                                 std::string(name(c.kind)) +
+                                 "; only simulated devices (kind sim) share a servo thread, a "
+                                 "hardware or replay device gets its own");
+            }
+        }
+    }
 }
 
 int runSession(const RunArgs& a) {
     // First, before any thread starts (the index build's TBB workers included), so that every
     // thread inherits the blocked stop signals and only the signal thread takes them.
     StopSignals signals;
-    const Scene scene = loadSceneOrDefault(a.scene);
+    // One copy of the scene: the world's first snapshot shares it with the devices and the view.
+    const auto shared = std::make_shared<const Scene>(loadSceneOrDefault(a.scene));
+    const Scene& scene = *shared;
     const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
     std::vector<DeviceConfig> configs =
         a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
@@ -95,7 +110,7 @@ int runSession(const RunArgs& a) {
         }
     }
     prepareSession(a, configs);
-    World world(scene, spec);
+    World world(shared, spec);
 
     std::vector<std::unique_ptr<TraceRecorder>> recorders;
     if (!a.record.empty()) {
@@ -127,6 +142,7 @@ int runSession(const RunArgs& a) {
     opt.spinNs = static_cast<std::uint64_t>(a.spinUs * 1000);
     opt.missLimit = a.missLimit;
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
+    opt.devicesPerThread = a.devicesPerThread;
     Runtime runtime(world, std::move(devices), opt);
     // A second signal while the orderly stop below is under way (or blocked): zero force
     // now, from the signal thread, and exit.
@@ -233,6 +249,12 @@ void addRunCommands(CLI::App& app) {
                     "it again this often, then drive it again from zero force (ms); 0 = never")
         ->capture_default_str()
         ->check(finiteRange(0, 3600000));
+    cmd->add_option("--devices-per-thread", a->devicesPerThread,
+                    "Simulated devices only: run K devices on one servo thread, each at its own "
+                    "deadline with its own load record and safety (one sleep per wake-up for all "
+                    "those due); 1 = one servo thread per device")
+        ->capture_default_str()
+        ->check(finiteRange(1, static_cast<double>(kMaxSessionDevices)));
     cmd->add_flag("--quiet", a->quiet, "No live lines on the terminal");
     addViewOptions(cmd, a->view);
     cmd->callback([a] {

@@ -58,6 +58,13 @@ struct RuntimeOptions {
                                ///< this long (ns), then drive it again from zero force; 0 = never.
     RendererConfig renderer{}; ///< Proxy settings for every device (a device's
                                ///< DeviceConfig::contactDampingNsPerM overrides the damping).
+    /// Simulated devices only (kind sim or scripted): K > 1 runs devices [0, K), [K, 2K), ...
+    /// on one servo thread per group (GroupedServo.cpp). Each device keeps its own deadline,
+    /// cursor, renderer, load record, safety and faults; the thread sleeps once to the
+    /// earliest deadline and ticks every device then due, earliest deadline first. 1 (the
+    /// default, and the design): one servo thread per device. The constructor throws
+    /// std::invalid_argument for K = 0 or K > 1 with a device of another kind.
+    std::size_t devicesPerThread = 1;
 };
 
 /// One device as the runtime drives it.
@@ -102,8 +109,8 @@ struct RunReport {
     std::string realtimeNote; ///< Why SCHED_FIFO or pinning was not granted, if not.
 };
 
-/// Runs D servo threads and a supervisor. Construct, start(), call maintain() every few
-/// milliseconds for world upkeep, stop().
+/// Runs D servo threads (or D / K, RuntimeOptions::devicesPerThread) and a supervisor. Construct,
+/// start(), call maintain() every few milliseconds for world upkeep, stop().
 ///
 /// Supervision (the watchdog, closing a faulted device, reopening it, starting its new servo
 /// thread) runs on the runtime's own supervisor thread, and every close and open on a worker
@@ -143,7 +150,9 @@ public:
     /// each device's tick the clock is set to `nowNs`; the device may advance it inside its
     /// read() or write() (that tick then takes that long: its load, misses and next deadline
     /// follow); afterwards the clock is set back to `nowNs`, since the other devices' threads
-    /// did not wait for it. [control]
+    /// did not wait for it. A group's members (RuntimeOptions::devicesPerThread) tick as
+    /// their one thread ticks them: those due, earliest deadline first, the clock carried from
+    /// one member's tick to the next and set back to `nowNs` after the group. [control]
     void stepAll(std::uint64_t nowNs);
     /// Step mode: one tick of device i woken at `nowNs` (clock as in stepAll()), when its
     /// servo runs and its deadline has come; a device not stepped meanwhile is a thread that
@@ -216,6 +225,7 @@ public:
 
 private:
     struct Channel;
+    struct Group;
     // Runtime.cpp: set-up and shutdown.
     std::size_t openAll();
     std::uint64_t now() const noexcept;
@@ -236,10 +246,18 @@ private:
     void reopenStepped(Channel& channel, std::uint64_t nowNs);
     bool waitUnlessStopping(std::uint64_t ns);
     void addEvent(Channel& channel, std::uint64_t nowNs, const std::string& what);
+    // GroupedServo.cpp: several simulated devices on one servo thread.
+    void makeGroups();
+    void restartServo(Channel& channel);
+    void tickDue(Group& group) noexcept;
+    void groupMain(Group& group);
+    void stepGroups(std::uint64_t nowNs);
+    void stopGroups();
 
     World& mWorld;
     RuntimeOptions mOptions;
     std::vector<std::unique_ptr<Channel>> mChannels;
+    std::vector<std::unique_ptr<Group>> mGroups; // empty: one servo thread per device
     ManualClock* mClock = nullptr; // step mode's clock; nullptr: threaded, CLOCK_MONOTONIC
     bool mStarted = false;         // start() or startStepped() was called (hooks are fixed)
     std::uint64_t mStartNs = 0;

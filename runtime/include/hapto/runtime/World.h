@@ -52,6 +52,10 @@ class World {
 public:
     /// Builds the index over the scene and publishes version 1. [control]
     World(Scene scene, IndexSpec spec);
+    /// The same over a scene the caller shares (not null): version 1 holds this very scene,
+    /// not a copy, so a command that also needs the scene (its devices, its view) keeps one
+    /// copy in memory. [control]
+    World(std::shared_ptr<const Scene> scene, IndexSpec spec);
     ~World();
     World(const World&) = delete;
     World& operator=(const World&) = delete;
