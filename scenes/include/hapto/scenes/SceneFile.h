@@ -16,7 +16,8 @@ inline constexpr int kSceneFormatVersion = 2;
 /// builds before version 2 wrote.
 inline constexpr int kSceneFormatVersionWithoutMeshes = 1;
 
-/// Loads a scene file. Streams the objects, so 10^7 objects load in bounded extra memory.
+/// Loads a scene file, JSON or binary (BinaryScene.h; told apart by its magic, not its name).
+/// Streams the objects, so 10^7 objects load in bounded extra memory.
 /// Model files named by mesh objects are read relative to the scene file's folder (MeshFile.h).
 /// Throws InputError naming the file and the JSON path (e.g. `objects[12].half_extents[1]`) on
 /// any bad input, and for a bad model file the model file and its place too (`objects[3].file:
