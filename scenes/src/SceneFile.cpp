@@ -112,6 +112,14 @@ void checkSpan(const Source& w, const Aabb& bounds, std::span<const SceneObject>
 
 void checkUniqueIds(const Source& w, std::span<const SceneObject> objects,
                     const Path& objectsPath) {
+    // Ids written in ascending order (as every generator does) are unique without a sort.
+    bool ascending = true;
+    for (std::size_t i = 1; i < objects.size() && ascending; ++i) {
+        ascending = objects[i - 1].id < objects[i].id;
+    }
+    if (ascending) {
+        return;
+    }
     std::vector<std::pair<ObjectId, std::uint32_t>> ids;
     ids.reserve(objects.size());
     for (std::uint32_t i = 0; i < objects.size(); ++i) {
