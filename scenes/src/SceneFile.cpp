@@ -459,8 +459,8 @@ template <class Flush> void appendMesh(std::string& out, const TriangleMesh& mes
 
 } // namespace
 
-Scene parseScene(std::string_view text, std::string_view sourceName,
-                 const std::filesystem::path& baseDir) {
+Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
+                        const std::filesystem::path& baseDir) {
     const Source w(sourceName);
     const Path top;
     const Path objectsPath = top / "objects";
@@ -583,7 +583,19 @@ Scene loadSceneFile(const std::filesystem::path& path) {
     if (isBinaryScene(text)) {
         return parseBinaryScene(text, path.string(), path.parent_path());
     }
-    return parseScene(text, path.string(), path.parent_path());
+    // The string's spare capacity is simdjson's padding when there is enough of it.
+    if (auto scene = detail::parseSceneFast(text, text.capacity(), path.string())) {
+        return std::move(*scene);
+    }
+    return parseSceneChecked(text, path.string(), path.parent_path());
+}
+
+Scene parseScene(std::string_view text, std::string_view sourceName,
+                 const std::filesystem::path& baseDir) {
+    if (auto scene = detail::parseSceneFast(text, text.size(), sourceName)) {
+        return std::move(*scene);
+    }
+    return parseSceneChecked(text, sourceName, baseDir);
 }
 
 namespace {

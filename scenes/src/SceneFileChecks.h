@@ -14,6 +14,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -63,5 +64,12 @@ using ModelCache = std::map<std::pair<std::string, double>, std::shared_ptr<cons
 std::shared_ptr<const TriangleMesh> loadModel(ModelCache& models,
                                               const std::filesystem::path& baseDir,
                                               const std::string& file, double scale);
+
+/// The JSON loader's fast path (SceneJsonFast.cpp): the scene when simdjson reads `text` as a
+/// box-and-sphere scene every check accepts, else nothing (the checked loader then reads it).
+/// `capacity` is how many bytes may be read at `text` (simdjson reads up to 64 past the end;
+/// the text is copied when there is not that much room).
+std::optional<Scene> parseSceneFast(std::string_view text, std::size_t capacity,
+                                    std::string_view sourceName);
 
 } // namespace hapto::detail

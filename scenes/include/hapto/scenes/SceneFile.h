@@ -29,6 +29,12 @@ Scene loadSceneFile(const std::filesystem::path& path);
 Scene parseScene(std::string_view text, std::string_view sourceName,
                  const std::filesystem::path& baseDir = {});
 
+/// parseScene without its simdjson fast path: the checked (nlohmann) loader alone, which gives
+/// every refusal's message and reads mesh scenes. The same scenes and messages as parseScene;
+/// for the tests and the fuzzer that hold the two to that. [control]
+Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
+                        const std::filesystem::path& baseDir = {});
+
 /// Writes the scene as JSON, every field explicit; the same scene gives the same bytes. A scene
 /// without meshes is written as version 1, one with meshes as version 2: a mesh from a model file
 /// by its file (as the scene that loaded it named it, so the scene must be written to the same
