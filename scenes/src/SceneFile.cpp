@@ -8,6 +8,7 @@
 #include "hapto/core/Finite.h"
 #include "hapto/scenes/BinaryScene.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/InputFile.h"
 #include "hapto/scenes/JsonInput.h"
 #include "hapto/scenes/MeshFile.h"
 
@@ -16,8 +17,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <span>
 #include <sstream>
@@ -578,8 +581,37 @@ Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
     return finishScene(w, std::move(objects), bounds, objectsPath);
 }
 
+namespace {
+
+/// Spare bytes kept after a scene file's text: simdjson reads up to SIMDJSON_PADDING (64) past
+/// the end, and finds them in the string's capacity instead of copying the text.
+constexpr std::size_t kReadPadding = 64;
+
+/// The scene file's bytes, read once into a string of exactly their size (a file that reports
+/// no size, as in /proc, is read as it comes). [control]
+std::string readSceneFile(const std::filesystem::path& path) {
+    InputFile file(path, "scene file");
+    if (file.size() == 0) {
+        return file.readAll();
+    }
+    std::string text;
+    text.reserve(file.size() + kReadPadding);
+    text.resize(file.size());
+    const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(file.releaseToStdio(), &std::fclose);
+    const std::size_t got = std::fread(text.data(), 1, text.size(), f.get());
+    if (std::ferror(f.get())) {
+        throw InputError(path.string() + ": cannot read the scene file");
+    }
+    if (got != text.size() || std::fgetc(f.get()) != EOF) {
+        throw InputError(path.string() + ": the scene file changed size while it was read");
+    }
+    return text;
+}
+
+} // namespace
+
 Scene loadSceneFile(const std::filesystem::path& path) {
-    const std::string text = readFile(path, "scene file");
+    const std::string text = readSceneFile(path);
     if (isBinaryScene(text)) {
         return parseBinaryScene(text, path.string(), path.parent_path());
     }
