@@ -203,7 +203,9 @@ void readMeshes(const Source& s, std::string_view section, std::uint64_t section
             }
             const char* t = v + 24 * vertexCount;
             std::vector<TriangleIndices> triangles(triangleCount);
-            std::memcpy(triangles.data(), t, 12 * triangleCount);
+            if (triangleCount > 0) { // memcpy from or to null is undefined, even for 0 bytes
+                std::memcpy(triangles.data(), t, 12 * triangleCount);
+            }
             static_assert(sizeof(TriangleIndices) == 12);
             o.mesh = atOffset(s, entry, [&] {
                 return detail::makeInlineMesh(s, path, std::move(vertices), std::move(triangles),

@@ -408,6 +408,12 @@ Aabb parseBounds(const Source& w, const Json& j, const Path& path) {
 }
 
 void appendNumber(std::string& out, double v) {
+    // Negative zero as "-0.0": a JSON reader takes "-0" for the integer 0, so the sign would
+    // not survive a round trip (friction -0 is valid: it is >= 0).
+    if (v == 0.0 && std::signbit(v)) {
+        out += "-0.0";
+        return;
+    }
     char buf[32];
     const auto res = std::to_chars(buf, buf + sizeof buf, v);
     out.append(buf, res.ptr);

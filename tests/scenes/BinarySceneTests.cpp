@@ -11,6 +11,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -76,6 +77,22 @@ TEST_CASE("JSON to binary to JSON gives the same scene, byte for byte") {
     CHECK(back == scene);
     CHECK(sceneToJson(back) == sceneToJson(scene));
     CHECK(sceneToBinary(back) == bytes);
+}
+
+TEST_CASE("a negative zero keeps its sign through JSON and the binary format") {
+    const Scene scene = parseScene(R"({"format": "hapto-scene", "version": 1, "objects": [
+        {"id": 0, "shape": "box", "center": [-0.0, 0, 0], "half_extents": [1, 1, 1],
+         "friction": [-0.0, -0.0]}]})",
+                                   "zero.json");
+    REQUIRE(std::signbit(scene.object(0).material.staticFriction));
+    const std::string json = sceneToJson(scene);
+    const Scene fromJson = parseScene(json, "again.json");
+    CHECK(std::signbit(fromJson.object(0).center.x));
+    CHECK(std::signbit(fromJson.object(0).material.dynamicFriction));
+    CHECK(sceneToJson(fromJson) == json);
+    const Scene fromBinary = parseBinaryScene(sceneToBinary(fromJson), "zero.hsb");
+    CHECK(sceneToJson(fromBinary) == json);
+    CHECK(sceneToBinary(fromBinary) == sceneToBinary(scene));
 }
 
 TEST_CASE("spheres, rotations, materials and inline meshes survive the binary format") {
