@@ -201,7 +201,10 @@ double number(const Source& s, const Json& j, const Path& path) {
     if (!j.is_number()) {
         s.fail(path, "expected a number, got " + typeName(j));
     }
-    const double v = j.get<double>();
+    return finiteNumber(s, j.get<double>(), path);
+}
+
+double finiteNumber(const Source& s, double v, const Path& path) {
     if (!std::isfinite(v)) {
         s.fail(path, "expected a finite number");
     }
@@ -260,7 +263,10 @@ Vec3 vec3(const Source& s, const Json& j, const Path& path) {
 }
 
 Quat quaternion(const Source& s, const Json& j, const Path& path) {
-    const auto q = numbers<4>(s, j, path);
+    return unitQuaternion(s, numbers<4>(s, j, path), path);
+}
+
+Quat unitQuaternion(const Source& s, const std::array<double, 4>& q, const Path& path) {
     const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     if (std::abs(len - 1.0) > 1e-3) {
         s.fail(path, "must be a unit quaternion (w, x, y, z); its length is " + show(len));

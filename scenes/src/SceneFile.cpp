@@ -6,31 +6,217 @@
 #include "hapto/scenes/SceneFile.h"
 
 #include "hapto/core/Finite.h"
+#include "hapto/scenes/BinaryScene.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/InputFile.h"
 #include "hapto/scenes/JsonInput.h"
 #include "hapto/scenes/MeshFile.h"
+
+#include "SceneFileChecks.h"
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <span>
 #include <sstream>
 #include <tuple>
 
 namespace hapto {
+
+namespace detail {
+
+using namespace hapto::json;
+
+double checkHalfExtent(const Source& s, double v, const Path& path) {
+    checkRange(s, v, path, 0.0, kUnbounded, true, "a half extent");
+    return v;
+}
+
+double checkRadius(const Source& s, double v, const Path& path) {
+    checkRange(s, v, path, 0.0, kUnbounded, true, "the radius");
+    return v;
+}
+
+double checkMeshScale(const Source& s, double v, const Path& path) {
+    checkRange(s, v, path, 0.0, kUnbounded, true, "the scale");
+    return v;
+}
+
+double checkStiffness(const Source& s, double v, const Path& path) {
+    checkRange(s, v, path, 0.0, Material::kMaxStiffness, true, "stiffness (N/m)");
+    return v;
+}
+
+void checkFriction(const Source& s, double staticMu, double dynamicMu, const Path& path) {
+    checkRange(s, staticMu, path[0], 0.0, Material::kMaxFriction, false, "a friction coefficient");
+    checkRange(s, dynamicMu, path[1], 0.0, Material::kMaxFriction, false, "a friction coefficient");
+    if (dynamicMu > staticMu) {
+        s.fail(path, "the dynamic coefficient (second) must not exceed the static one (first)");
+    }
+}
+
+void checkReach(const Source& s, const SceneObject& o, const Path& path) {
+    // A box reaches at most the sum of its half extents from its centre along any axis,
+    // whatever its rotation, a mesh at most its bounding radius. (Its size, and its distance
+    // from the bounds, are checked once the bounds are known: finishScene.)
+    const double reach = o.shape == Shape::Sphere ? o.halfExtents.x
+                         : o.shape == Shape::Mesh
+                             ? o.mesh->boundingRadius()
+                             : o.halfExtents.x + o.halfExtents.y + o.halfExtents.z;
+    for (int i = 0; i < 3; ++i) {
+        if (!std::isfinite(std::abs(o.center[i]) + reach)) {
+            s.fail(path, "the object reaches past the largest finite coordinate (centre " +
+                             show(o.center[i]) + " on axis " + std::to_string(i) + ", size " +
+                             show(reach) + ")");
+        }
+    }
+}
+
+void checkBounds(const Source& s, const Aabb& b, const Path& path) {
+    for (int i = 0; i < 3; ++i) {
+        if (!(b.min[i] < b.max[i])) {
+            s.fail(path, "min must be < max on every axis (axis " + std::to_string(i) + ")");
+        }
+        if (!std::isfinite(b.max[i] - b.min[i])) {
+            s.fail(path, "the bounds are too large: max - min overflows on axis " +
+                             std::to_string(i) + " (" + show(b.min[i]) + " .. " + show(b.max[i]) +
+                             "); every size must be a finite number of metres");
+        }
+    }
+}
+
+namespace {
+
+// Every distance an index computes between an object and the bounds must be finite: refuses
+// the first object whose AABB, together with the bounds, spans an overflowing size.
+void checkSpan(const Source& w, const Aabb& bounds, std::span<const SceneObject> objects,
+               const Path& objectsPath) {
+    for (std::size_t k = 0; k < objects.size(); ++k) {
+        const Aabb box = objects[k].aabb();
+        for (int i = 0; i < 3; ++i) {
+            const double lo = std::min(box.min[i], bounds.min[i]);
+            const double hi = std::max(box.max[i], bounds.max[i]);
+            if (!std::isfinite(hi - lo)) {
+                w.fail(objectsPath[k], "the object lies too far from the bounds: the space "
+                                       "spanning both overflows on axis " +
+                                           std::to_string(i) + " (" + show(lo) + " .. " + show(hi) +
+                                           ")");
+            }
+        }
+    }
+}
+
+} // namespace
+
+void checkUniqueIds(const Source& w, std::span<const SceneObject> objects,
+                    const Path& objectsPath) {
+    // Ids written in ascending order (as every generator does) are unique without a sort.
+    bool ascending = true;
+    for (std::size_t i = 1; i < objects.size() && ascending; ++i) {
+        ascending = objects[i - 1].id < objects[i].id;
+    }
+    if (ascending) {
+        return;
+    }
+    std::vector<std::pair<ObjectId, std::uint32_t>> ids;
+    ids.reserve(objects.size());
+    for (std::uint32_t i = 0; i < objects.size(); ++i) {
+        ids.emplace_back(objects[i].id, i);
+    }
+    std::sort(ids.begin(), ids.end());
+    for (std::size_t i = 1; i < ids.size(); ++i) {
+        if (ids[i].first == ids[i - 1].first) {
+            w.fail(objectsPath[ids[i].second] / "id",
+                   "duplicate id " + std::to_string(ids[i].first) + " (also at objects[" +
+                       std::to_string(ids[i - 1].second) + "])");
+        }
+    }
+}
+
+Scene finishScene(const Source& w, std::vector<SceneObject> objects,
+                  const std::optional<Aabb>& explicitBounds, const Path& objectsPath) {
+    if (explicitBounds) {
+        checkSpan(w, *explicitBounds, objects, objectsPath);
+        return Scene(*explicitBounds, std::move(objects));
+    }
+    // Default bounds pad the objects' union by 5 % (at least 1 mm). Far enough from the origin
+    // that margin is lost to rounding or overflows; refuse here, with the file and the reason,
+    // rather than let the Scene refuse the bounds.
+    const Aabb bounds = Scene::defaultBounds(objects);
+    for (int i = 0; i < 3; ++i) {
+        if (!(std::isfinite(bounds.min[i]) && std::isfinite(bounds.max[i]) &&
+              std::isfinite(bounds.max[i] - bounds.min[i]) && bounds.min[i] < bounds.max[i])) {
+            w.fail(objectsPath, "the objects lie too far out on axis " + std::to_string(i) +
+                                    " to pad default bounds around them (the margin is lost to "
+                                    "rounding or overflows); give \"bounds\" explicitly");
+        }
+    }
+    return Scene(bounds, std::move(objects));
+}
+
+std::shared_ptr<const TriangleMesh> makeInlineMesh(const Source& w, const Path& path,
+                                                   std::vector<Vec3> vertices,
+                                                   std::vector<TriangleIndices> triangles,
+                                                   double scale, std::uint32_t farMark,
+                                                   std::optional<std::int64_t> farValue) {
+    const Path vp = path / "vertices";
+    const Path tp = path / "triangles";
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const Vec3 scaled = vertices[i] * scale;
+        if (!finite(scaled)) {
+            w.fail(vp[i], "the vertex times the scale " + show(scale) + " is not finite");
+        }
+        vertices[i] = scaled;
+    }
+    const std::size_t count = vertices.size();
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (triangles[i][k] >= count) {
+                const bool far = farValue && triangles[i][k] == farMark;
+                const std::int64_t value = far ? *farValue : triangles[i][k];
+                w.fail(tp[i][k], "vertex index " + std::to_string(value) +
+                                     " is out of range (the mesh has " + std::to_string(count) +
+                                     " vertices)");
+            }
+        }
+    }
+    // make() names the element of what it refuses ("no triangles left" when all are
+    // degenerate) after the file and the object.
+    return TriangleMesh::make(std::move(vertices), std::move(triangles), MeshSource{"", scale},
+                              std::string(w.name()) + ": " + path.str());
+}
+
+std::shared_ptr<const TriangleMesh> loadModel(ModelCache& models,
+                                              const std::filesystem::path& baseDir,
+                                              const std::string& file, double scale) {
+    auto& cached = models[{file, scale}];
+    if (!cached) {
+        const std::filesystem::path where = std::filesystem::path(file).is_absolute()
+                                                ? std::filesystem::path(file)
+                                                : baseDir / file;
+        cached = loadMeshFile(where, MeshSource{file, scale});
+    }
+    return cached;
+}
+
+} // namespace detail
+
 namespace {
 
 using namespace hapto::json;
+using namespace hapto::detail;
 
 /// What the loader keeps while it streams objects: where model files are found, the models
 /// read so far (a file placed twice at one scale is read once and shared), and the file's
 /// version once its "version" field has been read (0 before).
 struct LoadContext {
     std::filesystem::path baseDir;
-    std::map<std::pair<std::string, double>, std::shared_ptr<const TriangleMesh>> models;
+    ModelCache models;
     std::int64_t version = 0;
     /// The inline "vertices" (unscaled) and "triangles" of the object being read, converted
     /// element by element as the parser completes them, so a large inline mesh never sits in
@@ -106,30 +292,13 @@ parseInlineMesh(const Source& w, const Json& j, const Path& path, double scale, 
     }
     std::vector<Vec3> vertices = std::move(c.vertices);
     std::vector<TriangleIndices> triangles = std::move(c.triangles);
+    std::optional<std::int64_t> far;
+    if (c.farIndex) {
+        far = std::get<2>(*c.farIndex);
+    }
     c.startObject();
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-        const Vec3 scaled = vertices[i] * scale;
-        if (!finite(scaled)) {
-            w.fail(vp[i], "the vertex times the scale " + show(scale) + " is not finite");
-        }
-        vertices[i] = scaled;
-    }
-    const std::size_t count = vertices.size();
-    for (std::size_t i = 0; i < triangles.size(); ++i) {
-        for (std::size_t k = 0; k < 3; ++k) {
-            if (triangles[i][k] >= count) {
-                const bool far = triangles[i][k] == LoadContext::kFarIndex;
-                const std::int64_t value = far ? std::get<2>(*c.farIndex) : triangles[i][k];
-                w.fail(tp[i][k], "vertex index " + std::to_string(value) +
-                                     " is out of range (the mesh has " + std::to_string(count) +
-                                     " vertices)");
-            }
-        }
-    }
-    // make() names the element of what it refuses ("no triangles left" when all are
-    // degenerate) after the file and the object.
-    return TriangleMesh::make(std::move(vertices), std::move(triangles), MeshSource{"", scale},
-                              std::string(w.name()) + ": " + path.str());
+    return makeInlineMesh(w, path, std::move(vertices), std::move(triangles), scale,
+                          LoadContext::kFarIndex, far);
 }
 
 /// A mesh read from a model file, named relative to the scene file's folder.
@@ -140,18 +309,11 @@ std::shared_ptr<const TriangleMesh> parseFileMesh(const Source& w, const Json& j
     if (file.empty()) {
         w.fail(fp, "expected the model file's path (relative to the scene file), got \"\"");
     }
-    auto& cached = context.models[{file, scale}];
-    if (!cached) {
-        const std::filesystem::path where = std::filesystem::path(file).is_absolute()
-                                                ? std::filesystem::path(file)
-                                                : context.baseDir / file;
-        try {
-            cached = loadMeshFile(where, MeshSource{file, scale});
-        } catch (const InputError& e) {
-            w.fail(fp, e.what());
-        }
+    try {
+        return loadModel(context.models, context.baseDir, file, scale);
+    } catch (const InputError& e) {
+        w.fail(fp, e.what());
     }
-    return cached;
 }
 
 void refuseMeshInVersion1(const Source& w, const Path& shapePath) {
@@ -180,15 +342,14 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
         const Path he = path / "half_extents";
         o.halfExtents = vec3(w, required(w, j, path, "half_extents"), he);
         for (std::size_t i = 0; i < 3; ++i) {
-            checkRange(w, o.halfExtents[static_cast<int>(i)], he[i], 0.0, kUnbounded, true,
-                       "a half extent");
+            checkHalfExtent(w, o.halfExtents[static_cast<int>(i)], he[i]);
         }
     } else if (shapeText == "sphere") {
         o.shape = Shape::Sphere;
         checkKeys(w, j, path,
                   {"id", "shape", "center", "radius", "rotation", "stiffness", "friction"});
-        o.halfExtents = Vec3(ranged(w, required(w, j, path, "radius"), path / "radius", 0.0,
-                                    kUnbounded, true, "the radius"));
+        const Path rp = path / "radius";
+        o.halfExtents = Vec3(checkRadius(w, number(w, required(w, j, path, "radius"), rp), rp));
     } else if (shapeText == "mesh") {
         if (context.version == 1) {
             refuseMeshInVersion1(w, path / "shape");
@@ -199,7 +360,7 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
                    "stiffness", "friction"});
         double scale = 1.0;
         if (const Json* v = optional(j, "scale")) {
-            scale = ranged(w, *v, path / "scale", 0.0, kUnbounded, true, "the scale");
+            scale = checkMeshScale(w, number(w, *v, path / "scale"), path / "scale");
         }
         const bool hasFile = optional(j, "file") != nullptr;
         const bool hasInline = optional(j, "vertices") || optional(j, "triangles");
@@ -217,38 +378,18 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
                "unknown shape '" + shapeText + "' (expected \"box\", \"sphere\" or \"mesh\")");
     }
     o.center = vec3(w, required(w, j, path, "center"), path / "center");
-    // The bounding box must be finite too: a box reaches at most the sum of its half extents
-    // from its centre along any axis, whatever its rotation, a mesh at most its bounding
-    // radius. (Its size, and its distance from the bounds, are checked once the bounds are
-    // known: checkSpan.)
-    const double reach = o.shape == Shape::Sphere ? o.halfExtents.x
-                         : o.shape == Shape::Mesh
-                             ? o.mesh->boundingRadius()
-                             : o.halfExtents.x + o.halfExtents.y + o.halfExtents.z;
-    for (int i = 0; i < 3; ++i) {
-        if (!std::isfinite(std::abs(o.center[i]) + reach)) {
-            w.fail(path, "the object reaches past the largest finite coordinate (centre " +
-                             show(o.center[i]) + " on axis " + std::to_string(i) + ", size " +
-                             show(reach) + ")");
-        }
-    }
+    checkReach(w, o, path); // the bounding box must be finite too
     if (const Json* v = optional(j, "rotation")) {
         o.rotation = quaternion(w, *v, path / "rotation");
     }
     if (const Json* v = optional(j, "stiffness")) {
-        o.material.stiffness = ranged(w, *v, path / "stiffness", 0.0, Material::kMaxStiffness, true,
-                                      "stiffness (N/m)");
+        const Path sp = path / "stiffness";
+        o.material.stiffness = checkStiffness(w, number(w, *v, sp), sp);
     }
     if (const Json* v = optional(j, "friction")) {
         const Path fp = path / "friction";
         const auto f = numbers<2>(w, *v, fp);
-        for (std::size_t i = 0; i < 2; ++i) {
-            checkRange(w, f[i], fp[i], 0.0, Material::kMaxFriction, false,
-                       "a friction coefficient");
-        }
-        if (f[1] > f[0]) {
-            w.fail(fp, "the dynamic coefficient (second) must not exceed the static one (first)");
-        }
+        checkFriction(w, f[0], f[1], fp);
         o.material.staticFriction = f[0];
         o.material.dynamicFriction = f[1];
     }
@@ -260,41 +401,19 @@ Aabb parseBounds(const Source& w, const Json& j, const Path& path) {
         w.fail(path, "expected an object {\"min\": [x,y,z], \"max\": [x,y,z]}, got " + typeName(j));
     }
     checkKeys(w, j, path, {"min", "max"});
-    Aabb b{vec3(w, required(w, j, path, "min"), path / "min"),
-           vec3(w, required(w, j, path, "max"), path / "max")};
-    for (int i = 0; i < 3; ++i) {
-        if (!(b.min[i] < b.max[i])) {
-            w.fail(path, "min must be < max on every axis (axis " + std::to_string(i) + ")");
-        }
-        if (!std::isfinite(b.max[i] - b.min[i])) {
-            w.fail(path, "the bounds are too large: max - min overflows on axis " +
-                             std::to_string(i) + " (" + show(b.min[i]) + " .. " + show(b.max[i]) +
-                             "); every size must be a finite number of metres");
-        }
-    }
+    const Aabb b{vec3(w, required(w, j, path, "min"), path / "min"),
+                 vec3(w, required(w, j, path, "max"), path / "max")};
+    checkBounds(w, b, path);
     return b;
 }
 
-// Every distance an index computes between an object and the bounds must be finite: refuses
-// the first object whose AABB, together with the bounds, spans an overflowing size.
-void checkSpan(const Source& w, const Aabb& bounds, std::span<const SceneObject> objects,
-               const Path& objectsPath) {
-    for (std::size_t k = 0; k < objects.size(); ++k) {
-        const Aabb box = objects[k].aabb();
-        for (int i = 0; i < 3; ++i) {
-            const double lo = std::min(box.min[i], bounds.min[i]);
-            const double hi = std::max(box.max[i], bounds.max[i]);
-            if (!std::isfinite(hi - lo)) {
-                w.fail(objectsPath[k], "the object lies too far from the bounds: the space "
-                                       "spanning both overflows on axis " +
-                                           std::to_string(i) + " (" + show(lo) + " .. " + show(hi) +
-                                           ")");
-            }
-        }
-    }
-}
-
 void appendNumber(std::string& out, double v) {
+    // Negative zero as "-0.0": a JSON reader takes "-0" for the integer 0, so the sign would
+    // not survive a round trip (friction -0 is valid: it is >= 0).
+    if (v == 0.0 && std::signbit(v)) {
+        out += "-0.0";
+        return;
+    }
     char buf[32];
     const auto res = std::to_chars(buf, buf + sizeof buf, v);
     out.append(buf, res.ptr);
@@ -349,8 +468,8 @@ template <class Flush> void appendMesh(std::string& out, const TriangleMesh& mes
 
 } // namespace
 
-Scene parseScene(std::string_view text, std::string_view sourceName,
-                 const std::filesystem::path& baseDir) {
+Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
+                        const std::filesystem::path& baseDir) {
     const Source w(sourceName);
     const Path top;
     const Path objectsPath = top / "objects";
@@ -459,45 +578,62 @@ Scene parseScene(std::string_view text, std::string_view sourceName,
         w.fail(objectsPath, "expected an array, got " + typeName(*objectsJson));
     }
 
-    // Duplicate ids, named by both places.
-    std::vector<std::pair<ObjectId, std::uint32_t>> ids;
-    ids.reserve(objects.size());
-    for (std::uint32_t i = 0; i < objects.size(); ++i) {
-        ids.emplace_back(objects[i].id, i);
-    }
-    std::sort(ids.begin(), ids.end());
-    for (std::size_t i = 1; i < ids.size(); ++i) {
-        if (ids[i].first == ids[i - 1].first) {
-            w.fail(objectsPath[ids[i].second] / "id",
-                   "duplicate id " + std::to_string(ids[i].first) + " (also at objects[" +
-                       std::to_string(ids[i - 1].second) + "])");
-        }
-    }
-
+    checkUniqueIds(w, objects, objectsPath);
     const Json* boundsJson = optional(root, "bounds");
+    std::optional<Aabb> bounds;
     if (boundsJson) {
-        const Aabb bounds = parseBounds(w, *boundsJson, top / "bounds");
-        checkSpan(w, bounds, objects, objectsPath);
-        return Scene(bounds, std::move(objects));
+        bounds = parseBounds(w, *boundsJson, top / "bounds");
     }
-    // Default bounds pad the objects' union by 5 % (at least 1 mm). Far enough from the origin
-    // that margin is lost to rounding or overflows; refuse here, with the file and the reason,
-    // rather than let the Scene refuse the bounds.
-    const Aabb bounds = Scene::defaultBounds(objects);
-    for (int i = 0; i < 3; ++i) {
-        if (!(std::isfinite(bounds.min[i]) && std::isfinite(bounds.max[i]) &&
-              std::isfinite(bounds.max[i] - bounds.min[i]) && bounds.min[i] < bounds.max[i])) {
-            w.fail(objectsPath, "the objects lie too far out on axis " + std::to_string(i) +
-                                    " to pad default bounds around them (the margin is lost to "
-                                    "rounding or overflows); give \"bounds\" explicitly");
-        }
-    }
-    return Scene(bounds, std::move(objects));
+    return finishScene(w, std::move(objects), bounds, objectsPath);
 }
 
+namespace {
+
+/// Spare bytes kept after a scene file's text: simdjson reads up to SIMDJSON_PADDING (64) past
+/// the end, and finds them in the string's capacity instead of copying the text.
+constexpr std::size_t kReadPadding = 64;
+
+/// The scene file's bytes, read once into a string of exactly their size (a file that reports
+/// no size, as in /proc, is read as it comes). [control]
+std::string readSceneFile(const std::filesystem::path& path) {
+    InputFile file(path, "scene file");
+    if (file.size() == 0) {
+        return file.readAll();
+    }
+    std::string text;
+    text.reserve(file.size() + kReadPadding);
+    text.resize(file.size());
+    const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(file.releaseToStdio(), &std::fclose);
+    const std::size_t got = std::fread(text.data(), 1, text.size(), f.get());
+    if (std::ferror(f.get())) {
+        throw InputError(path.string() + ": cannot read the scene file");
+    }
+    if (got != text.size() || std::fgetc(f.get()) != EOF) {
+        throw InputError(path.string() + ": the scene file changed size while it was read");
+    }
+    return text;
+}
+
+} // namespace
+
 Scene loadSceneFile(const std::filesystem::path& path) {
-    const std::string text = readFile(path, "scene file");
-    return parseScene(text, path.string(), path.parent_path());
+    const std::string text = readSceneFile(path);
+    if (isBinaryScene(text)) {
+        return parseBinaryScene(text, path.string(), path.parent_path());
+    }
+    // The string's spare capacity is simdjson's padding when there is enough of it.
+    if (auto scene = detail::parseSceneFast(text, text.capacity(), path.string())) {
+        return std::move(*scene);
+    }
+    return parseSceneChecked(text, path.string(), path.parent_path());
+}
+
+Scene parseScene(std::string_view text, std::string_view sourceName,
+                 const std::filesystem::path& baseDir) {
+    if (auto scene = detail::parseSceneFast(text, text.size(), sourceName)) {
+        return std::move(*scene);
+    }
+    return parseSceneChecked(text, sourceName, baseDir);
 }
 
 namespace {

@@ -1,4 +1,4 @@
-// `hapto scene import` and `hapto scene info` with meshes, end to end: the scene written refers
+// `hapto scene import`, `info` and `convert`, end to end: the scene written refers
 // to the model relative to itself and places it as asked; info reports the triangles; bad
 // models and options exit 2 naming the place, and nothing is written.
 
@@ -122,4 +122,58 @@ TEST_CASE("scene import refuses bad models and options with exit code 2 and writ
     CHECK(r.exitCode == 2);
     CHECK_THAT(r.output, Catch::Contains("the model file"));
     CHECK(readFile(dir / "cube.obj") == kCubeObj);
+}
+
+TEST_CASE("scene convert turns JSON into binary and back, and every --scene reads the binary") {
+    TempDir dir;
+    REQUIRE(runHapto("scene random --count 300 --rotate -o " + q(dir / "a.json")).exitCode == 0);
+    auto r = runHapto("scene convert " + q(dir / "a.json") + " -o " + q(dir / "a.hsb"));
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(readFile(dir / "a.hsb").starts_with("HAPTOSCN"));
+    // --format overrides the name; the input is told apart by its magic.
+    r = runHapto("scene convert " + q(dir / "a.hsb") + " -o " + q(dir / "b.out") +
+                 " --format json");
+    REQUIRE(r.exitCode == 0);
+    CHECK(readFile(dir / "b.out") == readFile(dir / "a.json"));
+    CHECK(loadSceneFile(dir / "a.hsb") == loadSceneFile(dir / "a.json"));
+    r = runHapto("scene info --scene " + q(dir / "a.hsb"));
+    CHECK(r.exitCode == 0);
+    CHECK_THAT(r.output, Catch::Contains("objects:  300 (300 boxes, 300 of them rotated"));
+}
+
+TEST_CASE("scene convert refuses its input as output, a damaged input and a model it would "
+          "lose, writing nothing") {
+    TempDir dir;
+    REQUIRE(runHapto("scene random --count 20 -o " + q(dir / "a.json")).exitCode == 0);
+    REQUIRE(runHapto("scene convert " + q(dir / "a.json") + " -o " + q(dir / "a.hsb")).exitCode ==
+            0);
+    const std::string json = readFile(dir / "a.json");
+    const std::string binary = readFile(dir / "a.hsb");
+    auto r = runHapto("scene convert " + q(dir / "a.hsb") + " -o " + q(dir / "a.hsb"));
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("an input is never overwritten"));
+    CHECK(readFile(dir / "a.hsb") == binary);
+
+    writeFile(dir / "cut.hsb", binary.substr(0, binary.size() - 1));
+    writeFile(dir / "old.json", "an older file\n");
+    r = runHapto("scene convert " + q(dir / "cut.hsb") + " -o " + q(dir / "old.json"));
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("cut.hsb: byte 24: ") &&
+                             Catch::Contains("the file is truncated or damaged"));
+    CHECK(readFile(dir / "old.json") == "an older file\n");
+
+    // A model named relative to the scene cannot be referenced from another folder.
+    writeFile(dir / "cube.obj", kCubeObj);
+    REQUIRE(runHapto("scene import " + q(dir / "cube.obj") + " -o " + q(dir / "m.json")).exitCode ==
+            0);
+    std::filesystem::create_directories(dir / "elsewhere");
+    r = runHapto("scene convert " + q(dir / "m.json") + " -o " + q(dir / "elsewhere/m.hsb"));
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("names its model file 'cube.obj' relative to the "
+                                         "scene's folder"));
+    CHECK(!std::filesystem::exists(dir / "elsewhere/m.hsb"));
+    r = runHapto("scene convert " + q(dir / "m.json") + " -o " + q(dir / "m.hsb"));
+    CHECK(r.exitCode == 0);
+    CHECK(sceneToJson(loadSceneFile(dir / "m.hsb")) == sceneToJson(loadSceneFile(dir / "m.json")));
 }

@@ -1,8 +1,9 @@
-// `hapto scene grid|random|cluster|default|import|info|mesh`.
+// `hapto scene grid|random|cluster|default|import|info|mesh|convert`.
 
 #include "Commands.h"
 #include "Options.h"
 
+#include "hapto/scenes/BinaryScene.h"
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
 #include "hapto/scenes/MeshFile.h"
@@ -198,6 +199,81 @@ void importModel(const ImportOptions& o) {
               << (mesh->closed() ? "closed" : "open") << ") to " << o.out << "\n";
 }
 
+/// What `hapto scene convert` takes.
+struct ConvertOptions {
+    std::string in;
+    std::string out;
+    std::string format; // "json", "binary" or "" (from OUT's extension)
+};
+
+/// The output format: --format, else OUT's extension (.json, .hsb). [control]
+bool convertToBinary(const ConvertOptions& o) {
+    if (!o.format.empty()) {
+        return o.format == "binary";
+    }
+    const std::string ext = std::filesystem::path(o.out).extension().string();
+    if (ext == ".json" || o.out == "-") {
+        return false;
+    }
+    if (ext == ".hsb") {
+        return true;
+    }
+    throw InputError("scene convert: cannot tell the output format from -o " + o.out +
+                     " (expected a name ending in .json or .hsb); give --format json or "
+                     "--format binary");
+}
+
+/// Refuses a conversion that would break the scene's references to model files: they are
+/// named relative to the scene's folder and are not copied, so OUT must sit in IN's folder.
+void checkModelReferences(const Scene& scene, const ConvertOptions& o) {
+    namespace fs = std::filesystem;
+    const fs::path inDir = fs::absolute(o.in).parent_path();
+    const fs::path outDir =
+        o.out == "-" ? fs::current_path() : fs::absolute(fs::path(o.out)).parent_path();
+    std::error_code ec;
+    if (fs::equivalent(inDir, outDir, ec)) {
+        return;
+    }
+    for (const SceneObject& obj : scene.objects()) {
+        if (obj.shape == Shape::Mesh && !obj.mesh->source().file.empty() &&
+            fs::path(obj.mesh->source().file).is_relative()) {
+            throw InputError("scene convert: " + o.in + ": mesh " + std::to_string(obj.id) +
+                             " names its model file '" + obj.mesh->source().file +
+                             "' relative to the scene's folder, and model files are referenced, "
+                             "not copied: write " +
+                             o.out + " into " + inDir.string());
+        }
+    }
+}
+
+/// JSON to binary or binary to JSON (the input told apart by its magic). [control]
+void convertScene(const ConvertOptions& o) {
+    const bool binary = convertToBinary(o);
+    if (o.out != "-") {
+        checkOutputFile(o.out, "-o");
+        refuseSameFile(o.out, "-o", o.in, "the input scene");
+    }
+    const Scene scene = loadSceneFile(o.in);
+    checkModelReferences(scene, o);
+    if (o.out == "-") {
+        if (binary) {
+            writeBinaryScene(scene, std::cout);
+        } else {
+            std::cout << sceneToJson(scene);
+        }
+        return;
+    }
+    AtomicOutputFile file(o.out);
+    if (binary) {
+        writeBinaryScene(scene, file.stream());
+    } else {
+        file.stream() << sceneToJson(scene);
+    }
+    file.commit();
+    std::cerr << "wrote " << scene.size() << " objects to " << o.out << " ("
+              << (binary ? "binary" : "JSON") << ")\n";
+}
+
 } // namespace
 
 void addSceneCommands(CLI::App& app) {
@@ -355,6 +431,21 @@ void addSceneCommands(CLI::App& app) {
         cmd->add_option("-o,--output", opt->out, "Output scene file ('-' for standard output)")
             ->required();
         cmd->callback([opt] { importModel(*opt); });
+    }
+    // convert
+    {
+        auto* cmd = scene->add_subcommand(
+            "convert", "Convert a scene between JSON and the binary format (for large scenes; "
+                       "every --scene reads both)");
+        auto opt = std::make_shared<ConvertOptions>();
+        cmd->add_option("input", opt->in, "The scene to read (JSON or binary)")->required();
+        cmd->add_option("-o,--output", opt->out,
+                        "Output scene file: .json for JSON, .hsb for binary, or --format ('-' "
+                        "for standard output)")
+            ->required();
+        cmd->add_option("--format", opt->format, "json or binary (default: from -o's extension)")
+            ->check(CLI::IsMember({"json", "binary"}));
+        cmd->callback([opt] { convertScene(*opt); });
     }
     // info
     {

@@ -67,6 +67,8 @@ std::string describe(const Json& j);
 
 /// A finite number.
 double number(const Source& s, const Json& j, const Path& path);
+/// Checks an already read value is finite, with number()'s message; returns it.
+double finiteNumber(const Source& s, double v, const Path& path);
 /// A finite number with lo < v (strictLow) or lo <= v, and v <= hi; `what` names it.
 double ranged(const Source& s, const Json& j, const Path& path, double lo, double hi,
               bool strictLow, const char* what);
@@ -98,6 +100,9 @@ Vec3 vec3(const Source& s, const Json& j, const Path& path);
 /// A unit quaternion [w, x, y, z], within 1e-3 of unit length; normalised (a quaternion
 /// written from a normalised one reads back bit for bit).
 Quat quaternion(const Source& s, const Json& j, const Path& path);
+/// Checks already read finite components [w, x, y, z] the same way; returns the quaternion,
+/// normalised.
+Quat unitQuaternion(const Source& s, const std::array<double, 4>& q, const Path& path);
 
 /// Checks that `j` is an object.
 const Json& object(const Source& s, const Json& j, const Path& path);

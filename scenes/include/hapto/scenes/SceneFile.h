@@ -16,7 +16,8 @@ inline constexpr int kSceneFormatVersion = 2;
 /// builds before version 2 wrote.
 inline constexpr int kSceneFormatVersionWithoutMeshes = 1;
 
-/// Loads a scene file. Streams the objects, so 10^7 objects load in bounded extra memory.
+/// Loads a scene file, JSON or binary (BinaryScene.h; told apart by its magic, not its name).
+/// Streams the objects, so 10^7 objects load in bounded extra memory.
 /// Model files named by mesh objects are read relative to the scene file's folder (MeshFile.h).
 /// Throws InputError naming the file and the JSON path (e.g. `objects[12].half_extents[1]`) on
 /// any bad input, and for a bad model file the model file and its place too (`objects[3].file:
@@ -27,6 +28,12 @@ Scene loadSceneFile(const std::filesystem::path& path);
 /// relative to `baseDir` (the current folder when empty). Throws InputError. [control]
 Scene parseScene(std::string_view text, std::string_view sourceName,
                  const std::filesystem::path& baseDir = {});
+
+/// parseScene without its simdjson fast path: the checked (nlohmann) loader alone, which gives
+/// every refusal's message and reads mesh scenes. The same scenes and messages as parseScene;
+/// for the tests and the fuzzer that hold the two to that. [control]
+Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
+                        const std::filesystem::path& baseDir = {});
 
 /// Writes the scene as JSON, every field explicit; the same scene gives the same bytes. A scene
 /// without meshes is written as version 1, one with meshes as version 2: a mesh from a model file
