@@ -80,3 +80,38 @@ TEST_CASE("hapto demo grasp --object on a closed mesh lifts, carries and puts it
     CHECK(report["index_finds_it_at_start"] == false);
     CHECK(report["mass_kg"].get<double>() > 0);
 }
+
+TEST_CASE("hapto demo grasp --object on a generated torus lifts and carries it, lets it fall to "
+          "the floor, and the index finds it there",
+          "[realtime]") {
+    TempDir dir;
+    // A 6 cm torus, axis along y (lying flat), 2016 triangles, written beside its own scene.
+    const CommandResult made =
+        runHapto("scene mesh --shape torus --triangles 2000 --size 0.06 -o " +
+                 (dir / "torus.json").string());
+    REQUIRE(made.exitCode == 0);
+    // Held 1.75 cm above the floor (y = -0.1) where the cube's centre is.
+    writeFile(dir / "scene.json", graspScene(R"("file": "torus.ply")"));
+    const CommandResult r = runHapto("demo grasp --scene " + (dir / "scene.json").string() +
+                                     " --object 0 --report " + (dir / "report.json").string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(r.output.find("grasped 1 time(s)") != std::string::npos);
+    CHECK(r.output.find("the index finds it at its new place: yes, at its old place: no") !=
+          std::string::npos);
+    const nlohmann::json report = nlohmann::json::parse(readFile(dir / "report.json"));
+    const auto& start = report["start_position"];
+    const auto& end = report["end_position"];
+    double top = -1;
+    for (const auto& p : report["path"]) {
+        top = std::max(top, p["position"][1].get<double>());
+    }
+    CHECK(top == Approx(start[1].get<double>() + 0.05).margin(0.008));
+    CHECK(end[0].get<double>() == Approx(start[0].get<double>() + 0.10).margin(0.008));
+    // Released above the floor, it falls and rests on it: lower than it started, not below
+    // the floor.
+    CHECK(end[1].get<double>() < start[1].get<double>() - 0.01);
+    CHECK(end[1].get<double>() > -0.1);
+    CHECK(report["back_in_index"] == true);
+    CHECK(report["index_finds_it_at_end"] == true);
+}
