@@ -99,7 +99,12 @@ double WarmedSimDevice::warmUp(double settleS, double maxS) {
         }
     }
     auto local = std::make_shared<const Scene>(region, std::move(near));
-    const WorldSnapshot snapshot{1, local, buildIndex(*local, IndexSpec::octree(2, 0.005)), {}};
+    // A mesh that reaches into the region brings all its triangles, most of them outside the
+    // region's bounds (kept in the index's outside list, 4 B each); the build's memory estimate
+    // counts every item as if placed, so at 10^7 triangles it would pass the default 1 GB
+    // limit for an index that is in fact small. The limit here is the machine's, not a guard.
+    const WorldSnapshot snapshot{
+        1, local, buildIndex(*local, IndexSpec::octree(2, 0.005).withMaxMegabytes(1u << 20)), {}};
 
     const WorkspaceTransform& xf = mConfig.transform;
     const double dt = 1.0 / mConfig.rateHz;
