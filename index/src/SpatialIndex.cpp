@@ -141,11 +141,10 @@ std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec) {
         pairs += cells;
     }
     const std::uint64_t cellCount = n * n * n;
-    // Cell offsets and the per-cell counts of the stats; per item its id, shape and pair
-    // offset; per pair the (cell, item) sort key and the item.
+    // The counting sort (UniformGrid.cpp): cell offsets and the per-cell counters (which become
+    // the stats' counts); per item its id and shape; per pair the item.
     return (2 * cellCount + 1) * sizeof(std::uint32_t) +
-           count * (sizeof(std::uint32_t) + sizeof(OverlapShape) + sizeof(std::uint64_t)) +
-           pairs * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+           count * (sizeof(std::uint32_t) + sizeof(OverlapShape)) + pairs * sizeof(std::uint32_t);
 }
 
 std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec) {

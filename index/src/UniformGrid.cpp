@@ -7,6 +7,7 @@
 #include "hapto/scenes/InputError.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -94,56 +95,57 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z) {
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    const std::uint32_t id = g.cellId(x, y, z);
-                    if (overlaps(s, g.leafBounds(id), spec.mode)) {
-                        visit(id);
+                    const Aabb cell{{g.coord(x, 0), g.coord(y, 1), g.coord(z, 2)},
+                                    {g.coord(x + 1, 0), g.coord(y + 1, 1), g.coord(z + 1, 2)}};
+                    if (overlaps(s, cell, spec.mode)) {
+                        visit(g.cellId(x, y, z));
                     }
                 }
             }
         }
     };
 
-    // Count, then write (cell, k) pairs, sort them by cell, and cut them into runs.
-    std::vector<std::uint64_t> pairStart(std::size_t(count) + 1, 0);
+    // A counting sort by cell: count each cell's items, cut the item array into the cells'
+    // runs by a prefix sum, then place every item at its cells' next free position. Both passes
+    // run in parallel over items (relaxed atomic counters, as the order within a run does not
+    // matter yet); each run is then sorted, so it lists its items ascending on any number of
+    // threads. The counters become the stats' per-cell counts at the end.
+    const std::size_t cells = g.cellCount();
+    std::vector<std::uint32_t> fill(cells, 0);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
-        std::uint64_t c = 0;
-        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t) { ++c; });
-        pairStart[i + 1] = c;
+        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t cell) {
+            std::atomic_ref<std::uint32_t>(fill[cell]).fetch_add(1, std::memory_order_relaxed);
+        });
     });
-    for (std::size_t i = 0; i < count; ++i) {
-        pairStart[i + 1] += pairStart[i];
+    std::vector<std::uint32_t>& cellStart = grid->mCellStart;
+    cellStart.assign(cells + 1, 0);
+    std::uint64_t pairs = 0;
+    for (std::size_t c = 0; c < cells; ++c) {
+        pairs += fill[c];
+        if (pairs >= std::numeric_limits<std::uint32_t>::max()) {
+            throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
+                             " item-cell pairs or more do not fit 32-bit offsets; use fewer "
+                             "cells");
+        }
+        cellStart[c + 1] = static_cast<std::uint32_t>(pairs);
+        fill[c] = cellStart[c]; // from here on: the cell's next free position
     }
-    const std::uint64_t pairs = pairStart[count];
-    if (pairs >= std::numeric_limits<std::uint32_t>::max()) {
-        throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
-                         " item-cell pairs do not fit 32-bit offsets; use fewer cells");
-    }
-    std::vector<std::uint64_t> keys(pairs);
-    parallel::forEach(0, count, 256, [&](std::size_t i) {
-        std::uint64_t k = pairStart[i];
-        forEachCell(static_cast<std::uint32_t>(i),
-                    [&](std::uint32_t cell) { keys[k++] = (std::uint64_t(cell) << 32) | i; });
-    });
-    parallel::sort(keys.begin(), keys.end());
     grid->mItems.resize(pairs);
-    grid->mCellStart.assign(std::size_t(g.cellCount()) + 1, 0);
-    for (const std::uint64_t k : keys) {
-        ++grid->mCellStart[(k >> 32) + 1];
-    }
-    for (std::size_t c = 0; c < g.cellCount(); ++c) {
-        grid->mCellStart[c + 1] += grid->mCellStart[c];
-    }
-    parallel::forEach(0, pairs, 65536, [&](std::size_t i) {
-        grid->mItems[i] = items[static_cast<std::uint32_t>(keys[i])];
+    parallel::forEach(0, count, 256, [&](std::size_t i) {
+        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t cell) {
+            const std::uint32_t at =
+                std::atomic_ref<std::uint32_t>(fill[cell]).fetch_add(1, std::memory_order_relaxed);
+            grid->mItems[at] = items[i];
+        });
+    });
+    parallel::forEach(0, cells, 4096, [&](std::size_t c) {
+        std::sort(grid->mItems.begin() + cellStart[c], grid->mItems.begin() + cellStart[c + 1]);
+        fill[c] = cellStart[c + 1] - cellStart[c];
     });
 
     IndexStats& st = grid->mStats;
     st.nodes = g.cellCount();
-    std::vector<std::uint32_t> perCell(g.cellCount());
-    for (std::size_t c = 0; c < perCell.size(); ++c) {
-        perCell[c] = grid->mCellStart[c + 1] - grid->mCellStart[c];
-    }
-    st.recordLeaves(perCell);
+    st.recordLeaves(fill);
     st.bytes = (grid->mCellStart.size() + grid->mItems.size() + grid->outsideObjects().size()) *
                sizeof(std::uint32_t);
     st.bytesPerObject = count == 0 ? 0.0 : static_cast<double>(st.bytes) / count;
