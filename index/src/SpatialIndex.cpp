@@ -142,9 +142,10 @@ std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec) {
     }
     const std::uint64_t cellCount = n * n * n;
     // The counting sort (UniformGrid.cpp): cell offsets and the per-cell counters (which become
-    // the stats' counts); per item its id and shape; per pair the item.
-    return (2 * cellCount + 1) * sizeof(std::uint32_t) +
-           count * (sizeof(std::uint32_t) + sizeof(OverlapShape)) + pairs * sizeof(std::uint32_t);
+    // the stats' counts); per item its id, shape and pair offset; per pair its cell and item.
+    return (2 * cellCount + 1) * sizeof(std::uint32_t) + sizeof(std::uint64_t) +
+           count * (sizeof(std::uint32_t) + sizeof(OverlapShape) + sizeof(std::uint64_t)) +
+           pairs * 2 * sizeof(std::uint32_t);
 }
 
 std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec) {

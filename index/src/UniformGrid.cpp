@@ -105,43 +105,52 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         }
     };
 
-    // A counting sort by cell: count each cell's items, cut the item array into the cells'
-    // runs by a prefix sum, then place every item at its cells' next free position. Both passes
-    // run in parallel over items (relaxed atomic counters, as the order within a run does not
-    // matter yet); each run is then sorted, so it lists its items ascending on any number of
-    // threads. The counters become the stats' per-cell counts at the end.
+    // A counting sort by cell. In parallel over items: count each cell's items (relaxed atomic
+    // counters) and each item's cells; then list each item's cells at its own offset (plain
+    // sequential writes). Serially, in item order: place each item at its cells' next free
+    // positions, so every cell's run lists its items ascending on any number of threads (no
+    // locked instruction per pair: random stores that do not wait for each other). The
+    // counters become the stats' per-cell counts at the end.
     const std::size_t cells = g.cellCount();
     std::vector<std::uint32_t> fill(cells, 0);
+    std::vector<std::uint64_t> pairStart(std::size_t(count) + 1, 0);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
+        std::uint64_t n = 0;
         forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t cell) {
             std::atomic_ref<std::uint32_t>(fill[cell]).fetch_add(1, std::memory_order_relaxed);
+            ++n;
         });
+        pairStart[i + 1] = n;
     });
+    for (std::size_t i = 0; i < count; ++i) {
+        pairStart[i + 1] += pairStart[i];
+    }
+    const std::uint64_t pairs = pairStart[count];
+    if (pairs >= std::numeric_limits<std::uint32_t>::max()) {
+        throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
+                         " item-cell pairs do not fit 32-bit offsets; use fewer cells");
+    }
     std::vector<std::uint32_t>& cellStart = grid->mCellStart;
     cellStart.assign(cells + 1, 0);
-    std::uint64_t pairs = 0;
     for (std::size_t c = 0; c < cells; ++c) {
-        pairs += fill[c];
-        if (pairs >= std::numeric_limits<std::uint32_t>::max()) {
-            throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
-                             " item-cell pairs or more do not fit 32-bit offsets; use fewer "
-                             "cells");
-        }
-        cellStart[c + 1] = static_cast<std::uint32_t>(pairs);
+        cellStart[c + 1] = cellStart[c] + fill[c];
         fill[c] = cellStart[c]; // from here on: the cell's next free position
     }
-    grid->mItems.resize(pairs);
+    std::vector<std::uint32_t> pairCell(pairs);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
-        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t cell) {
-            const std::uint32_t at =
-                std::atomic_ref<std::uint32_t>(fill[cell]).fetch_add(1, std::memory_order_relaxed);
-            grid->mItems[at] = items[i];
-        });
+        std::uint64_t at = pairStart[i];
+        forEachCell(static_cast<std::uint32_t>(i),
+                    [&](std::uint32_t cell) { pairCell[at++] = cell; });
     });
-    parallel::forEach(0, cells, 4096, [&](std::size_t c) {
-        std::sort(grid->mItems.begin() + cellStart[c], grid->mItems.begin() + cellStart[c + 1]);
+    grid->mItems.resize(pairs);
+    for (std::size_t i = 0; i < count; ++i) {
+        for (std::uint64_t p = pairStart[i]; p < pairStart[i + 1]; ++p) {
+            grid->mItems[fill[pairCell[p]]++] = items[i];
+        }
+    }
+    for (std::size_t c = 0; c < cells; ++c) {
         fill[c] = cellStart[c + 1] - cellStart[c];
-    });
+    }
 
     IndexStats& st = grid->mStats;
     st.nodes = g.cellCount();

@@ -264,10 +264,11 @@ TEST_CASE("an index that would exceed its memory limit is refused before it is b
                       {makeBox(1, Vec3(0.0), Vec3(0.1)), makeBox(2, Vec3(0.0), Vec3(0.099)),
                        makeBox(3, Vec3(0.001), Vec3(0.098))});
     IndexSpec fine = IndexSpec::grid(256);
-    // 2 * 256^3 cell offsets and counters and nearly 3 * 256^3 pairs, 4 bytes each: 330 MB.
+    // 2 * 256^3 cell offsets and counters of 4 bytes and nearly 3 * 256^3 pairs of 8 bytes:
+    // about 530 MB.
     const std::uint64_t need = estimateIndexBytes(scene, fine);
-    CHECK(need >= 4ull * 256 * 256 * 256 * 4);
-    CHECK(need < 400ull << 20);
+    CHECK(need >= (2ull * 4 + 2 * 8) * 256 * 256 * 256);
+    CHECK(need < 600ull << 20);
     fine.maxBytes = 256ull << 20;
     CHECK_THROWS_AS(buildIndex(scene, fine), IndexTooLargeError);
     CHECK_THROWS_AS(buildIndex(scene, fine), InputError); // reported as bad input (exit 2)
