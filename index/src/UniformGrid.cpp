@@ -7,7 +7,6 @@
 #include "hapto/scenes/InputError.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -105,21 +104,18 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         }
     };
 
-    // A counting sort by cell. In parallel over items: count each cell's items (relaxed atomic
-    // counters) and each item's cells; then list each item's cells at its own offset (plain
-    // sequential writes). Serially, in item order: place each item at its cells' next free
-    // positions, so every cell's run lists its items ascending on any number of threads (no
-    // locked instruction per pair: random stores that do not wait for each other). The
-    // counters become the stats' per-cell counts at the end.
+    // A counting sort by cell. In parallel over items: count each item's cells, then list them
+    // at the item's own offset (plain sequential writes). Serially: count each cell's items
+    // from those lists, and, in item order, place each item at its cells' next free positions,
+    // so every cell's run lists its items ascending on any number of threads (no locked
+    // instruction per pair: the random stores do not wait for each other). The counters become
+    // the stats' per-cell counts at the end.
     const std::size_t cells = g.cellCount();
     std::vector<std::uint32_t> fill(cells, 0);
     std::vector<std::uint64_t> pairStart(std::size_t(count) + 1, 0);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
         std::uint64_t n = 0;
-        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t cell) {
-            std::atomic_ref<std::uint32_t>(fill[cell]).fetch_add(1, std::memory_order_relaxed);
-            ++n;
-        });
+        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t) { ++n; });
         pairStart[i + 1] = n;
     });
     for (std::size_t i = 0; i < count; ++i) {
@@ -130,18 +126,21 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
                          " item-cell pairs do not fit 32-bit offsets; use fewer cells");
     }
-    std::vector<std::uint32_t>& cellStart = grid->mCellStart;
-    cellStart.assign(cells + 1, 0);
-    for (std::size_t c = 0; c < cells; ++c) {
-        cellStart[c + 1] = cellStart[c] + fill[c];
-        fill[c] = cellStart[c]; // from here on: the cell's next free position
-    }
     std::vector<std::uint32_t> pairCell(pairs);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
         std::uint64_t at = pairStart[i];
         forEachCell(static_cast<std::uint32_t>(i),
                     [&](std::uint32_t cell) { pairCell[at++] = cell; });
     });
+    for (const std::uint32_t cell : pairCell) {
+        ++fill[cell];
+    }
+    std::vector<std::uint32_t>& cellStart = grid->mCellStart;
+    cellStart.assign(cells + 1, 0);
+    for (std::size_t c = 0; c < cells; ++c) {
+        cellStart[c + 1] = cellStart[c] + fill[c];
+        fill[c] = cellStart[c]; // from here on: the cell's next free position
+    }
     grid->mItems.resize(pairs);
     for (std::size_t i = 0; i < count; ++i) {
         for (std::uint64_t p = pairStart[i]; p < pairStart[i + 1]; ++p) {
