@@ -18,8 +18,10 @@
 // levels is the same double in both, and "which leaf holds p" has one answer everywhere:
 // the half-open cell [lo, hi) that holds p, closed on the bounds' upper faces.
 // Cost: build O(sum over levels of the objects listed at that level), each with up to 8
-// overlap tests (an AABB reject, then the SAT); memory 56 bytes per node + 4 bytes per
-// object-leaf pair. Query: O(depth) from the root; O(1) + descent with links (see Cursor.h).
+// overlap tests (an AABB reject, then the SAT; an axis-aligned box stops at the AABB test);
+// memory 48 bytes per node + 4 bytes per eight siblings (their parent) + 4 bytes per
+// object-leaf pair, every array sized exactly. Query: O(depth) from the root; O(1) + descent with
+// links (see Cursor.h).
 
 #include "hapto/index/Octree.h"
 
@@ -65,20 +67,23 @@ bool Octree::canSplit(int level) const noexcept {
 Aabb Octree::nodeBounds(std::uint32_t node) const noexcept {
     const OctreeNode& n = mNodes[node];
     Aabb b;
+    const int l = n.level();
     for (int a = 0; a < 3; ++a) {
-        b.min[a] = coord(n.level, n.cell[a], a);
-        b.max[a] = coord(n.level, n.cell[a] + 1, a);
+        b.min[a] = coord(l, n.cell(a), a);
+        b.max[a] = coord(l, n.cell(a) + 1, a);
     }
     return b;
 }
 
 bool Octree::holds(std::uint32_t node, const Vec3& p) const noexcept {
     const OctreeNode& n = mNodes[node];
-    const std::uint32_t top = 1u << n.level;
+    const int l = n.level();
+    const std::uint32_t top = 1u << l;
     for (int a = 0; a < 3; ++a) {
-        const double lo = coord(n.level, n.cell[a], a);
-        const double hi = coord(n.level, n.cell[a] + 1, a);
-        if (!(p[a] >= lo && (p[a] < hi || (n.cell[a] + 1 == top && p[a] <= hi)))) {
+        const std::uint32_t c = n.cell(a);
+        const double lo = coord(l, c, a);
+        const double hi = coord(l, c + 1, a);
+        if (!(p[a] >= lo && (p[a] < hi || (c + 1 == top && p[a] <= hi)))) {
             return false;
         }
     }
@@ -106,10 +111,10 @@ LocateResult Octree::descend(std::uint32_t node, const Vec3& p,
                              std::uint32_t steps) const noexcept {
     const OctreeNode* n = &mNodes[node];
     while (!n->isLeaf()) {
-        const int l = n->level + 1;
+        const int l = n->level() + 1;
         std::uint32_t octant = 0;
         for (int a = 0; a < 3; ++a) {
-            octant |= std::uint32_t(p[a] >= coord(l, 2 * n->cell[a] + 1, a)) << a;
+            octant |= std::uint32_t(p[a] >= coord(l, 2 * n->cell(a) + 1, a)) << a;
         }
         node = n->firstChild + octant;
         n = &mNodes[node];
@@ -128,7 +133,7 @@ LocateResult Octree::locate(const Vec3& p) const noexcept {
 LocateResult Octree::climb(std::uint32_t leaf, const Vec3& p) const noexcept {
     std::uint32_t node = leaf, steps = 0;
     while (!holds(node, p)) {
-        node = mNodes[node].parent;
+        node = parent(node);
         ++steps;
         if (node == kNoNode) { // cannot happen for a point in the bounds; stay safe
             return descend(0, p, steps);
@@ -142,10 +147,10 @@ LocateResult Octree::followLinks(std::uint32_t leaf, const Vec3& p) const noexce
     // the point must lie in the 3x3x3 block of leaf-sized cells around the leaf, and a corner
     // crossing (3 axes) needs the common ancestor to be 2+ levels up.
     const OctreeNode& from = mNodes[leaf];
-    const int level = from.level;
+    const int level = from.level();
     std::uint32_t axesCrossed = 0, differ = 0;
     for (int a = 0; a < 3; ++a) {
-        const std::uint32_t q = cellIndex(level, p[a], a), c = from.cell[a];
+        const std::uint32_t q = cellIndex(level, p[a], a), c = from.cell(a);
         if (q + 1 < c || q > c + 1) {
             return climb(leaf, p);
         }
@@ -159,9 +164,10 @@ LocateResult Octree::followLinks(std::uint32_t leaf, const Vec3& p) const noexce
     std::uint32_t node = leaf, steps = 0;
     for (int a = 0; a < 3; ++a) {
         const OctreeNode& n = mNodes[node];
-        const double lo = coord(n.level, n.cell[a], a);
-        const double hi = coord(n.level, n.cell[a] + 1, a);
-        const bool top = n.cell[a] + 1 == (1u << n.level);
+        const int l = n.level();
+        const double lo = coord(l, n.cell(a), a);
+        const double hi = coord(l, n.cell(a) + 1, a);
+        const bool top = n.cell(a) + 1 == (1u << l);
         if (p[a] < lo) {
             node = n.neighbours[2 * a];
         } else if (!(p[a] < hi || (top && p[a] <= hi))) {
@@ -207,16 +213,19 @@ std::unique_ptr<Octree> Octree::build(const Scene& scene, const IndexSpec& spec)
     IndexStats& st = tree->mStats;
     st.nodes = tree->mNodes.size();
     std::vector<std::uint32_t> perLeaf;
-    for (const OctreeNode& n : tree->mNodes) {
+    for (std::uint32_t i = 0; i < tree->mNodes.size(); ++i) {
+        const OctreeNode& n = tree->mNodes[i];
         if (n.isLeaf()) {
             perLeaf.push_back(n.slotCount);
-            st.depth = std::max<std::uint32_t>(st.depth, n.level);
-            st.leavesAtMinimumSize += n.atMinimumSize;
+            st.depth = std::max<std::uint32_t>(st.depth, static_cast<std::uint32_t>(n.level()));
+            st.leavesAtMinimumSize += tree->atMinimumSize(i);
         }
     }
     st.recordLeaves(perLeaf);
-    st.bytes = tree->mNodes.size() * sizeof(OctreeNode) +
-               (tree->mSlots.size() + tree->outsideObjects().size()) * sizeof(std::uint32_t);
+    st.bytes =
+        tree->mNodes.capacity() * sizeof(OctreeNode) +
+        (tree->mGroupParent.capacity() + tree->mSlots.capacity() + tree->outsideObjects().size()) *
+            sizeof(std::uint32_t);
     st.bytesPerObject = items.empty() ? 0.0 : static_cast<double>(st.bytes) / items.size();
     timer.finish(st);
     return tree;
@@ -272,7 +281,7 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
     std::vector<std::uint64_t> nextStart;
     std::uint64_t levelBegin = 0, levelEnd = 1;
     while (levelBegin < levelEnd) {
-        const int level = mNodes[levelBegin].level;
+        const int level = mNodes[levelBegin].level();
         const bool splittable = canSplit(level);
         const std::size_t width = levelEnd - levelBegin;
         std::vector<std::array<std::uint32_t, 8>> childCount(width);
@@ -291,7 +300,7 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
             for (std::uint32_t o = 0; o < 8; ++o) {
                 Aabb box;
                 for (int a = 0; a < 3; ++a) {
-                    const std::uint32_t c = 2 * n.cell[a] + ((o >> a) & 1);
+                    const std::uint32_t c = 2 * n.cell(a) + ((o >> a) & 1);
                     box.min[a] = coord(level + 1, c, a);
                     box.max[a] = coord(level + 1, c + 1, a);
                 }
@@ -300,7 +309,7 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
             const OverlapCell whole = OverlapCell::of(nodeBounds(levelBegin + k));
             Vec3 mid(0.0);
             for (int a = 0; a < 3; ++a) {
-                mid[a] = coord(level + 1, 2 * n.cell[a] + 1, a);
+                mid[a] = coord(level + 1, 2 * n.cell(a) + 1, a);
             }
             const auto classify = [&](std::size_t lo, std::size_t hi) {
                 for (std::size_t i = lo; i < hi; ++i) {
@@ -351,7 +360,7 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
         const std::uint64_t perObject =
             std::uint64_t(count) * (sizeof(std::uint32_t) + sizeof(OverlapShape));
         const auto memory = [&](std::uint64_t nodes, std::uint64_t slots, std::uint64_t next) {
-            return nodes * sizeof(OctreeNode) + (slots + next) * sizeof(std::uint32_t) +
+            return nodes * sizeof(OctreeNode) + (nodes / 8 + slots + next) * sizeof(std::uint32_t) +
                    entries.size() * (sizeof(std::uint32_t) + 1) + perObject;
         };
         const auto checkMemory = [&](std::uint64_t bytes) {
@@ -371,6 +380,10 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
                              "size); raise MIN or M");
         }
         const std::uint64_t slotBase = mSlots.size();
+        // Arrays sized exactly: each level reserves what it adds, so no capacity is left over
+        // (a reallocation per level copies the nodes so far: a geometric sum, cheap).
+        mNodes.reserve(mNodes.size() + 8 * splitCount);
+        mGroupParent.reserve(mGroupParent.size() + splitCount);
         std::vector<std::uint64_t> leafAt(width, 0);
         std::uint64_t leafTotal = 0, nextTotal = 0;
         nextStart.assign(1, 0);
@@ -380,7 +393,6 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
                 OctreeNode& n = mNodes[id];
                 n.firstSlot = static_cast<std::uint32_t>(slotBase + leafTotal);
                 n.slotCount = static_cast<std::uint32_t>(start[k + 1] - start[k]);
-                n.atMinimumSize = !splittable;
                 leafAt[k] = slotBase + leafTotal;
                 leafTotal += n.slotCount;
                 continue;
@@ -388,13 +400,11 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
             const std::uint32_t first = static_cast<std::uint32_t>(mNodes.size());
             mNodes[id].firstChild = first;
             const OctreeNode parent = mNodes[id];
+            mGroupParent.push_back(id);
             for (std::uint32_t o = 0; o < 8; ++o) {
                 OctreeNode c;
-                c.parent = id;
-                c.level = static_cast<std::uint8_t>(level + 1);
-                for (int a = 0; a < 3; ++a) {
-                    c.cell[a] = 2 * parent.cell[a] + ((o >> a) & 1);
-                }
+                c.setCell(level + 1, 2 * parent.cell(0) + (o & 1),
+                          2 * parent.cell(1) + ((o >> 1) & 1), 2 * parent.cell(2) + ((o >> 2) & 1));
                 mNodes.push_back(c);
                 nextTotal += childCount[k][o];
                 nextStart.push_back(nextTotal);
@@ -406,6 +416,7 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
                              ": more than 2^32 object-leaf pairs; raise MIN or M");
         }
         checkMemory(memory(mNodes.size(), slotBase + leafTotal, nextTotal));
+        mSlots.reserve(slotBase + leafTotal);
         mSlots.resize(slotBase + leafTotal);
         next.resize(nextTotal);
 
@@ -447,7 +458,7 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
         const std::uint64_t newBegin = levelEnd, newEnd = mNodes.size();
         parallel::forEach(newBegin, newEnd, 1024, [&](std::size_t j) {
             OctreeNode& c = mNodes[j];
-            const OctreeNode& parent = mNodes[c.parent];
+            const OctreeNode& parent = mNodes[mGroupParent[(j - 1) / 8]];
             const std::uint32_t o = static_cast<std::uint32_t>(j - parent.firstChild);
             for (int a = 0; a < 3; ++a) {
                 const std::uint32_t bit = 1u << a;

@@ -14,6 +14,11 @@ OverlapShape OverlapShape::of(const SceneObject& object) {
     s.radius = sphere ? object.halfExtents.x : 0.0;
     s.scale = maxAbsComponent(object.center) +
               std::max({object.halfExtents.x, object.halfExtents.y, object.halfExtents.z});
+    s.axisAligned = !sphere;
+    for (int i = 0; i < 3; ++i) { // each axis one of +-x, +-y, +-z, exactly
+        const Vec3 m = glm::abs(s.obb.axes[i]);
+        s.axisAligned = s.axisAligned && m.x + m.y + m.z == 1.0 && std::max({m.x, m.y, m.z}) == 1.0;
+    }
     return s;
 }
 
@@ -64,7 +69,7 @@ bool overlaps(const OverlapShape& shape, const OverlapCell& prepared, OverlapMod
           a.min.z <= cell.max.z + tol && a.max.z + tol >= cell.min.z)) {
         return false;
     }
-    if (mode == OverlapMode::Aabb) {
+    if (mode == OverlapMode::Aabb || shape.axisAligned) {
         return true;
     }
     // The centre (a triangle: its centroid) in the cell, or the AABB inside it: an overlap for

@@ -94,21 +94,29 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z) {
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    const std::uint32_t id = g.cellId(x, y, z);
-                    if (overlaps(s, g.leafBounds(id), spec.mode)) {
-                        visit(id);
+                    const Aabb cell{{g.coord(x, 0), g.coord(y, 1), g.coord(z, 2)},
+                                    {g.coord(x + 1, 0), g.coord(y + 1, 1), g.coord(z + 1, 2)}};
+                    if (overlaps(s, cell, spec.mode)) {
+                        visit(g.cellId(x, y, z));
                     }
                 }
             }
         }
     };
 
-    // Count, then write (cell, k) pairs, sort them by cell, and cut them into runs.
+    // A counting sort by cell. In parallel over items: count each item's cells, then list them
+    // at the item's own offset (plain sequential writes). Serially: count each cell's items
+    // from those lists, and, in item order, place each item at its cells' next free positions,
+    // so every cell's run lists its items ascending on any number of threads (no locked
+    // instruction per pair: the random stores do not wait for each other). The counters become
+    // the stats' per-cell counts at the end.
+    const std::size_t cells = g.cellCount();
+    std::vector<std::uint32_t> fill(cells, 0);
     std::vector<std::uint64_t> pairStart(std::size_t(count) + 1, 0);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
-        std::uint64_t c = 0;
-        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t) { ++c; });
-        pairStart[i + 1] = c;
+        std::uint64_t n = 0;
+        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t) { ++n; });
+        pairStart[i + 1] = n;
     });
     for (std::size_t i = 0; i < count; ++i) {
         pairStart[i + 1] += pairStart[i];
@@ -118,32 +126,34 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
                          " item-cell pairs do not fit 32-bit offsets; use fewer cells");
     }
-    std::vector<std::uint64_t> keys(pairs);
+    std::vector<std::uint32_t> pairCell(pairs);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
-        std::uint64_t k = pairStart[i];
+        std::uint64_t at = pairStart[i];
         forEachCell(static_cast<std::uint32_t>(i),
-                    [&](std::uint32_t cell) { keys[k++] = (std::uint64_t(cell) << 32) | i; });
+                    [&](std::uint32_t cell) { pairCell[at++] = cell; });
     });
-    parallel::sort(keys.begin(), keys.end());
+    for (const std::uint32_t cell : pairCell) {
+        ++fill[cell];
+    }
+    std::vector<std::uint32_t>& cellStart = grid->mCellStart;
+    cellStart.assign(cells + 1, 0);
+    for (std::size_t c = 0; c < cells; ++c) {
+        cellStart[c + 1] = cellStart[c] + fill[c];
+        fill[c] = cellStart[c]; // from here on: the cell's next free position
+    }
     grid->mItems.resize(pairs);
-    grid->mCellStart.assign(std::size_t(g.cellCount()) + 1, 0);
-    for (const std::uint64_t k : keys) {
-        ++grid->mCellStart[(k >> 32) + 1];
+    for (std::size_t i = 0; i < count; ++i) {
+        for (std::uint64_t p = pairStart[i]; p < pairStart[i + 1]; ++p) {
+            grid->mItems[fill[pairCell[p]]++] = items[i];
+        }
     }
-    for (std::size_t c = 0; c < g.cellCount(); ++c) {
-        grid->mCellStart[c + 1] += grid->mCellStart[c];
+    for (std::size_t c = 0; c < cells; ++c) {
+        fill[c] = cellStart[c + 1] - cellStart[c];
     }
-    parallel::forEach(0, pairs, 65536, [&](std::size_t i) {
-        grid->mItems[i] = items[static_cast<std::uint32_t>(keys[i])];
-    });
 
     IndexStats& st = grid->mStats;
     st.nodes = g.cellCount();
-    std::vector<std::uint32_t> perCell(g.cellCount());
-    for (std::size_t c = 0; c < perCell.size(); ++c) {
-        perCell[c] = grid->mCellStart[c + 1] - grid->mCellStart[c];
-    }
-    st.recordLeaves(perCell);
+    st.recordLeaves(fill);
     st.bytes = (grid->mCellStart.size() + grid->mItems.size() + grid->outsideObjects().size()) *
                sizeof(std::uint32_t);
     st.bytesPerObject = count == 0 ? 0.0 : static_cast<double>(st.bytes) / count;

@@ -117,7 +117,7 @@ TEST_CASE("cursor: unbound, outside and back, reset to another index, FromRoot s
     for (const Vec3& p : queryPoints(scene, 4, 200)) {
         const LocateResult r = fromRoot.locate(p);
         if (!r.outside) {
-            CHECK(r.steps == tree->nodes()[r.leaf].level);
+            CHECK(r.steps == static_cast<std::uint32_t>(tree->nodes()[r.leaf].level()));
         }
     }
     // The upper faces of the bounds are inside (closed), one ulp beyond is not.

@@ -19,8 +19,8 @@ std::uint32_t expectedNode(const Octree& tree, int level, std::array<std::int64_
         }
     }
     std::uint32_t node = 0;
-    while (tree.nodes()[node].level < level && !tree.nodes()[node].isLeaf()) {
-        const int shift = level - tree.nodes()[node].level - 1;
+    while (tree.nodes()[node].level() < level && !tree.nodes()[node].isLeaf()) {
+        const int shift = level - tree.nodes()[node].level() - 1;
         std::uint32_t octant = 0;
         for (int a = 0; a < 3; ++a) {
             octant |= std::uint32_t((c[a] >> shift) & 1) << a;
@@ -41,13 +41,13 @@ TEST_CASE("neighbour links name the equal-size neighbour, else the smallest larg
             for (std::uint32_t i = 0; i < tree->nodes().size(); ++i) {
                 const OctreeNode& n = tree->nodes()[i];
                 for (int face = 0; face < 6; ++face) {
-                    std::array<std::int64_t, 3> c{n.cell[0], n.cell[1], n.cell[2]};
+                    std::array<std::int64_t, 3> c{n.cell(0), n.cell(1), n.cell(2)};
                     c[face / 2] += (face % 2) ? 1 : -1;
-                    const std::uint32_t want = expectedNode(*tree, n.level, c);
+                    const std::uint32_t want = expectedNode(*tree, n.level(), c);
                     const std::uint32_t got = tree->neighbour(i, static_cast<Face>(face));
                     wrong += got != want;
                     outside += want == kNoNode;
-                    larger += want != kNoNode && tree->nodes()[want].level < n.level;
+                    larger += want != kNoNode && tree->nodes()[want].level() < n.level();
                     if (got != kNoNode) {
                         // It covers the face: shares the plane, and spans the face.
                         const Aabb a = tree->nodeBounds(i), b = tree->nodeBounds(got);
@@ -70,15 +70,21 @@ TEST_CASE("octree layout: breadth first, siblings together, leaves one contiguou
     const Scene scene = makeDegenerateScene();
     const auto tree = Octree::build(scene, IndexSpec::octree(2, 0.002));
     const auto nodes = tree->nodes();
-    REQUIRE(nodes[0].parent == kNoNode);
+    REQUIRE(tree->parent(0) == kNoNode);
     std::vector<std::pair<std::uint32_t, std::uint32_t>> runs;
     for (std::uint32_t i = 0; i < nodes.size(); ++i) {
         const OctreeNode& n = nodes[i];
         if (i > 0) {
-            CHECK(nodes[i - 1].level <= n.level);
-            CHECK(nodes[n.parent].firstChild <= i);
-            CHECK(i < nodes[n.parent].firstChild + 8);
-            CHECK(n.level == nodes[n.parent].level + 1);
+            const std::uint32_t parent = tree->parent(i);
+            REQUIRE(parent < i);
+            CHECK(nodes[i - 1].level() <= n.level());
+            CHECK(nodes[parent].firstChild <= i);
+            CHECK(i < nodes[parent].firstChild + 8);
+            CHECK(n.level() == nodes[parent].level() + 1);
+            for (int a = 0; a < 3; ++a) { // the cell is the parent's octant i - firstChild
+                CHECK(n.cell(a) ==
+                      2 * nodes[parent].cell(a) + (((i - nodes[parent].firstChild) >> a) & 1));
+            }
         }
         if (n.isLeaf()) {
             runs.emplace_back(n.firstSlot, n.slotCount);
@@ -88,7 +94,7 @@ TEST_CASE("octree layout: breadth first, siblings together, leaves one contiguou
         } else {
             CHECK(n.slotCount == 0);
             for (std::uint32_t o = 0; o < 8; ++o) {
-                CHECK(nodes[n.firstChild + o].parent == i);
+                CHECK(tree->parent(n.firstChild + o) == i);
             }
         }
     }
@@ -104,6 +110,13 @@ TEST_CASE("octree layout: breadth first, siblings together, leaves one contiguou
     CHECK(std::equal(tree->slots().begin(), tree->slots().end(), again->slots().begin(),
                      again->slots().end()));
     CHECK(tree->nodes().size() == again->nodes().size());
+    // Every array is sized exactly: the heap bytes the stats count (capacities) are what the
+    // nodes, one parent per eight siblings, the slots and the outside list need.
+    const std::uint64_t exact =
+        nodes.size() * sizeof(OctreeNode) +
+        ((nodes.size() - 1) / 8 + tree->slots().size() + tree->outsideObjects().size()) *
+            sizeof(std::uint32_t);
+    CHECK(tree->stats().bytes == exact);
 }
 
 TEST_CASE("the paper's set-ups: octree leaves stay small on lattice and random scenes") {

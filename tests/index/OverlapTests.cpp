@@ -147,3 +147,55 @@ TEST_CASE("SAT never misses an overlap that sampled points prove (random boxes)"
     CHECK(overlapping > 100);
     CHECK(separated > 300);
 }
+
+TEST_CASE("an axis-aligned box stops at its AABB test, with the full test's answer") {
+    const auto shapeOf = [](const Quat& r, const Vec3& c, const Vec3& h) {
+        SceneObject o;
+        o.shape = Shape::Box;
+        o.center = c;
+        o.halfExtents = h;
+        o.rotation = r;
+        return OverlapShape::of(o);
+    };
+    CHECK(shapeOf(Quat(1, 0, 0, 0), Vec3(0.1), Vec3(0.01)).axisAligned);
+    CHECK(shapeOf(Quat(0, 1, 0, 0), Vec3(0.1), Vec3(0.01)).axisAligned); // half turn about x
+    CHECK_FALSE(shapeOf(glm::angleAxis(0.3, Vec3(0, 0, 1)), Vec3(0.1), Vec3(0.01)).axisAligned);
+    SceneObject ball;
+    ball.shape = Shape::Sphere;
+    ball.halfExtents = Vec3(0.01);
+    CHECK_FALSE(OverlapShape::of(ball).axisAligned);
+
+    // Random boxes against cells of a 1/16 lattice, placed to touch, nearly touch (within and
+    // beyond the tolerance) and overlap: the short path agrees with the 15-axis test.
+    Random rng(17);
+    const double step = 1.0 / 16;
+    std::size_t disagree = 0, overlapping = 0, apart = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 h(rng.uniform(0.0, 0.05), rng.uniform(0.0, 0.05), rng.uniform(0.0, 0.05));
+        Vec3 c(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5));
+        const int a = i % 3;
+        const double face = std::round(c[a] / step) * step;
+        const double offsets[] = {0.0, 1e-12, -1e-12, 1e-9, 1e-6, rng.uniform(-0.01, 0.01)};
+        c[a] = face + h[a] + offsets[i % 6]; // the box's lower face on a cell face, or near it
+        const OverlapShape fast =
+            shapeOf(i % 2 ? Quat(1, 0, 0, 0) : Quat(0, 0, 1, 0), c, h); // identity, half turn
+        REQUIRE(fast.axisAligned);
+        OverlapShape full = fast;
+        full.axisAligned = false;
+        for (int dx = -1; dx <= 1; ++dx) {
+            Vec3 lo = glm::floor(c / step) * step;
+            lo[a] = face - step;
+            lo[(a + 1) % 3] += dx * step;
+            const Aabb cell{lo, lo + Vec3(step)};
+            for (const OverlapMode mode : {OverlapMode::Obb, OverlapMode::Aabb}) {
+                const bool got = overlaps(fast, cell, mode);
+                disagree += got != overlaps(full, cell, mode);
+                overlapping += got;
+                apart += !got;
+            }
+        }
+    }
+    CHECK(disagree == 0);
+    CHECK(overlapping > 1000);
+    CHECK(apart > 1000);
+}

@@ -17,10 +17,12 @@ inline constexpr std::uint32_t kNoNode = 0xFFFFFFFFu;
 /// The six faces of a node, in link order: face = 2 * axis + (positive ? 1 : 0).
 enum class Face : std::uint8_t { NegX, PosX, NegY, PosY, NegZ, PosZ };
 
-/// One octree node (56 bytes). Its cell is given by level and integer coordinates: along each
+/// One octree node (48 bytes). Its cell is given by level and integer coordinates: along each
 /// axis it spans [min + c * step(level), min + (c + 1) * step(level)], step = size / 2^level.
+/// What can be derived is not stored: the parent (one entry per eight siblings,
+/// Octree::parent) and whether a leaf reached the minimum size (Octree::atMinimumSize); the
+/// level shares a word with the x coordinate.
 struct OctreeNode {
-    std::uint32_t parent = kNoNode;     ///< Parent node, kNoNode for the root.
     std::uint32_t firstChild = kNoNode; ///< Children firstChild + octant (bit a: upper half
                                         ///< on axis a); kNoNode for a leaf.
     /// Per face: the adjacent node of equal size, else the smallest larger node covering the
@@ -28,15 +30,22 @@ struct OctreeNode {
     std::array<std::uint32_t, 6> neighbours{kNoNode, kNoNode, kNoNode, kNoNode, kNoNode, kNoNode};
     std::uint32_t firstSlot = 0; ///< Leaf: its items are slots()[firstSlot, +slotCount).
     std::uint32_t slotCount = 0; ///< Leaf: number of items.
-    std::array<std::uint32_t, 3> cell{0, 0, 0}; ///< Integer coordinates at this level.
-    std::uint8_t level = 0;                     ///< Root 0.
-    std::uint8_t atMinimumSize = 0; ///< 1 when halving it would go below the minimum size.
-    std::uint8_t padding[2] = {0, 0};
+    /// Bits 0-19 of word a: the integer coordinate on axis a (< 2^20, the deepest level's
+    /// count); bits 24-31 of word 0: the level.
+    std::array<std::uint32_t, 3> packedCell{0, 0, 0};
 
     /// True for a leaf. [any thread]
     bool isLeaf() const noexcept { return firstChild == kNoNode; }
+    /// The level, root 0. [any thread]
+    int level() const noexcept { return static_cast<int>(packedCell[0] >> 24); }
+    /// The integer coordinate on an axis at this level. [any thread]
+    std::uint32_t cell(int axis) const noexcept { return packedCell[axis] & 0xFFFFFu; }
+    /// Sets level and coordinates (each below 2^20). [control]
+    void setCell(int level, std::uint32_t x, std::uint32_t y, std::uint32_t z) noexcept {
+        packedCell = {x | (static_cast<std::uint32_t>(level) << 24), y, z};
+    }
 };
-static_assert(sizeof(OctreeNode) == 56, "octree nodes are 56 bytes; update the note if not");
+static_assert(sizeof(OctreeNode) == 48, "octree nodes are 48 bytes; update the note if not");
 
 /// A leaf holds at most M items unless it reached the minimum size; each item (a box, a sphere
 /// or a mesh triangle) is listed in every leaf its bounds overlap. Nodes are stored breadth first,
@@ -45,6 +54,7 @@ class Octree final : public SpatialIndex {
 public:
     /// Deepest level a node may have (cells of size / 2^20).
     static constexpr int kMaxDepth = 20;
+    static_assert(kMaxDepth <= 20, "OctreeNode packs coordinates in 20 bits");
     /// Most nodes a build may create (then it throws InputError: raise MIN or M).
     static constexpr std::uint32_t kMaxNodes = 1u << 26;
 
@@ -67,6 +77,14 @@ public:
     std::span<const OctreeNode> nodes() const noexcept { return mNodes; }
     /// Every leaf's items, each leaf one contiguous run. [any thread]
     std::span<const std::uint32_t> slots() const noexcept { return mSlots; }
+    /// A node's parent, kNoNode for the root (stored once per eight siblings). [servo]
+    std::uint32_t parent(std::uint32_t node) const noexcept {
+        return node == 0 ? kNoNode : mGroupParent[(node - 1) / 8];
+    }
+    /// True for a leaf that halving would make smaller than the minimum leaf size. [any thread]
+    bool atMinimumSize(std::uint32_t node) const noexcept {
+        return mNodes[node].isLeaf() && !canSplit(mNodes[node].level());
+    }
     /// The neighbour of a node across a face, or kNoNode. [servo]
     std::uint32_t neighbour(std::uint32_t node, Face face) const noexcept {
         return mNodes[node].neighbours[static_cast<int>(face)];
@@ -89,6 +107,7 @@ private:
 
     std::array<Vec3, kMaxDepth + 2> mStep{}; // cell size per level (m)
     std::vector<OctreeNode> mNodes;
+    std::vector<std::uint32_t> mGroupParent; // per eight siblings (nodes 1 + 8g ...): parent
     std::vector<std::uint32_t> mSlots;
 };
 

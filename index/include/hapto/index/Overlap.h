@@ -34,6 +34,9 @@ struct OverlapShape {
     double scale = 0.0;    ///< Box, sphere: largest |centre| coordinate plus largest half
                            ///< extent; triangle: aabbScale of its AABB (m).
     Kind kind = Kind::Box; ///< Which member of the union holds the bounds.
+    /// Box: its axes are signed unit axes exactly (no rotation, or a quarter turn whose matrix
+    /// came out exact), so its AABB is the box itself and the AABB test is its whole test.
+    bool axisAligned = false;
 
     /// Prepares a box's or sphere's bounds (not a mesh's: its triangles are the items).
     /// [any thread]
@@ -67,7 +70,10 @@ struct OverlapCell {
 /// Whether an item's bounds overlap a cell. Aabb mode: its world AABB. Obb mode: its AABB
 /// and then its OBB (boxes), exact sphere (spheres) or exact triangle (the 13-axis test of
 /// overlapsTriangleAabb), so Obb mode never places an item in a cell that Aabb mode leaves
-/// out. [any thread]
+/// out. An axis-aligned box stops at its AABB test in both modes: the 15-axis test of such a
+/// box repeats the face tests with a tolerance no smaller (its R is a signed permutation and
+/// the edge axes are face axes again), so it could only reject a pair the AABB test kept by
+/// less than a rounding error, and biased to overlap, we keep it. [any thread]
 bool overlaps(const OverlapShape& shape, const Aabb& cell, OverlapMode mode) noexcept;
 /// The same, for a prepared cell. [any thread]
 bool overlaps(const OverlapShape& shape, const OverlapCell& cell, OverlapMode mode) noexcept;
