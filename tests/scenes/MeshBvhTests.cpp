@@ -1,7 +1,8 @@
 // The local BVH of a mesh: its queries equal a linear scan, and they never allocate. This
-// binary replaces the global operator new to count allocations (the pattern of
-// tests/runtime/ServoAllocationTests.cpp), so it is a test binary of its own.
+// binary replaces the global operator new to count allocations (tests/support/CountingNew.h),
+// so it is a test binary of its own.
 
+#include "CountingNew.h"
 #include "TestMeshes.h"
 
 #include "hapto/scenes/Random.h"
@@ -15,67 +16,7 @@
 #include <new>
 #include <vector>
 
-namespace {
-std::atomic<std::uint64_t> gAllocations{0};
-
-void* counted(std::size_t n, std::size_t align = 0) noexcept {
-    gAllocations.fetch_add(1, std::memory_order_relaxed);
-    n = n ? n : 1;
-    if (align > alignof(std::max_align_t)) {
-        return std::aligned_alloc(align, (n + align - 1) / align * align);
-    }
-    return std::malloc(n);
-}
-void* countedOrThrow(std::size_t n, std::size_t align = 0) {
-    if (void* p = counted(n, align)) {
-        return p;
-    }
-    throw std::bad_alloc();
-}
-} // namespace
-
-void* operator new(std::size_t n) {
-    return countedOrThrow(n);
-}
-void* operator new[](std::size_t n) {
-    return countedOrThrow(n);
-}
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-    return counted(n);
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-    return counted(n);
-}
-void* operator new(std::size_t n, std::align_val_t a) {
-    return countedOrThrow(n, static_cast<std::size_t>(a));
-}
-void* operator new[](std::size_t n, std::align_val_t a) {
-    return countedOrThrow(n, static_cast<std::size_t>(a));
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::align_val_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::align_val_t) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
-    std::free(p);
-}
+using hapto::test::gAllocations;
 
 using namespace hapto;
 
