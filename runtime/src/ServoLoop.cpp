@@ -16,8 +16,11 @@
 //     while the device held its last force): that tick commands zero, and force grows from
 //     zero at the safety filter's rate once ticks are on time again.
 
+#include "hapto/runtime/ServoLoop.h"
+
 #include "Channel.h"
 
+#include "hapto/core/CpuPause.h"
 #include "hapto/core/Finite.h"
 #include "hapto/devices/TraceRecorder.h"
 
@@ -26,6 +29,59 @@
 #include <unistd.h>
 
 namespace hapto {
+namespace {
+
+/// Prefetches the scene objects that `items` name (at most kMaxWarmUpPrefetches; triangle
+/// items are skipped: finding their mesh is a search, not a load) and returns their sum. [servo]
+std::uint64_t touchObjects(const Scene& scene, std::span<const std::uint32_t> items) noexcept {
+    const std::span<const SceneObject> objects = scene.objects();
+    std::uint64_t sum = 0;
+    const std::size_t n = std::min(items.size(), kMaxWarmUpPrefetches);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t item = items[i];
+        if (!isTriangleItem(item) && item < objects.size()) {
+            __builtin_prefetch(&objects[item]);
+        }
+        sum += item;
+    }
+    return sum;
+}
+
+} // namespace
+
+std::uint64_t warmUpTick(const WorldSnapshot& snapshot, const GodObjectRenderer& renderer,
+                         std::span<const std::byte> tickState, const Vec3& lastPointM,
+                         double dtS) noexcept {
+    // The tick's own state first: the cursors, the renderer, the safety filter, the effects.
+    for (std::size_t offset = 0; offset < tickState.size(); offset += 64) {
+        __builtin_prefetch(tickState.data() + offset);
+    }
+    const Scene& scene = *snapshot.scene;
+    const SpatialIndex& index = *snapshot.index;
+    // The index's path to the device point's leaf and the proxy's (a locate from the root
+    // reads every node on the way; no cursor moves), and the objects they list.
+    CandidateSet candidates;
+    const LocateResult atDevice = index.locate(lastPointM);
+    std::uint64_t sum = atDevice.leaf + touchObjects(scene, atDevice.candidates);
+    candidates.add(atDevice.candidates);
+    const LocateResult atProxy = index.locate(renderer.proxy());
+    if (atProxy.leaf != atDevice.leaf) {
+        sum += atProxy.leaf + touchObjects(scene, atProxy.candidates);
+        candidates.add(atProxy.candidates);
+    }
+    sum += touchObjects(scene, snapshot.movingSlots());
+    candidates.add(snapshot.movingSlots());
+    // A dry render on a copy: the solver's code and the near objects' data, warm.
+    GodObjectRenderer dry = renderer; // a plain copy: no allocation
+    const RenderOutput out = dry.update(scene, candidates, lastPointM, Vec3(0.0), dtS);
+    return sum + out.objectsTested + out.contactCount;
+}
+
+void spinUntilNs(std::uint64_t deadlineNs) noexcept {
+    while (rt::nowNs() < deadlineNs) {
+        cpuPause();
+    }
+}
 
 void Runtime::startServo(Channel& ch, std::uint64_t nowNs) noexcept {
     ServoState& s = ch.servo;
@@ -198,6 +254,15 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
     return true;
 }
 
+std::uint64_t Runtime::warm(Channel& ch) noexcept {
+    ServoState& s = ch.servo;
+    const WorldSnapshot& snap = mWorld.acquire(*s.reader); // the tick claims it again
+    const std::uint64_t sum = warmUpTick(snap, s.haptic.renderer(), std::as_bytes(std::span(&s, 1)),
+                                         s.lastPosition, s.dtS);
+    asm volatile("" : : "r"(sum) : "memory"); // what was read counts as used
+    return sum;
+}
+
 void Runtime::leaveServo(Channel& ch) noexcept {
     ServoState& s = ch.servo;
     DeviceMetrics& m = ch.metrics;
@@ -233,8 +298,19 @@ void Runtime::servoMain(Channel& ch) {
     s.deadlineNs = rt::nowNs() + s.periodNs;
 
     rt::setInServoLoop(true);
+    const std::uint64_t warmNs = std::min(mOptions.warmUpNs, s.periodNs / 2); // documented
     while (!s.stop.load(std::memory_order_acquire)) {
-        rt::sleepUntilNs(s.deadlineNs, mOptions.spinNs);
+        if (warmNs > 0 && s.deadlineNs > warmNs) {
+            // Wake warmNs early (after spinning the part of --spin-us before that, if longer),
+            // touch the tick's working set, spin to the deadline; the device is read after it.
+            const std::uint64_t spinBefore =
+                mOptions.spinNs > warmNs ? mOptions.spinNs - warmNs : 0;
+            rt::sleepUntilNs(s.deadlineNs - warmNs, spinBefore);
+            (void)warm(ch);
+            spinUntilNs(s.deadlineNs);
+        } else {
+            rt::sleepUntilNs(s.deadlineNs, mOptions.spinNs);
+        }
         if (!servoTick(ch, rt::nowNs())) {
             break;
         }
@@ -252,6 +328,9 @@ bool Runtime::step(std::size_t i, std::uint64_t nowNs) {
     }
     mClock->set(nowNs);
     rt::setInServoLoop(true);
+    if (mOptions.warmUpNs > 0) {
+        (void)warm(ch); // the step mode has no sleep to wake from; it warms up so tests cover it
+    }
     const bool ticked = !s.stop.load(std::memory_order_acquire) && servoTick(ch, nowNs);
     if (!ticked) {
         leaveServo(ch);

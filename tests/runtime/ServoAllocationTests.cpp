@@ -144,7 +144,9 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
     const Scene scene = makeDefaultScene();
     const std::string spec =
         GENERATE(std::string("octree:2:0.005"), std::string("grid:5"), std::string("brute"));
-    INFO(spec);
+    // With and without the warm-up before each tick (the step mode runs it too).
+    const std::uint64_t warmUpNs = GENERATE(std::uint64_t{0}, std::uint64_t{50'000});
+    INFO(spec << ", warm-up " << warmUpNs << " ns");
     ManualClock clock;
     World world(scene, IndexSpec::parse(spec));
     world.useClock(clock);
@@ -161,6 +163,7 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
     }
     RuntimeOptions opt;
     opt.realtime = false;
+    opt.warmUpNs = warmUpNs;
     Runtime runtime(world, std::move(devices), opt);
     PullToOther hooks[2];
     for (std::size_t i = 0; i < 2; ++i) {
@@ -210,6 +213,9 @@ TEST_CASE("servo threads make no heap allocation while running, across snapshot 
     }
     RuntimeOptions opt;
     opt.realtime = false;
+    // Each wake-up comes early, touches the tick's working set and spins to the deadline.
+    opt.warmUpNs = GENERATE(std::uint64_t{0}, std::uint64_t{50'000});
+    INFO("warm-up " << opt.warmUpNs << " ns");
     Runtime runtime(world, std::move(devices), opt);
     PullToOther hooks[2];
     for (std::size_t i = 0; i < 2; ++i) {

@@ -1,11 +1,14 @@
-// `hapto bench query` (its hand walk: tests/experiments/HandWalkTests.cpp). Behaviour only:
-// nothing here depends on how fast anything runs.
+// `hapto bench query` and `hapto bench tick` (their hand walk:
+// tests/experiments/HandWalkTests.cpp). Behaviour only: nothing here depends on how fast anything
+// runs.
 
 #include "TestSupport.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
+#include <iterator>
 #include <string>
 
 using namespace hapto;
@@ -134,4 +137,139 @@ TEST_CASE("hapto bench query refuses bad index specs and options with exit code 
         const auto r = test::runHapto("bench query --steps 100 --scene /nonexistent/s.json");
         CHECK(r.exitCode == 2);
     }
+}
+
+namespace {
+
+constexpr const char* kTickStages[] = {"read",    "snapshot", "locate", "candidates", "render",
+                                       "effects", "safety",   "write",  "metrics"};
+
+/// Runs `hapto bench tick ARGS --json OUT` and returns the file's JSON.
+json runTickJson(const test::TempDir& dir, const std::string& args) {
+    const std::string out = (dir / "tick.json").string();
+    const auto r = test::runHapto("bench tick " + args + " --json " + out);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    return json::parse(test::readFile(out));
+}
+
+/// The structure and the invariants of one bench tick entry: every stage, ordered quantiles,
+/// each stage no slower than the whole tick at the same quantile (every tick's stages lie
+/// inside it), and the stage means adding up to the tick's mean (the stages tile the tick).
+void checkTickEntry(const json& e, std::size_t ticks) {
+    INFO(e.dump());
+    for (const char* key :
+         {"index", "mode", "objects", "ticks", "sleep_us", "warm_us", "device", "stages", "tick",
+          "locate_steps_mean", "candidates_mean", "contact_fraction"}) {
+        CHECK(e.contains(key));
+    }
+    CHECK(e["ticks"] == ticks);
+    const json& tick = e["tick"];
+    CHECK(tick["ns_p50"].get<double>() >= 0.0);
+    CHECK(tick["ns_p50"].get<double>() <= tick["ns_p99"].get<double>());
+    CHECK(tick["ns_p99"].get<double>() <= tick["ns_p999"].get<double>());
+    REQUIRE(e["stages"].size() == std::size(kTickStages));
+    double meanSum = 0.0, medianSum = 0.0;
+    for (const char* name : kTickStages) {
+        INFO(name);
+        REQUIRE(e["stages"].contains(name));
+        const json& s = e["stages"][name];
+        CHECK(s["ns_p50"].get<double>() >= 0.0);
+        CHECK(s["ns_p50"].get<double>() <= s["ns_p99"].get<double>());
+        CHECK(s["ns_p99"].get<double>() <= s["ns_p999"].get<double>());
+        for (const char* q : {"ns_p50", "ns_p99", "ns_p999", "ns_mean"}) {
+            CHECK(s[q].get<double>() <= tick[q].get<double>());
+        }
+        meanSum += s["ns_mean"].get<double>();
+        medianSum += s["ns_p50"].get<double>();
+    }
+    CHECK(meanSum == Approx(tick["ns_mean"].get<double>()).epsilon(1e-9));
+    // Each stage's median is at most the tick's, so nine of them are at most nine ticks'.
+    CHECK(medianSum <= std::size(kTickStages) * tick["ns_p50"].get<double>());
+    CHECK(e["candidates_mean"].get<double>() >= 0.0);
+    CHECK(e["contact_fraction"].get<double>() >= 0.0);
+    CHECK(e["contact_fraction"].get<double>() <= 1.0);
+}
+
+} // namespace
+
+TEST_CASE("hapto bench tick --json reports every stage of every mode for every index") {
+    test::TempDir dir;
+    const std::string scene = makeScene(dir);
+    const json j = runTickJson(dir, "--scene " + scene +
+                                        " --ticks 300 --sleep-us 200 --warm-us 20 --index grid:4 "
+                                        "--index octree:2:0.005");
+    REQUIRE(j.is_array());
+    REQUIRE(j.size() == 6);
+    const char* modes[] = {"hot", "sleep", "sleep+warm"};
+    for (std::size_t i = 0; i < j.size(); ++i) {
+        const json& e = j[i];
+        CHECK(e["index"] == (i < 3 ? "grid:4" : "octree:2:0.005"));
+        CHECK(e["mode"] == modes[i % 3]);
+        CHECK(e["objects"] == 60);
+        CHECK(e["device"] == "walk");
+        CHECK(e["sleep_us"].get<double>() == (i % 3 == 0 ? 0.0 : 200.0));
+        CHECK(e["warm_us"].get<double>() == (i % 3 == 2 ? 20.0 : 0.0));
+        checkTickEntry(e, 300);
+    }
+    // The same walk in every mode: the same candidates, the same contacts.
+    for (std::size_t i = 1; i < 3; ++i) {
+        CHECK(j[i]["candidates_mean"] == j[0]["candidates_mean"]);
+        CHECK(j[i]["contact_fraction"] == j[0]["contact_fraction"]);
+        CHECK(j[3 + i]["candidates_mean"] == j[3]["candidates_mean"]);
+    }
+}
+
+TEST_CASE("hapto bench tick drives a simulated hand's reads and writes, and prints a table") {
+    test::TempDir dir;
+    const json j = runTickJson(dir, "--device sim --ticks 200 --sleep-us 100 --warm-us 10");
+    REQUIRE(j.size() == 3);
+    for (const json& e : j) {
+        CHECK(e["device"] == "sim");
+        CHECK(e["objects"] == 200);
+        checkTickEntry(e, 200);
+    }
+    const auto r = test::runHapto("bench tick --ticks 100 --sleep-us 50 --warm-us 5");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK_THAT(r.output, Catch::Contains("200 objects"));
+    CHECK_THAT(r.output, Catch::Contains("octree:2:0.005"));
+    CHECK_THAT(r.output, Catch::Contains("sleep+warm"));
+    CHECK_THAT(r.output, Catch::Contains("p99.9 ns"));
+    for (const char* name : kTickStages) {
+        CHECK_THAT(r.output, Catch::Contains(name));
+    }
+}
+
+TEST_CASE("hapto bench tick refuses bad options with exit code 2 and writes nothing") {
+    test::TempDir dir;
+    const std::string out = (dir / "tick.json").string();
+    SECTION("a warm-up not shorter than the sleep") {
+        const auto r =
+            test::runHapto("bench tick --ticks 10 --sleep-us 10 --warm-us 20 --json " + out);
+        CHECK(r.exitCode == 2);
+        CHECK_THAT(r.output, Catch::Contains("--warm-us"));
+    }
+    SECTION("an unknown device") {
+        const auto r = test::runHapto("bench tick --ticks 10 --device falcon --json " + out);
+        CHECK(r.exitCode == 2);
+        CHECK_THAT(r.output, Catch::Contains("--device"));
+    }
+    SECTION("no ticks") {
+        const auto r = test::runHapto("bench tick --ticks 0 --json " + out);
+        CHECK(r.exitCode == 2);
+        CHECK_THAT(r.output, Catch::Contains("--ticks"));
+    }
+    SECTION("an unknown index") {
+        const auto r = test::runHapto("bench tick --ticks 10 --index kdtree:3 --json " + out);
+        CHECK(r.exitCode == 2);
+        CHECK_THAT(r.output, Catch::Contains("kdtree:3"));
+    }
+    SECTION("an output in a missing folder") {
+        const auto r = test::runHapto("bench tick --ticks 10 --json " +
+                                      (dir / "missing" / "tick.json").string());
+        CHECK(r.exitCode == 2);
+        CHECK_THAT(r.output, Catch::Contains("--json"));
+    }
+    CHECK_FALSE(std::filesystem::exists(out));
 }

@@ -1,23 +1,42 @@
 // `hapto bench query`: per-query cost of indices over one scene, along one hand-speed walk.
+// `hapto bench tick`: the servo tick's stages over one scene along the same walk, back to back,
+// after a sleep, and after a sleep with the servo loop's warm-up.
 
 #include "Commands.h"
 #include "Options.h"
 
+#include "hapto/core/Mailbox.h"
+#include "hapto/devices/DeviceConfig.h"
+#include "hapto/devices/DeviceFactory.h"
 #include "hapto/experiments/HandWalk.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/runtime/CandidateSet.h"
+#include "hapto/runtime/DeviceMetrics.h"
+#include "hapto/runtime/Effects.h"
+#include "hapto/runtime/ForceSafety.h"
+#include "hapto/runtime/GodObjectRenderer.h"
+#include "hapto/runtime/Realtime.h"
+#include "hapto/runtime/Runtime.h"
+#include "hapto/runtime/ServoLoop.h"
+#include "hapto/runtime/World.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/OutputFile.h"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <span>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hapto::cli {
@@ -219,10 +238,392 @@ void runQuery(const QueryArgs& args) {
     }
 }
 
+// ---- `hapto bench tick` ----------------------------------------------------------------------
+
+/// The stages of one servo tick, in the order Runtime::servoTick and HapticTick::tick run them.
+constexpr std::array<const char*, 9> kStages{
+    "read", "snapshot", "locate", "candidates", "render", "effects", "safety", "write", "metrics"};
+constexpr std::size_t kStageCount = kStages.size();
+
+/// How a tick is started: back to back, after a sleep, or after a sleep with the servo loop's
+/// warm-up before the deadline.
+enum class TickMode : std::uint8_t { Hot, Sleep, Warm };
+constexpr std::array<const char*, 3> kModeNames{"hot", "sleep", "sleep+warm"};
+
+/// A device that plays the hand walk: read() hands over the walk's next point (device frame =
+/// world frame), write() keeps the force. Kind "scripted": made by this program, never by a
+/// device file.
+class WalkDevice final : public Device {
+public:
+    WalkDevice(const Aabb& bounds, std::uint64_t seed) : mWalk(bounds, seed) {}
+    std::string_view name() const override { return "walk"; }
+    DeviceKind kind() const override { return DeviceKind::Scripted; }
+    DeviceCapabilities capabilities() const override { return {}; }
+    DeviceStatus open() override { return DeviceStatus::Ok; }
+    void close() override {}
+    DeviceStatus read(DeviceState& state) noexcept override {
+        state.position = mWalk.next();
+        state.hasVelocity = false;
+        return DeviceStatus::Ok;
+    }
+    DeviceStatus write(const Vec3& forceN) noexcept override {
+        mForceN = forceN;
+        return DeviceStatus::Ok;
+    }
+    std::string errorMessage() const override { return {}; }
+
+private:
+    experiments::HandWalk mWalk;
+    Vec3 mForceN{0.0};
+};
+
+/// What one tick reads and writes, laid out like the servo's hot state: the pieces HapticTick
+/// holds (two cursors, the renderer, the safety filter, the candidates, the effects), driven
+/// stage by stage from outside so each stage can be timed. One per (index, mode).
+struct alignas(64) TickPieces {
+    Cursor deviceCursor, proxyCursor;
+    GodObjectRenderer renderer;
+    ForceSafety safety;
+    CandidateSet candidates;
+    EffectSet effects;
+    DeviceState sample;
+    Vec3 lastPoint{0.0};
+    const SpatialIndex* boundIndex = nullptr;
+    std::uint64_t boundVersion = 0;
+    bool fresh = true;
+};
+
+/// One (index, mode) being driven: its device, its tick state, its per-stage samples (ns).
+struct TickRun {
+    TickMode mode = TickMode::Hot;
+    std::unique_ptr<Device> device;
+    std::unique_ptr<experiments::HandWalk> walk; // the point, when the device is a sim hand
+    std::unique_ptr<TickPieces> pieces;
+    std::unique_ptr<DeviceMetrics> metrics;
+    std::unique_ptr<Mailbox<ContactReport>> contacts;
+    SnapshotReader* reader = nullptr;
+    std::array<std::vector<double>, kStageCount> stageNs;
+    std::vector<double> tickNs;
+    std::uint64_t ticks = 0, locateSteps = 0, candidates = 0, contactTicks = 0;
+    std::uint64_t kept = 0; // what the warm-up read, kept
+};
+
+/// One `--index`: its world (scene copy, index, snapshots) and its three runs.
+struct TickTarget {
+    IndexSpec spec;
+    std::unique_ptr<World> world;
+    std::vector<std::unique_ptr<TickRun>> runs;
+};
+
+struct TickArgs {
+    std::string scene;
+    std::vector<std::string> indices;
+    std::string device = "walk";
+    std::size_t ticks = 5000;
+    double sleepUs = 1000;
+    double warmUs = static_cast<double>(kDefaultWarmUpNs) / 1000.0;
+    std::uint64_t seed = 1;
+    std::string json;
+    std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
+};
+
+/// One tick, stage by stage, as Runtime::servoTick and HapticTick::tick run it; the stage
+/// boundaries are steady clock readings (`wake` is the first). What HapticTick does that is
+/// not reachable from outside (the re-solve with a leaf the proxy slid into) is not run.
+void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs, double dtS) {
+    TickPieces& t = *run.pieces;
+    std::array<std::uint64_t, kStageCount + 1> stamp{};
+    stamp[0] = wakeNs;
+    // read
+    (void)run.device->read(t.sample);
+    if (run.walk) {
+        t.sample.position = run.walk->next(); // the sim hand was read; the walk drives the tick
+        t.sample.hasVelocity = false;
+    }
+    stamp[1] = rt::nowNs();
+    // snapshot: claim it, the device point in the world (identity frame), its velocity
+    const WorldSnapshot& snap = world.acquire(*run.reader);
+    const Vec3 p = t.sample.position;
+    if (t.fresh) {
+        t.lastPoint = p;
+    }
+    const Vec3 v = t.sample.hasVelocity ? t.sample.velocity : (p - t.lastPoint) / dtS;
+    t.lastPoint = p;
+    stamp[2] = rt::nowNs();
+    // locate
+    const SpatialIndex* index = snap.index.get();
+    if (t.fresh || snap.version != t.boundVersion || index != t.boundIndex) {
+        t.deviceCursor.reset(*index);
+        t.proxyCursor.reset(*index);
+        t.boundIndex = index;
+        t.boundVersion = snap.version;
+    }
+    if (t.fresh) {
+        t.renderer.reset(p);
+        t.fresh = false;
+    }
+    const LocateResult atDevice = t.deviceCursor.locate(p);
+    const LocateResult atProxy = t.proxyCursor.locate(t.renderer.proxy());
+    stamp[3] = rt::nowNs();
+    // candidates
+    t.candidates.clear();
+    t.candidates.add(atDevice.candidates);
+    if (atProxy.leaf != atDevice.leaf || atProxy.outside != atDevice.outside) {
+        t.candidates.add(atProxy.candidates);
+    }
+    t.candidates.add(snap.movingSlots());
+    stamp[4] = rt::nowNs();
+    // render
+    const RenderOutput out = t.renderer.update(*snap.scene, t.candidates, p, v, dtS);
+    stamp[5] = rt::nowNs();
+    // effects
+    const Vec3 effectsN = t.effects.forceN(p, v);
+    stamp[6] = rt::nowNs();
+    // safety
+    const Vec3 force = t.safety.filter(out.force + effectsN);
+    stamp[7] = rt::nowNs();
+    // write
+    (void)run.device->write(force);
+    stamp[8] = rt::nowNs();
+    // metrics: what servoTick records and publishes
+    DeviceMetrics& m = *run.metrics;
+    m.tickNs.record(stamp[8] - wakeNs);
+    m.latenessNs.record(0);
+    m.ioNs.record((stamp[1] - wakeNs) + (stamp[8] - stamp[7]));
+    DeviceMetrics::bump(m.locateStepsSum, atDevice.steps + atProxy.steps);
+    DeviceMetrics::bump(m.candidatesSum, out.objectsTested);
+    if (out.contactCount > 0) {
+        DeviceMetrics::bump(m.contactTicks);
+    }
+    for (int i = 0; i < 3; ++i) {
+        m.forceN[i].store(force[i], std::memory_order_relaxed);
+        m.positionM[i].store(p[i], std::memory_order_relaxed);
+    }
+    m.leafAtVersion.store((snap.version & 0xFFFFFFFFu) << 32 | atDevice.leaf,
+                          std::memory_order_relaxed);
+    ContactReport report;
+    report.tick = run.ticks;
+    report.devicePoint = p;
+    report.proxy = out.proxy;
+    report.force = force;
+    report.contactCount = out.contactCount;
+    for (std::uint32_t c = 0; c < out.contactCount && c < report.objects.size(); ++c) {
+        report.objects[c] = out.contacts[c].id;
+        report.normals[c] = out.contacts[c].normal;
+    }
+    run.contacts->publish(report);
+    DeviceMetrics::bump(m.ticks);
+    m.heartbeatNs.store(stamp[8], std::memory_order_relaxed);
+    stamp[9] = rt::nowNs();
+
+    for (std::size_t s = 0; s < kStageCount; ++s) {
+        run.stageNs[s][at] = static_cast<double>(stamp[s + 1] - stamp[s]);
+    }
+    run.tickNs[at] = static_cast<double>(stamp[kStageCount] - stamp[0]);
+    ++run.ticks;
+    run.locateSteps += atDevice.steps + atProxy.steps;
+    run.candidates += out.objectsTested;
+    run.contactTicks += out.contactCount > 0 ? 1 : 0;
+}
+
+/// Runs `count` ticks of `run` from sample `at` on, started as its mode says.
+void driveTicks(TickRun& run, World& world, std::size_t at, std::size_t count,
+                const TickArgs& args) {
+    const auto sleepNs = static_cast<std::uint64_t>(args.sleepUs * 1000.0);
+    const auto warmNs = static_cast<std::uint64_t>(args.warmUs * 1000.0);
+    const double dtS = 1e-3;
+    for (std::size_t k = at; k < at + count; ++k) {
+        std::uint64_t wake = rt::nowNs();
+        if (run.mode != TickMode::Hot) {
+            const std::uint64_t deadline = wake + sleepNs;
+            if (run.mode == TickMode::Warm) {
+                // As the servo loop does with a warm-up: wake early, touch, spin to the deadline.
+                rt::sleepUntilNs(deadline - warmNs, 0);
+                const WorldSnapshot& snap = world.acquire(*run.reader);
+                run.kept += warmUpTick(snap, run.pieces->renderer,
+                                       std::as_bytes(std::span(run.pieces.get(), 1)),
+                                       run.pieces->lastPoint, dtS);
+                spinUntilNs(deadline);
+            } else {
+                rt::sleepUntilNs(deadline, 0);
+            }
+            wake = rt::nowNs();
+        }
+        timedTick(run, world, k, wake, dtS);
+    }
+}
+
+/// Nearest-rank quantiles of a copy of `ns`, as JSON and as a row.
+struct Quantiles {
+    double p50 = 0, p99 = 0, p999 = 0, mean = 0;
+};
+Quantiles quantilesOf(std::vector<double> ns) {
+    Quantiles q;
+    if (ns.empty()) {
+        return q;
+    }
+    double sum = 0;
+    for (const double x : ns) {
+        sum += x;
+    }
+    q.mean = sum / static_cast<double>(ns.size());
+    std::sort(ns.begin(), ns.end());
+    q.p50 = quantile(ns, 0.5);
+    q.p99 = quantile(ns, 0.99);
+    q.p999 = quantile(ns, 0.999);
+    return q;
+}
+
+nlohmann::ordered_json toJson(const Quantiles& q) {
+    return {{"ns_p50", q.p50}, {"ns_p99", q.p99}, {"ns_p999", q.p999}, {"ns_mean", q.mean}};
+}
+
+void runTick(const TickArgs& args) {
+    std::vector<std::string> texts = args.indices;
+    if (texts.empty()) {
+        texts = {"octree:2:0.005"};
+    }
+    std::vector<IndexSpec> specs;
+    for (const std::string& t : texts) {
+        try {
+            specs.push_back(IndexSpec::parse(t).withMaxMegabytes(args.maxIndexMb));
+        } catch (const InputError& e) {
+            throw InputError(std::string("--index: ") + e.what());
+        }
+    }
+    if (args.warmUs >= args.sleepUs) {
+        char message[160];
+        std::snprintf(message, sizeof message,
+                      "--warm-us %g: not shorter than --sleep-us %g; the warm-up happens inside "
+                      "the sleep",
+                      args.warmUs, args.sleepUs);
+        throw InputError(message);
+    }
+    if (!args.json.empty()) {
+        checkOutputFile(args.json, "--json");
+        refuseSameFile(args.json, "--json", args.scene, "--scene");
+    }
+    const Scene scene = loadSceneOrDefault(args.scene);
+
+    std::vector<TickTarget> targets;
+    for (const IndexSpec& spec : specs) {
+        TickTarget target;
+        target.spec = spec;
+        target.world = std::make_unique<World>(scene, spec);
+        for (const TickMode mode : {TickMode::Hot, TickMode::Sleep, TickMode::Warm}) {
+            auto run = std::make_unique<TickRun>();
+            run->mode = mode;
+            if (args.device == "sim") {
+                DeviceConfig c = defaultDeviceConfigs().front();
+                c.name = "bench";
+                run->device = makeDevice(c, scene);
+                run->walk = std::make_unique<experiments::HandWalk>(scene.bounds(), args.seed);
+            } else {
+                run->device = std::make_unique<WalkDevice>(scene.bounds(), args.seed);
+            }
+            if (run->device->open() != DeviceStatus::Ok) {
+                throw std::runtime_error("bench tick: the " + args.device +
+                                         " device did not open: " + run->device->errorMessage());
+            }
+            run->pieces = std::make_unique<TickPieces>();
+            run->metrics = std::make_unique<DeviceMetrics>();
+            run->contacts = std::make_unique<Mailbox<ContactReport>>();
+            run->reader = target.world->registerReader();
+            for (std::vector<double>& s : run->stageNs) {
+                s.assign(args.ticks, 0.0);
+            }
+            run->tickNs.assign(args.ticks, 0.0);
+            target.runs.push_back(std::move(run));
+        }
+        targets.push_back(std::move(target));
+    }
+
+    // Every run walks the same seeded path; the runs take turns in blocks, each block starting
+    // with a different one, so a slow spell of the machine falls on all of them alike.
+    constexpr std::size_t kTickBlock = 256;
+    rt::tightenTimerSlack();
+    for (std::size_t done = 0, round = 0; done < args.ticks; ++round) {
+        const std::size_t length = std::min(kTickBlock, args.ticks - done);
+        std::vector<std::pair<TickTarget*, TickRun*>> order;
+        for (TickTarget& t : targets) {
+            for (auto& r : t.runs) {
+                order.emplace_back(&t, r.get());
+            }
+        }
+        for (std::size_t r = 0; r < order.size(); ++r) {
+            const auto [target, run] = order[(r + round) % order.size()];
+            driveTicks(*run, *target->world, done, length, args);
+        }
+        done += length;
+    }
+
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    std::printf("scene:   %s, %u objects\n",
+                args.scene.empty() ? "(embedded default scene)" : args.scene.c_str(), scene.size());
+    std::printf("walk:    %zu ticks per mode of 1 ms, seed %llu, device %s, <= 0.5 m/s, "
+                "mirrored at the bounds\n",
+                args.ticks, static_cast<unsigned long long>(args.seed), args.device.c_str());
+    std::printf("modes:   hot = back to back; sleep = after a %.0f us sleep; sleep+warm = the "
+                "same with the servo loop's warm-up %.1f us before the deadline\n",
+                args.sleepUs, args.warmUs);
+    std::printf("timing:  steady clock at each stage boundary (%zu readings per tick, one costs "
+                "~%.0f ns); nearest-rank quantiles over every tick; runs interleaved in blocks "
+                "of %zu ticks\n",
+                kStageCount + 1, clockOverheadNs(), kTickBlock);
+    for (const TickTarget& target : targets) {
+        std::printf("\nindex %s\n%-12s", target.spec.toString().c_str(), "stage");
+        for (const char* mode : kModeNames) {
+            std::printf(" | %-10s %7s %7s %8s", mode, "p50 ns", "p99 ns", "p99.9 ns");
+        }
+        std::printf("\n");
+        std::vector<std::array<Quantiles, kStageCount + 1>> q(target.runs.size());
+        for (std::size_t r = 0; r < target.runs.size(); ++r) {
+            for (std::size_t s = 0; s < kStageCount; ++s) {
+                q[r][s] = quantilesOf(target.runs[r]->stageNs[s]);
+            }
+            q[r][kStageCount] = quantilesOf(target.runs[r]->tickNs);
+        }
+        for (std::size_t s = 0; s <= kStageCount; ++s) {
+            std::printf("%-12s", s < kStageCount ? kStages[s] : "tick");
+            for (std::size_t r = 0; r < target.runs.size(); ++r) {
+                std::printf(" | %-10s %7.0f %7.0f %8.0f", "", q[r][s].p50, q[r][s].p99,
+                            q[r][s].p999);
+            }
+            std::printf("\n");
+        }
+        for (std::size_t r = 0; r < target.runs.size(); ++r) {
+            const TickRun& run = *target.runs[r];
+            const double n = static_cast<double>(run.ticks);
+            nlohmann::ordered_json stages = nlohmann::ordered_json::object();
+            for (std::size_t s = 0; s < kStageCount; ++s) {
+                stages[kStages[s]] = toJson(q[r][s]);
+            }
+            out.push_back({{"index", target.spec.toString()},
+                           {"mode", kModeNames[static_cast<std::size_t>(run.mode)]},
+                           {"objects", scene.size()},
+                           {"ticks", run.ticks},
+                           {"sleep_us", run.mode == TickMode::Hot ? 0.0 : args.sleepUs},
+                           {"warm_us", run.mode == TickMode::Warm ? args.warmUs : 0.0},
+                           {"device", args.device},
+                           {"stages", stages},
+                           {"tick", toJson(q[r][kStageCount])},
+                           {"locate_steps_mean", static_cast<double>(run.locateSteps) / n},
+                           {"candidates_mean", static_cast<double>(run.candidates) / n},
+                           {"contact_fraction", static_cast<double>(run.contactTicks) / n}});
+            keep(run.kept);
+        }
+    }
+    if (!args.json.empty()) {
+        writeFileAtomically(args.json, out.dump(2) + "\n");
+        std::printf("\nwrote %s\n", args.json.c_str());
+    }
+}
+
 } // namespace
 
 void addBenchCommands(CLI::App& app) {
-    CLI::App* bench = app.add_subcommand("bench", "Measure the speed of the spatial indices");
+    CLI::App* bench =
+        app.add_subcommand("bench", "Measure the speed of the spatial indices and the servo tick");
     bench->require_subcommand(1);
 
     auto args = std::make_shared<QueryArgs>();
@@ -258,6 +659,50 @@ void addBenchCommands(CLI::App& app) {
                   "Print only a JSON array of {index, objects, steps, ns_p50, ns_p999, ns_mean, "
                   "locate_steps_mean, candidates_mean}");
     cmd->callback([args] { runQuery(*args); });
+
+    auto targs = std::make_shared<TickArgs>();
+    auto* tick = bench->add_subcommand(
+        "tick",
+        "The servo tick's cost stage by stage (device read, snapshot acquire, locate, "
+        "candidates, render, effects, safety, write, metrics) over one scene, along the same "
+        "seeded hand walk as bench query, each tick started three ways, side by side in one "
+        "run: back to back (hot), after a --sleep-us sleep (a real 1 kHz servo), and after the "
+        "same sleep with the servo loop's warm-up --warm-us before the deadline (hapto run "
+        "--warm-us). The stages are the public pieces Runtime::servoTick and HapticTick::tick "
+        "call, in their order, with a steady clock reading at each boundary; the re-solve "
+        "HapticTick runs when the proxy slides into an unlisted leaf is not run. Reports each "
+        "stage's and the whole tick's median, p99 and p99.9 (ns).");
+    tick->add_option("--scene", targs->scene, "Scene file (default: the embedded default scene)");
+    tick->add_option("--index", targs->indices,
+                     "Index to tick over, repeatable: brute, grid:N, octree:M:MIN (MIN in m), "
+                     "each optionally with :aabb. Default: octree:2:0.005");
+    addMaxIndexMbOption(tick, targs->maxIndexMb);
+    tick->add_option("--device", targs->device,
+                     "walk: a device that plays the walk (read and write cost nothing but a "
+                     "call); sim: a simulated hand (its read and write are timed; the walk still "
+                     "drives the tick)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"walk", "sim"}));
+    tick->add_option("--ticks", targs->ticks, "Ticks per mode and index, e.g. 5000")
+        ->capture_default_str()
+        ->transform(wholeNumber(1, 1e7));
+    tick->add_option("--sleep-us", targs->sleepUs,
+                     "Sleep before each tick of the sleep modes (us; 1000 = a 1 kHz servo)")
+        ->capture_default_str()
+        ->check(finiteRange(1, 1e6));
+    tick->add_option("--warm-us", targs->warmUs,
+                     "Warm-up before the deadline in the sleep+warm mode (us), shorter than "
+                     "--sleep-us")
+        ->capture_default_str()
+        ->check(finiteRange(0.001, static_cast<double>(kMaxWarmUpNs) / 1000.0));
+    tick->add_option("--seed", targs->seed, "Walk seed; same seed, same walk")
+        ->capture_default_str()
+        ->check(finiteRange(0, kMaxSeed));
+    tick->add_option("--json", targs->json,
+                     "Also write a JSON array of {index, mode, objects, ticks, sleep_us, warm_us, "
+                     "device, stages: {read, ...: {ns_p50, ns_p99, ns_p999, ns_mean}}, tick: "
+                     "{...}, locate_steps_mean, candidates_mean, contact_fraction} to this file");
+    tick->callback([targs] { runTick(*targs); });
 }
 
 } // namespace hapto::cli

@@ -28,7 +28,8 @@ void addReportCommands(CLI::App& app);
 /// [control]
 void checkPlotOutputs(const std::string& out, const std::string& script);
 
-/// `hapto bench query`: per-query cost of indices along a hand-speed walk. [control]
+/// `hapto bench query` and `hapto bench tick`: per-query cost of indices and the servo tick's
+/// stages along a hand-speed walk. [control]
 void addBenchCommands(CLI::App& app);
 
 /// `hapto demo grasp`: the scripted two-handed grasp. [control]

@@ -41,6 +41,7 @@ struct RunArgs {
     std::string record;
     bool realtime = true;
     double spinUs = 0;
+    double warmUs = static_cast<double>(kDefaultWarmUpNs) / 1000.0;
     int missLimit = 3;
     std::size_t devicesPerThread = 1;
     double reopenMs = 1000;
@@ -80,6 +81,17 @@ void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
     useTraceSettings(configs, !(a.rateHz > 0));
     checkDeviceCount(configs.size(), a.devices);
     checkSpinAgainstRates(a.spinUs, configs);
+    for (const DeviceConfig& c : configs) {
+        const double periodUs = 1e6 / c.rateHz;
+        if (a.warmUs > 0 && a.warmUs >= periodUs / 2) {
+            char text[256];
+            std::snprintf(text, sizeof text,
+                          "--warm-us %g: not shorter than half the servo period of device '%s' "
+                          "(%g us at %g Hz); warm up for less, or run slower",
+                          a.warmUs, c.name.c_str(), periodUs, c.rateHz);
+            throw InputError(text);
+        }
+    }
     checkSessionFiles({a.scene, a.devices, a.report, a.record}, configs);
     if (a.devicesPerThread > 1) {
         for (const DeviceConfig& c : configs) {
@@ -140,6 +152,7 @@ int runSession(const RunArgs& a) {
     RuntimeOptions opt;
     opt.realtime = a.realtime;
     opt.spinNs = static_cast<std::uint64_t>(a.spinUs * 1000);
+    opt.warmUpNs = static_cast<std::uint64_t>(a.warmUs * 1000);
     opt.missLimit = a.missLimit;
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
     opt.devicesPerThread = a.devicesPerThread;
@@ -240,6 +253,13 @@ void addRunCommands(CLI::App& app) {
     cmd->add_option("--spin-us", a->spinUs, "Spin this long before each deadline (us)")
         ->capture_default_str()
         ->check(finiteRange(0, 1000));
+    cmd->add_option("--warm-us", a->warmUs,
+                    "Wake this long before each deadline, touch the tick's working set (snapshot, "
+                    "index path, candidate objects, renderer) and spin to the deadline, so the "
+                    "tick starts warm; 0 = off (us; less than half the period; the default was "
+                    "chosen with `hapto bench tick`, docs/results/tick.md)")
+        ->capture_default_str()
+        ->check(finiteRange(0, static_cast<double>(kMaxWarmUpNs) / 1000.0));
     cmd->add_option("--miss-limit", a->missLimit,
                     "K: after K missed deadlines in a row, command zero force until caught up")
         ->capture_default_str()

@@ -10,6 +10,7 @@
 #include "hapto/runtime/ForceSafety.h"
 #include "hapto/runtime/GodObjectRenderer.h"
 #include "hapto/runtime/ManualClock.h"
+#include "hapto/runtime/ServoLoop.h"
 #include "hapto/runtime/TickHook.h"
 #include "hapto/runtime/World.h"
 
@@ -48,8 +49,13 @@ struct RuntimeOptions {
     bool realtime = true;     ///< Ask for SCHED_FIFO and pin device i to core i % cores.
     int fifoPriority = 80;    ///< SCHED_FIFO priority when realtime.
     std::uint64_t spinNs = 0; ///< Spin this long before each deadline instead of sleeping (ns).
-    int missLimit = 3;        ///< K: after K missed deadlines in a row, command zero force
-                              ///< until a tick meets its deadline again.
+    /// Wake this long before each deadline, touch the tick's working set (warmUpTick in
+    /// ServoLoop.h) and spin to the deadline (ns); 0 = off. At most half the device's period
+    /// is used (a longer one is cut to that). The step
+    /// mode runs the same warm-up before each tick (it has no sleep to wake from).
+    std::uint64_t warmUpNs = kDefaultWarmUpNs;
+    int missLimit = 3;               ///< K: after K missed deadlines in a row, command zero force
+                                     ///< until a tick meets its deadline again.
     double lateWakeupFraction = 0.1; ///< A wake-up later than this fraction of the period is late.
     std::uint64_t stallTimeoutNs =
         50'000'000; ///< Watchdog: no tick for this long faults the device.
@@ -234,6 +240,7 @@ private:
     void startServo(Channel& channel, std::uint64_t nowNs) noexcept;
     bool servoTick(Channel& channel, std::uint64_t wakeNs) noexcept;
     void leaveServo(Channel& channel) noexcept;
+    std::uint64_t warm(Channel& channel) noexcept;
     void startThread(Channel& channel);
     void servoMain(Channel& channel);
     // Supervision.cpp: the watchdog, closing and reopening.

@@ -1,0 +1,52 @@
+#pragma once
+/// The servo loop's warm-up: what a servo thread does a few microseconds before its deadline so
+/// that the tick starts with its working set in cache (RuntimeOptions::warmUpNs).
+///
+/// Design note. A servo thread sleeps about a millisecond between ticks, and in that time the
+/// other threads on its core evict what the tick reads: the snapshot, the cursor's leaf and its
+/// candidate objects, the renderer and the rest of the haptic tick. With a warm-up the thread
+/// wakes warmUpNs before its deadline, calls warmUpTick() (a read-only walk over that working
+/// set: a prefetch of the servo's hot state, a locate from the root at the last device point
+/// and at the proxy, a prefetch of every candidate object, and a dry render on a copy of the
+/// renderer, which also brings the solver's code back into the instruction cache), spins to the
+/// deadline, and only then reads the device and ticks as before. Invariant: the warm-up writes
+/// nothing the tick reads (it does not move a cursor or the proxy; the snapshot claim it may take
+/// is the one the tick takes again), so forces and timing semantics are unchanged: the device is
+/// still sampled at the deadline. Cost: warmUpNs of CPU per tick (spinning), which is why it is an
+/// option.
+
+#include "hapto/core/Geometry.h"
+#include "hapto/runtime/GodObjectRenderer.h"
+#include "hapto/runtime/World.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+namespace hapto {
+
+/// The default RuntimeOptions::warmUpNs (ns): chosen by measurement with `hapto bench tick`
+/// (docs/results/tick.md).
+inline constexpr std::uint64_t kDefaultWarmUpNs = 5'000;
+/// The largest warm-up the options accept (ns): 100 µs, a tenth of a 1 kHz period.
+inline constexpr std::uint64_t kMaxWarmUpNs = 100'000;
+/// Candidate objects warmUpTick() prefetches per point at most (bounds its time).
+inline constexpr std::size_t kMaxWarmUpPrefetches = 256;
+
+/// Warms the next tick up without changing anything it reads: prefetches every cache line of
+/// `tickState` (the servo's hot state: the HapticTick with its cursors, renderer, safety filter
+/// and effects), locates `lastPointM` (m, world; the last device point) and the renderer's proxy
+/// from the index root (reading the nodes on the way; no cursor moves), prefetches the scene
+/// objects those leaves and the moving list name (up to kMaxWarmUpPrefetches each), and runs a
+/// dry render: a copy of `renderer` (on the stack) updated at `lastPointM` at rest against
+/// those candidates, so the solver's code and the objects' data are in cache; the copy is
+/// dropped. Returns a value derived from what it read (callers keep it, so the work is not
+/// optimised away). Never allocates, locks, logs or throws. [servo]
+std::uint64_t warmUpTick(const WorldSnapshot& snapshot, const GodObjectRenderer& renderer,
+                         std::span<const std::byte> tickState, const Vec3& lastPointM,
+                         double dtS) noexcept;
+
+/// Spins (cpuPause) until CLOCK_MONOTONIC reaches `deadlineNs`. [servo]
+void spinUntilNs(std::uint64_t deadlineNs) noexcept;
+
+} // namespace hapto
