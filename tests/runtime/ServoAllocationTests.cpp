@@ -1,6 +1,7 @@
 // Proves the servo path never allocates: this binary replaces the global operator new and
 // counts every allocation made inside a servo loop (a servo thread's, or a step-mode tick).
 
+#include "CountingNew.h"
 #include "MeshShapes.h"
 
 #include "hapto/devices/DeviceConfig.h"
@@ -24,90 +25,15 @@
 #include <thread>
 
 namespace {
-std::atomic<std::uint64_t> gServoAllocations{0};
-std::atomic<std::uint64_t> gAllAllocations{0};
-
-// Every form of operator new comes here (plain, array, nothrow, over-aligned), so nothing a
-// servo thread allocates escapes the count, and every delete frees what its new allocated.
-void* counted(std::size_t n, std::size_t align = 0) noexcept {
-    gAllAllocations.fetch_add(1, std::memory_order_relaxed);
-    if (hapto::rt::inServoLoop()) {
-        gServoAllocations.fetch_add(1, std::memory_order_relaxed);
-    }
-    n = n ? n : 1;
-    if (align > alignof(std::max_align_t)) {
-        return std::aligned_alloc(align, (n + align - 1) / align * align);
-    }
-    return std::malloc(n);
-}
-void* countedOrThrow(std::size_t n, std::size_t align = 0) {
-    if (void* p = counted(n, align)) {
-        return p;
-    }
-    throw std::bad_alloc();
-}
+// Every allocation is counted (tests/support/CountingNew.h); those made inside a servo loop
+// (rt::inServoLoop: a servo thread's, or a step-mode tick) are flagged.
+auto& gServoAllocations = hapto::test::gFlaggedAllocations;
+auto& gAllAllocations = hapto::test::gAllocations;
+[[maybe_unused]] const bool gFlagsServo = [] {
+    hapto::test::gFlagAllocation = []() noexcept { return hapto::rt::inServoLoop(); };
+    return true;
+}();
 } // namespace
-
-void* operator new(std::size_t n) {
-    return countedOrThrow(n);
-}
-void* operator new[](std::size_t n) {
-    return countedOrThrow(n);
-}
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-    return counted(n);
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-    return counted(n);
-}
-void* operator new(std::size_t n, std::align_val_t a) {
-    return countedOrThrow(n, static_cast<std::size_t>(a));
-}
-void* operator new[](std::size_t n, std::align_val_t a) {
-    return countedOrThrow(n, static_cast<std::size_t>(a));
-}
-void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
-    return counted(n, static_cast<std::size_t>(a));
-}
-void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
-    return counted(n, static_cast<std::size_t>(a));
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, const std::nothrow_t&) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, const std::nothrow_t&) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::align_val_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::align_val_t) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept {
-    std::free(p);
-}
 
 using namespace hapto;
 
