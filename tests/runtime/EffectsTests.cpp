@@ -2,6 +2,7 @@
 // through the runtime's step mode (the servo tick itself): picked up at the next tick, added
 // before the safety filter, clamped and sanitised by it.
 
+#include "CubeScene.h"
 #include "ScriptedDevice.h"
 #include "TestSupport.h"
 
@@ -17,6 +18,7 @@
 #include <stdexcept>
 
 using namespace hapto;
+using hapto::test::cubeScene;
 using test::ScriptedDevice;
 
 namespace {
@@ -26,14 +28,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool near(const Vec3& a, const Vec3& b, double eps = 1e-12) {
     return glm::length(a - b) <= eps;
-}
-
-/// A 5 cm cube (500 N/m) at the origin of a 25 cm world.
-Scene cubeScene() {
-    Material m;
-    m.stiffness = 500.0;
-    return Scene(Aabb{Vec3(-0.125), Vec3(0.125)},
-                 {makeBox(7, Vec3(0), Vec3(0.025), Quat(1, 0, 0, 0), m)});
 }
 
 /// One scripted device at 1 kHz in step mode over the cube scene; `config` brings its effects,

@@ -4,6 +4,7 @@
 // "takes" moves the ManualClock (ScriptedDevice::useClock). One [realtime] case runs real
 // group threads and checks only what eventually happens.
 
+#include "CubeScene.h"
 #include "ScriptedDevice.h"
 #include "TestSupport.h"
 
@@ -17,19 +18,13 @@
 #include <thread>
 
 using namespace hapto;
+using hapto::test::cubeScene;
 using test::Inject;
 using test::ScriptedDevice;
 
 namespace {
 
 constexpr std::uint64_t kMs = 1'000'000;
-
-Scene cubeScene() {
-    Material m;
-    m.stiffness = 500.0;
-    return Scene(Aabb{Vec3(-0.125), Vec3(0.125)},
-                 {makeBox(7, Vec3(0), Vec3(0.025), Quat(1, 0, 0, 0), m)});
-}
 
 /// A stepped runtime of `count` scripted devices over the cube scene, `perThread` to a servo
 /// thread: device i presses into the cube at x = 0.004 i - 0.01.

@@ -4,6 +4,7 @@
 // updates are tested on the step mode (SteppedRuntimeTests.cpp), which runs the same tick and
 // the same supervision pass.
 
+#include "CubeScene.h"
 #include "ScriptedDevice.h"
 
 #include "hapto/devices/FaultInjectingDevice.h"
@@ -19,17 +20,11 @@
 #include <thread>
 
 using namespace hapto;
+using hapto::test::cubeScene;
 using test::Inject;
 using test::ScriptedDevice;
 
 namespace {
-
-Scene cubeScene() {
-    Material m;
-    m.stiffness = 500.0;
-    return Scene(Aabb{Vec3(-0.125), Vec3(0.125)},
-                 {makeBox(7, Vec3(0), Vec3(0.025), Quat(1, 0, 0, 0), m)});
-}
 
 struct Rig {
     World world;

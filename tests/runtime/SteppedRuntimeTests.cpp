@@ -3,6 +3,7 @@
 // gives the same bytes. Time a device "takes" (a stall, a slow tick, an absence) moves the
 // clock (ScriptedDevice::useClock).
 
+#include "CubeScene.h"
 #include "ScriptedDevice.h"
 #include "TestSupport.h"
 
@@ -19,19 +20,13 @@
 #include <functional>
 
 using namespace hapto;
+using hapto::test::cubeScene;
 using test::Inject;
 using test::ScriptedDevice;
 
 namespace {
 
 constexpr std::uint64_t kMs = 1'000'000;
-
-Scene cubeScene() {
-    Material m;
-    m.stiffness = 500.0;
-    return Scene(Aabb{Vec3(-0.125), Vec3(0.125)},
-                 {makeBox(7, Vec3(0), Vec3(0.025), Quat(1, 0, 0, 0), m)});
-}
 
 /// A stepped runtime over the cube scene: device i presses into the cube at x = 0.004 i - 0.01.
 struct Rig {

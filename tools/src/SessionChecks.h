@@ -20,8 +20,9 @@ struct SessionPaths {
 
 /// The most devices one `hapto run` drives: 1024. The World has no cap on readers; this one
 /// guards against a generated device file gone wrong. Every device is a servo thread, and at
-/// 1 kHz a device-tick costs about 8 us of CPU with the kernel's sleep and wake-up, so 1024
-/// devices already need about eight cores.
+/// 1 kHz a device-tick costs about 13 us of CPU with the kernel's sleep and wake-up
+/// (docs/results/many-devices.md; about 4 us in servo groups of 16), so 1024 devices on their
+/// own threads already need about thirteen cores.
 inline constexpr std::size_t kMaxSessionDevices = 1024;
 
 /// Refuses more devices than kMaxSessionDevices, naming the limit and `source` (the device
