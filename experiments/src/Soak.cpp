@@ -164,12 +164,13 @@ void checkSoakOptions(const SoakOptions& a) {
     }
 }
 
-int runSoak(const Scene& scene, const SoakOptions& a, const SoakControl& control) {
+int runSoak(std::shared_ptr<const Scene> shared, const SoakOptions& a, const SoakControl& control) {
+    const Scene& scene = *shared;
     checkSoakOptions(a);
     const double durationS = a.durationS;
     const double quietTailS = soakQuietTailS(a);
     const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
-    World world(scene, spec);
+    World world(shared, spec);
 
     std::vector<FaultInjectingDevice*> injectors;
     std::vector<RuntimeDevice> rds;

@@ -25,13 +25,13 @@ int runSoakCommand(const SoakArgs& a) {
     StopSignals signals; // before any thread starts; see `hapto run`
     experiments::checkSoakOptions(a);
     checkSessionFiles({a.scene, "", a.report, ""}, {});
-    const Scene scene = loadSceneOrDefault(a.scene);
+    auto scene = std::make_shared<const Scene>(loadSceneOrDefault(a.scene));
     experiments::SoakControl control;
     control.stopRequested = [&signals] { return signals.requested(); };
     control.onRuntime = [&signals](Runtime& runtime) {
         signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
     };
-    return experiments::runSoak(scene, a, control);
+    return experiments::runSoak(std::move(scene), a, control);
 }
 
 } // namespace

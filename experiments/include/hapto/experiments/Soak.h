@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -46,10 +47,11 @@ double soakQuietTailS(const SoakOptions& options);
 /// Refuses a soak that could test nothing (it would end before its first fault), throwing
 /// InputError naming the option. [any thread]
 void checkSoakOptions(const SoakOptions& options);
-/// Runs the soak over `scene`, printing each window and the verdict (stdout) and writing the
-/// JSON report atomically when asked. Returns 0 on PASS, 1 on FAIL or when stopped (no
-/// verdict). Throws InputError for bad options. [control]
-int runSoak(const Scene& scene, const SoakOptions& options, const SoakControl& control);
+/// Runs the soak over `scene` (shared with the World, not copied), printing each window and the
+/// verdict (stdout) and writing the JSON report atomically when asked. Returns 0 on PASS, 1 on
+/// FAIL or when stopped (no verdict). Throws InputError for bad options. [control]
+int runSoak(std::shared_ptr<const Scene> scene, const SoakOptions& options,
+            const SoakControl& control);
 
 /// Least-squares slope of y over x, per hour when x is in seconds; 0 for fewer than two
 /// points or no spread in x. [any thread]
