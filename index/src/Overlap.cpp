@@ -6,18 +6,24 @@
 namespace hapto {
 
 OverlapShape OverlapShape::of(const SceneObject& object) {
+    return of(Scene::bodyOf(object));
+}
+
+OverlapShape OverlapShape::of(const RenderBody& body) noexcept {
     OverlapShape s;
-    s.obb = object.obb();
-    const bool sphere = object.shape == Shape::Sphere;
+    s.obb = body.obb();
+    const bool sphere = body.shape == Shape::Sphere;
     s.kind = sphere ? OverlapShape::Kind::Sphere : OverlapShape::Kind::Box;
-    s.aabb = sphere ? object.aabb() : s.obb.aabb();
-    s.radius = sphere ? object.halfExtents.x : 0.0;
-    s.scale = maxAbsComponent(object.center) +
-              std::max({object.halfExtents.x, object.halfExtents.y, object.halfExtents.z});
+    s.aabb = sphere ? Aabb{body.center - body.halfExtents, body.center + body.halfExtents}
+                    : s.obb.aabb();
+    s.radius = sphere ? body.halfExtents.x : 0.0;
+    s.scale = maxAbsComponent(body.center) +
+              std::max({body.halfExtents.x, body.halfExtents.y, body.halfExtents.z});
     s.axisAligned = !sphere;
-    for (int i = 0; i < 3; ++i) { // each axis one of +-x, +-y, +-z, exactly
+    for (int i = 0; i < 3 && s.axisAligned && !body.axisAligned; ++i) {
+        // each axis one of +-x, +-y, +-z, exactly (a quarter turn whose matrix came out exact)
         const Vec3 m = glm::abs(s.obb.axes[i]);
-        s.axisAligned = s.axisAligned && m.x + m.y + m.z == 1.0 && std::max({m.x, m.y, m.z}) == 1.0;
+        s.axisAligned = m.x + m.y + m.z == 1.0 && std::max({m.x, m.y, m.z}) == 1.0;
     }
     return s;
 }
@@ -32,12 +38,17 @@ OverlapShape OverlapShape::ofTriangle(const TriangleCorners& corners) noexcept {
 }
 
 OverlapShape OverlapShape::of(const Scene& scene, std::uint32_t item) {
-    return isTriangleItem(item) ? ofTriangle(scene.triangleCorners(item)) : of(scene.object(item));
+    return isTriangleItem(item) ? ofTriangle(scene.triangleCorners(item)) : of(scene.body(item));
 }
 
 Aabb itemAabb(const Scene& scene, std::uint32_t item) noexcept {
-    return isTriangleItem(item) ? triangleAabb(scene.triangleCorners(item))
-                                : scene.object(item).aabb();
+    if (isTriangleItem(item)) {
+        return triangleAabb(scene.triangleCorners(item));
+    }
+    // SceneObject::aabb() from the render copy (the same oriented box, bit for bit).
+    const RenderBody& b = scene.body(item);
+    return b.shape == Shape::Sphere ? Aabb{b.center - b.halfExtents, b.center + b.halfExtents}
+                                    : b.obb().aabb();
 }
 
 Vec3 itemCenter(const Scene& scene, std::uint32_t item) noexcept {

@@ -7,10 +7,12 @@
 #include "hapto/scenes/InputError.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <thread>
 
 namespace hapto {
 
@@ -60,9 +62,30 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
     grid->recordOutsideObjects(scene, items);
     const UniformGrid& g = *grid;
 
-    std::vector<OverlapShape> shapes(count);
-    parallel::forEach(0, count, 4096,
-                      [&](std::size_t k) { shapes[k] = OverlapShape::of(scene, items[k]); });
+    // Each pass below prepares an item's bounds afresh from the scene's render copy: cheaper
+    // than writing and rereading 192 bytes per item.
+
+    // Each cell's box and tolerance scale (OverlapCell::of: aabbScale of the box) from per-axis
+    // tables, with the same arithmetic, so the tests below see exactly the cells they would
+    // otherwise build one by one.
+    struct Axis {
+        std::vector<double> coord, absCenter, edge;
+    };
+    std::array<Axis, 3> axes;
+    for (int a = 0; a < 3; ++a) {
+        Axis& ax = axes[a];
+        ax.coord.resize(std::size_t(n) + 1);
+        for (std::uint32_t i = 0; i <= n; ++i) {
+            ax.coord[i] = g.coord(i, a);
+        }
+        ax.absCenter.resize(n);
+        ax.edge.resize(n);
+        for (std::uint32_t i = 0; i < n; ++i) {
+            ax.absCenter[i] = std::abs(0.5 * (ax.coord[i] + ax.coord[i + 1]));
+            ax.edge[i] = ax.coord[i + 1] - ax.coord[i];
+        }
+    }
+    const OverlapCell whole = OverlapCell::of(g.bounds());
 
     // The candidate cell range of an item: the cells its AABB reaches, widened by the
     // overlap tolerance, plus the lower neighbour when that touches a cell's lower face
@@ -74,28 +97,38 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
     const auto rangeOf = [&](const OverlapShape& s) {
         Range r{};
         r.empty = !overlapsAabbAabb(s.aabb, g.bounds());
-        const double tol = overlapTolerance(s, OverlapCell::of(g.bounds()));
+        const double tol = overlapTolerance(s, whole);
         for (int a = 0; a < 3 && !r.empty; ++a) {
             const double lo = s.aabb.min[a] - tol, hi = s.aabb.max[a] + tol;
             r.lo[a] = g.cellIndex(lo, a);
-            if (r.lo[a] > 0 && lo <= g.coord(r.lo[a], a)) {
+            if (r.lo[a] > 0 && lo <= axes[a].coord[r.lo[a]]) {
                 --r.lo[a];
             }
             r.hi[a] = g.cellIndex(hi, a);
         }
         return r;
     };
+    const auto rangeSize = [&](std::uint32_t k) -> std::uint64_t {
+        const Range r = rangeOf(OverlapShape::of(scene, items[k]));
+        return r.empty ? 0
+                       : std::uint64_t(r.hi[0] - r.lo[0] + 1) * (r.hi[1] - r.lo[1] + 1) *
+                             (r.hi[2] - r.lo[2] + 1);
+    };
     const auto forEachCell = [&](std::uint32_t k, auto&& visit) {
-        const OverlapShape& s = shapes[k];
+        const OverlapShape s = OverlapShape::of(scene, items[k]);
         const Range r = rangeOf(s);
         if (r.empty) {
             return;
         }
+        const Axis &ax = axes[0], &ay = axes[1], &az = axes[2];
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z) {
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    const Aabb cell{{g.coord(x, 0), g.coord(y, 1), g.coord(z, 2)},
-                                    {g.coord(x + 1, 0), g.coord(y + 1, 1), g.coord(z + 1, 2)}};
+                    const OverlapCell cell{
+                        {{ax.coord[x], ay.coord[y], az.coord[z]},
+                         {ax.coord[x + 1], ay.coord[y + 1], az.coord[z + 1]}},
+                        std::max({ax.absCenter[x], ay.absCenter[y], az.absCenter[z]}) +
+                            std::max({ax.edge[x], ay.edge[y], az.edge[z]})};
                     if (overlaps(s, cell, spec.mode)) {
                         visit(g.cellId(x, y, z));
                     }
@@ -104,37 +137,57 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         }
     };
 
-    // A counting sort by cell. In parallel over items: count each item's cells, then list them
-    // at the item's own offset (plain sequential writes). Serially: count each cell's items
-    // from those lists, and, in item order, place each item at its cells' next free positions,
-    // so every cell's run lists its items ascending on any number of threads (no locked
+    // A counting sort by cell. In parallel over items: size each item's candidate range (no
+    // overlap test), then test its cells once and list the overlapped ones at the item's own
+    // offset (plain sequential writes), keeping the count. Then count each cell's items from
+    // those lists, and, in item order, place each item at its cells' next free positions, so
+    // every cell's run lists its items ascending on any number of threads (no locked
     // instruction per pair: the random stores do not wait for each other). The counters become
     // the stats' per-cell counts at the end.
     const std::size_t cells = g.cellCount();
     std::vector<std::uint32_t> fill(cells, 0);
     std::vector<std::uint64_t> pairStart(std::size_t(count) + 1, 0);
     parallel::forEach(0, count, 256, [&](std::size_t i) {
-        std::uint64_t n = 0;
-        forEachCell(static_cast<std::uint32_t>(i), [&](std::uint32_t) { ++n; });
-        pairStart[i + 1] = n;
+        pairStart[i + 1] = rangeSize(static_cast<std::uint32_t>(i));
     });
     for (std::size_t i = 0; i < count; ++i) {
         pairStart[i + 1] += pairStart[i];
     }
-    const std::uint64_t pairs = pairStart[count];
+    std::vector<std::uint32_t> pairCell(pairStart[count]);
+    std::vector<std::uint32_t> pairCount(count, 0);
+    parallel::forEach(0, count, 256, [&](std::size_t i) {
+        std::uint32_t* out = pairCell.data() + pairStart[i];
+        std::uint32_t listed = 0;
+        forEachCell(static_cast<std::uint32_t>(i),
+                    [&](std::uint32_t cell) { out[listed++] = cell; });
+        pairCount[i] = listed;
+    });
+    // The cells are split into bands, one per thread; each band's thread reads every item's
+    // list in item order and handles only its own cells' pairs, so the lists stay ascending
+    // and no two threads write the same counter or slot.
+    const std::size_t bands = std::max(1u, std::thread::hardware_concurrency());
+    const std::size_t bandCells = (cells + bands - 1) / bands;
+    const auto forEachBandPair = [&](auto&& visit) {
+        parallel::forEach(0, bands, 1, [&](std::size_t b) {
+            const std::size_t lo = b * bandCells, hi = std::min(cells, lo + bandCells);
+            for (std::size_t i = 0; i < count; ++i) {
+                for (std::uint64_t p = pairStart[i]; p < pairStart[i] + pairCount[i]; ++p) {
+                    if (pairCell[p] >= lo && pairCell[p] < hi) {
+                        visit(i, pairCell[p]);
+                    }
+                }
+            }
+        });
+    };
+    std::uint64_t pairs = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        pairs += pairCount[i];
+    }
     if (pairs >= std::numeric_limits<std::uint32_t>::max()) {
         throw InputError("grid index " + spec.toString() + ": " + std::to_string(pairs) +
                          " item-cell pairs do not fit 32-bit offsets; use fewer cells");
     }
-    std::vector<std::uint32_t> pairCell(pairs);
-    parallel::forEach(0, count, 256, [&](std::size_t i) {
-        std::uint64_t at = pairStart[i];
-        forEachCell(static_cast<std::uint32_t>(i),
-                    [&](std::uint32_t cell) { pairCell[at++] = cell; });
-    });
-    for (const std::uint32_t cell : pairCell) {
-        ++fill[cell];
-    }
+    forEachBandPair([&](std::size_t, std::uint32_t cell) { ++fill[cell]; });
     std::vector<std::uint32_t>& cellStart = grid->mCellStart;
     cellStart.assign(cells + 1, 0);
     for (std::size_t c = 0; c < cells; ++c) {
@@ -142,11 +195,8 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         fill[c] = cellStart[c]; // from here on: the cell's next free position
     }
     grid->mItems.resize(pairs);
-    for (std::size_t i = 0; i < count; ++i) {
-        for (std::uint64_t p = pairStart[i]; p < pairStart[i + 1]; ++p) {
-            grid->mItems[fill[pairCell[p]]++] = items[i];
-        }
-    }
+    std::uint32_t* const placed = grid->mItems.data();
+    forEachBandPair([&](std::size_t i, std::uint32_t cell) { placed[fill[cell]++] = items[i]; });
     for (std::size_t c = 0; c < cells; ++c) {
         fill[c] = cellStart[c + 1] - cellStart[c];
     }

@@ -112,7 +112,7 @@ TEST_CASE("the bad-scene corpus and the fuzz corpus get the same answers from bo
     namespace fs = std::filesystem;
     const fs::path root = HAPTO_SOURCE_DIR;
     int files = 0;
-    for (const fs::path dir :
+    for (const fs::path& dir :
          {root / "tests/tools/bad_inputs/scenes", root / "tools/fuzz/corpus/scene_file"}) {
         for (const auto& entry : fs::directory_iterator(dir)) {
             if (entry.path().extension() == ".json") {

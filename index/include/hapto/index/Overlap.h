@@ -41,6 +41,9 @@ struct OverlapShape {
     /// Prepares a box's or sphere's bounds (not a mesh's: its triangles are the items).
     /// [any thread]
     static OverlapShape of(const SceneObject& object);
+    /// The same from the object's render copy (Scene::body), without turning its rotation into
+    /// a matrix again. [any thread]
+    static OverlapShape of(const RenderBody& body) noexcept;
     /// Prepares a triangle's bounds from its world corners (m). [any thread]
     static OverlapShape ofTriangle(const TriangleCorners& corners) noexcept;
     /// Prepares an index item's bounds (Scene.h: an object slot or a triangle item); the item

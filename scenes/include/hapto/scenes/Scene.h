@@ -127,6 +127,8 @@ public:
     }
     /// The render copy of the object in slot i. [any thread]
     const RenderBody& body(std::uint32_t slot) const noexcept { return mBodies[slot]; }
+    /// The render copy of an object (what body() holds for it). [any thread]
+    static RenderBody bodyOf(const SceneObject& o);
 
     /// Moves one object (m, unit quaternion); the caller owns this copy of the scene. [control]
     void setPose(std::uint32_t slot, const Vec3& center, const Quat& rotation);
@@ -141,8 +143,6 @@ public:
     }
 
 private:
-    static RenderBody bodyOf(const SceneObject& o);
-
     /// Where each mesh's triangles start in the scene's triangle numbering.
     struct MeshRange {
         std::uint32_t firstTriangle;
