@@ -19,7 +19,7 @@
 // the half-open cell [lo, hi) that holds p, closed on the bounds' upper faces.
 // Cost: build O(sum over levels of the objects listed at that level), each with up to 8
 // overlap tests (an AABB reject, then the SAT; an axis-aligned box stops at the AABB test);
-// memory 48 bytes per node + 4 bytes per eight siblings (their parent) + 4 bytes per
+// memory 40 bytes per node + 4 bytes per eight siblings (their parent) + 4 bytes per
 // object-leaf pair, every array sized exactly. Query: O(depth) from the root; O(1) + descent with
 // links (see Cursor.h).
 
@@ -69,8 +69,8 @@ Aabb Octree::nodeBounds(std::uint32_t node) const noexcept {
     Aabb b;
     const int l = n.level();
     for (int a = 0; a < 3; ++a) {
-        b.min[a] = coord(l, n.cell(a), a);
-        b.max[a] = coord(l, n.cell(a) + 1, a);
+        b.min[a] = coord(l, n.cellAt(a, l), a);
+        b.max[a] = coord(l, n.cellAt(a, l) + 1, a);
     }
     return b;
 }
@@ -80,7 +80,7 @@ bool Octree::holds(std::uint32_t node, const Vec3& p) const noexcept {
     const int l = n.level();
     const std::uint32_t top = 1u << l;
     for (int a = 0; a < 3; ++a) {
-        const std::uint32_t c = n.cell(a);
+        const std::uint32_t c = n.cellAt(a, l);
         const double lo = coord(l, c, a);
         const double hi = coord(l, c + 1, a);
         if (!(p[a] >= lo && (p[a] < hi || (c + 1 == top && p[a] <= hi)))) {
@@ -104,7 +104,7 @@ std::uint32_t Octree::cellIndex(int level, double v, int axis) const noexcept {
 
 std::span<const std::uint32_t> Octree::leafObjects(std::uint32_t node) const noexcept {
     const OctreeNode& n = mNodes[node];
-    return {mSlots.data() + n.firstSlot, n.slotCount};
+    return {mSlots.data() + n.firstSlot(), n.slotCount()};
 }
 
 LocateResult Octree::descend(std::uint32_t node, const Vec3& p,
@@ -114,13 +114,13 @@ LocateResult Octree::descend(std::uint32_t node, const Vec3& p,
         const int l = n->level() + 1;
         std::uint32_t octant = 0;
         for (int a = 0; a < 3; ++a) {
-            octant |= std::uint32_t(p[a] >= coord(l, 2 * n->cell(a) + 1, a)) << a;
+            octant |= std::uint32_t(p[a] >= coord(l, 2 * n->cellAt(a, l - 1) + 1, a)) << a;
         }
-        node = n->firstChild + octant;
+        node = n->firstChild() + octant;
         n = &mNodes[node];
         ++steps;
     }
-    return {{mSlots.data() + n->firstSlot, n->slotCount}, node, steps, false};
+    return {{mSlots.data() + n->firstSlot(), n->slotCount()}, node, steps, false};
 }
 
 LocateResult Octree::locate(const Vec3& p) const noexcept {
@@ -150,7 +150,7 @@ LocateResult Octree::followLinks(std::uint32_t leaf, const Vec3& p) const noexce
     const int level = from.level();
     std::uint32_t axesCrossed = 0, differ = 0;
     for (int a = 0; a < 3; ++a) {
-        const std::uint32_t q = cellIndex(level, p[a], a), c = from.cell(a);
+        const std::uint32_t q = cellIndex(level, p[a], a), c = from.cellAt(a, level);
         if (q + 1 < c || q > c + 1) {
             return climb(leaf, p);
         }
@@ -165,9 +165,10 @@ LocateResult Octree::followLinks(std::uint32_t leaf, const Vec3& p) const noexce
     for (int a = 0; a < 3; ++a) {
         const OctreeNode& n = mNodes[node];
         const int l = n.level();
-        const double lo = coord(l, n.cell(a), a);
-        const double hi = coord(l, n.cell(a) + 1, a);
-        const bool top = n.cell(a) + 1 == (1u << l);
+        const std::uint32_t c = n.cellAt(a, l);
+        const double lo = coord(l, c, a);
+        const double hi = coord(l, c + 1, a);
+        const bool top = c + 1 == (1u << l);
         if (p[a] < lo) {
             node = n.neighbours[2 * a];
         } else if (!(p[a] < hi || (top && p[a] <= hi))) {
@@ -216,7 +217,7 @@ std::unique_ptr<Octree> Octree::build(const Scene& scene, const IndexSpec& spec)
     for (std::uint32_t i = 0; i < tree->mNodes.size(); ++i) {
         const OctreeNode& n = tree->mNodes[i];
         if (n.isLeaf()) {
-            perLeaf.push_back(n.slotCount);
+            perLeaf.push_back(n.slotCount());
             st.depth = std::max<std::uint32_t>(st.depth, static_cast<std::uint32_t>(n.level()));
             st.leavesAtMinimumSize += tree->atMinimumSize(i);
         }
@@ -391,14 +392,14 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
             const std::uint32_t id = static_cast<std::uint32_t>(levelBegin + k);
             if (!splits[k]) {
                 OctreeNode& n = mNodes[id];
-                n.firstSlot = static_cast<std::uint32_t>(slotBase + leafTotal);
-                n.slotCount = static_cast<std::uint32_t>(start[k + 1] - start[k]);
+                n.makeLeaf(static_cast<std::uint32_t>(slotBase + leafTotal),
+                           static_cast<std::uint32_t>(start[k + 1] - start[k]));
                 leafAt[k] = slotBase + leafTotal;
-                leafTotal += n.slotCount;
+                leafTotal += n.slotCount();
                 continue;
             }
             const std::uint32_t first = static_cast<std::uint32_t>(mNodes.size());
-            mNodes[id].firstChild = first;
+            mNodes[id].makeInner(first);
             const OctreeNode parent = mNodes[id];
             mGroupParent.push_back(id);
             for (std::uint32_t o = 0; o < 8; ++o) {
@@ -459,20 +460,20 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
         parallel::forEach(newBegin, newEnd, 1024, [&](std::size_t j) {
             OctreeNode& c = mNodes[j];
             const OctreeNode& parent = mNodes[mGroupParent[(j - 1) / 8]];
-            const std::uint32_t o = static_cast<std::uint32_t>(j - parent.firstChild);
+            const std::uint32_t o = static_cast<std::uint32_t>(j - parent.firstChild());
             for (int a = 0; a < 3; ++a) {
                 const std::uint32_t bit = 1u << a;
                 for (int positive = 0; positive < 2; ++positive) {
                     const int face = 2 * a + positive;
                     if (((o & bit) != 0) != (positive != 0)) { // inner face: a sibling
-                        c.neighbours[face] = parent.firstChild + (o ^ bit);
+                        c.neighbours[face] = parent.firstChild() + (o ^ bit);
                         continue;
                     }
                     const std::uint32_t across = parent.neighbours[face];
                     if (across == kNoNode || mNodes[across].isLeaf()) {
                         c.neighbours[face] = across;
                     } else { // same size as the parent, split: its mirrored child
-                        c.neighbours[face] = mNodes[across].firstChild + (o ^ bit);
+                        c.neighbours[face] = mNodes[across].firstChild() + (o ^ bit);
                     }
                 }
             }

@@ -124,14 +124,14 @@ TEST_CASE("octree leaves hold at most M items unless at minimum size, exactly th
                     continue;
                 }
                 ++leaves;
-                pairs += n.slotCount;
+                pairs += n.slotCount();
                 const Aabb box = tree->nodeBounds(i);
                 const double edge = std::max({box.size().x, box.size().y, box.size().z});
                 // At minimum size exactly when halving would go below MIN.
                 const bool atMinimumSize = tree->atMinimumSize(i);
                 wrongSize += atMinimumSize != (edge / 2 < spec.minLeafSize * (1 - 1e-12));
                 atMin += atMinimumSize;
-                if (!atMinimumSize && n.slotCount > static_cast<std::uint32_t>(spec.maxObjects)) {
+                if (!atMinimumSize && n.slotCount() > static_cast<std::uint32_t>(spec.maxObjects)) {
                     ++overfull;
                 }
                 std::vector<std::uint32_t> want;

@@ -25,7 +25,7 @@ std::uint32_t expectedNode(const Octree& tree, int level, std::array<std::int64_
         for (int a = 0; a < 3; ++a) {
             octant |= std::uint32_t((c[a] >> shift) & 1) << a;
         }
-        node = tree.nodes()[node].firstChild + octant;
+        node = tree.nodes()[node].firstChild() + octant;
     }
     return node;
 }
@@ -78,23 +78,23 @@ TEST_CASE("octree layout: breadth first, siblings together, leaves one contiguou
             const std::uint32_t parent = tree->parent(i);
             REQUIRE(parent < i);
             CHECK(nodes[i - 1].level() <= n.level());
-            CHECK(nodes[parent].firstChild <= i);
-            CHECK(i < nodes[parent].firstChild + 8);
+            CHECK(nodes[parent].firstChild() <= i);
+            CHECK(i < nodes[parent].firstChild() + 8);
             CHECK(n.level() == nodes[parent].level() + 1);
             for (int a = 0; a < 3; ++a) { // the cell is the parent's octant i - firstChild
                 CHECK(n.cell(a) ==
-                      2 * nodes[parent].cell(a) + (((i - nodes[parent].firstChild) >> a) & 1));
+                      2 * nodes[parent].cell(a) + (((i - nodes[parent].firstChild()) >> a) & 1));
             }
         }
         if (n.isLeaf()) {
-            runs.emplace_back(n.firstSlot, n.slotCount);
+            runs.emplace_back(n.firstSlot(), n.slotCount());
             const auto objs = tree->leafObjects(i);
             CHECK(std::is_sorted(objs.begin(), objs.end()));
             CHECK(std::adjacent_find(objs.begin(), objs.end()) == objs.end());
         } else {
-            CHECK(n.slotCount == 0);
+            CHECK(n.slotCount() == 0);
             for (std::uint32_t o = 0; o < 8; ++o) {
-                CHECK(tree->parent(n.firstChild + o) == i);
+                CHECK(tree->parent(n.firstChild() + o) == i);
             }
         }
     }

@@ -4,6 +4,7 @@
 #include "hapto/index/SpatialIndex.h"
 
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -17,35 +18,62 @@ inline constexpr std::uint32_t kNoNode = 0xFFFFFFFFu;
 /// The six faces of a node, in link order: face = 2 * axis + (positive ? 1 : 0).
 enum class Face : std::uint8_t { NegX, PosX, NegY, PosY, NegZ, PosZ };
 
-/// One octree node (48 bytes). Its cell is given by level and integer coordinates: along each
+/// One octree node (40 bytes). Its cell is given by level and integer coordinates: along each
 /// axis it spans [min + c * step(level), min + (c + 1) * step(level)], step = size / 2^level.
 /// What can be derived is not stored: the parent (one entry per eight siblings,
-/// Octree::parent) and whether a leaf reached the minimum size (Octree::atMinimumSize); the
-/// level shares a word with the x coordinate.
+/// Octree::parent) and whether a leaf reached the minimum size (Octree::atMinimumSize). A leaf's
+/// first slot and an inner node's first child share a word, told apart by the slot count; the
+/// level and the three coordinates share one 64-bit word: per axis a 21-bit field
+/// 2^level + c (c < 2^level <= 2^20), whose top set bit gives the level.
 struct OctreeNode {
-    std::uint32_t firstChild = kNoNode; ///< Children firstChild + octant (bit a: upper half
-                                        ///< on axis a); kNoNode for a leaf.
     /// Per face: the adjacent node of equal size, else the smallest larger node covering the
     /// face; kNoNode outside the bounds.
     std::array<std::uint32_t, 6> neighbours{kNoNode, kNoNode, kNoNode, kNoNode, kNoNode, kNoNode};
-    std::uint32_t firstSlot = 0; ///< Leaf: its items are slots()[firstSlot, +slotCount).
-    std::uint32_t slotCount = 0; ///< Leaf: number of items.
-    /// Bits 0-19 of word a: the integer coordinate on axis a (< 2^20, the deepest level's
-    /// count); bits 24-31 of word 0: the level.
-    std::array<std::uint32_t, 3> packedCell{0, 0, 0};
 
     /// True for a leaf. [any thread]
-    bool isLeaf() const noexcept { return firstChild == kNoNode; }
+    bool isLeaf() const noexcept { return mCount != kInner; }
+    /// Inner node: its children are firstChild() + octant (bit a: upper half on axis a);
+    /// kNoNode for a leaf. [any thread]
+    std::uint32_t firstChild() const noexcept { return isLeaf() ? kNoNode : mFirst; }
+    /// Leaf: its items are slots()[firstSlot(), +slotCount()); 0 for an inner node. [any thread]
+    std::uint32_t firstSlot() const noexcept { return isLeaf() ? mFirst : 0; }
+    /// Leaf: number of items; 0 for an inner node. [any thread]
+    std::uint32_t slotCount() const noexcept { return isLeaf() ? mCount : 0; }
     /// The level, root 0. [any thread]
-    int level() const noexcept { return static_cast<int>(packedCell[0] >> 24); }
+    int level() const noexcept { return std::bit_width(mCell & kField) - 1; }
     /// The integer coordinate on an axis at this level. [any thread]
-    std::uint32_t cell(int axis) const noexcept { return packedCell[axis] & 0xFFFFFu; }
-    /// Sets level and coordinates (each below 2^20). [control]
-    void setCell(int level, std::uint32_t x, std::uint32_t y, std::uint32_t z) noexcept {
-        packedCell = {x | (static_cast<std::uint32_t>(level) << 24), y, z};
+    std::uint32_t cell(int axis) const noexcept { return cellAt(axis, level()); }
+    /// The same, given the level (level()) a caller already has. [any thread]
+    std::uint32_t cellAt(int axis, int level) const noexcept {
+        return static_cast<std::uint32_t>(((mCell >> (kFieldBits * axis)) & kField) ^
+                                          (std::uint64_t(1) << level));
     }
+    /// Sets level and coordinates (each below 2^level, level <= 20). [control]
+    void setCell(int level, std::uint32_t x, std::uint32_t y, std::uint32_t z) noexcept {
+        const std::uint64_t top = std::uint64_t(1) << level;
+        mCell = (top | x) | (top | y) << kFieldBits | (top | z) << (2 * kFieldBits);
+    }
+    /// Makes this node a leaf listing slots()[first, +count), count < 2^32 - 1. [control]
+    void makeLeaf(std::uint32_t first, std::uint32_t count) noexcept {
+        mFirst = first;
+        mCount = count;
+    }
+    /// Makes this node an inner node whose children start at `first`. [control]
+    void makeInner(std::uint32_t first) noexcept {
+        mFirst = first;
+        mCount = kInner;
+    }
+
+private:
+    static constexpr std::uint32_t kInner = 0xFFFFFFFFu; ///< mCount of an inner node
+    static constexpr int kFieldBits = 21;
+    static constexpr std::uint64_t kField = (std::uint64_t(1) << kFieldBits) - 1;
+
+    std::uint32_t mFirst = 0; ///< Leaf: first slot; inner node: first child.
+    std::uint32_t mCount = 0; ///< Leaf: slot count; kInner for an inner node.
+    std::uint64_t mCell = 1 | std::uint64_t(1) << kFieldBits | std::uint64_t(1) << (2 * kFieldBits);
 };
-static_assert(sizeof(OctreeNode) == 48, "octree nodes are 48 bytes; update the note if not");
+static_assert(sizeof(OctreeNode) == 40, "octree nodes are 40 bytes; update the note if not");
 
 /// A leaf holds at most M items unless it reached the minimum size; each item (a box, a sphere
 /// or a mesh triangle) is listed in every leaf its bounds overlap. Nodes are stored breadth first,
@@ -54,6 +82,7 @@ class Octree final : public SpatialIndex {
 public:
     /// Deepest level a node may have (cells of size / 2^20).
     static constexpr int kMaxDepth = 20;
+    static_assert(kMaxDepth <= 20, "OctreeNode packs a level and a coordinate in 21 bits");
     static_assert(kMaxDepth <= 20, "OctreeNode packs coordinates in 20 bits");
     /// Most nodes a build may create (then it throws InputError: raise MIN or M).
     static constexpr std::uint32_t kMaxNodes = 1u << 26;
