@@ -241,6 +241,24 @@ TEST_CASE("hapto bench tick drives a simulated hand's reads and writes, and prin
     }
 }
 
+TEST_CASE("hapto bench tick --walk-edge keeps the walk in a cube about the scene's centre") {
+    test::TempDir dir;
+    const std::string scene = makeScene(dir);
+    const json whole = runTickJson(dir, "--scene " + scene + " --ticks 50 --sleep-us 50");
+    const json inner =
+        runTickJson(dir, "--scene " + scene + " --ticks 50 --sleep-us 50 --walk-edge 0.02");
+    REQUIRE(whole.size() == 3);
+    REQUIRE(inner.size() == 3);
+    for (int a = 0; a < 3; ++a) {
+        const double lo = whole[0]["walk_min"][a], hi = whole[0]["walk_max"][a];
+        const double ilo = inner[0]["walk_min"][a], ihi = inner[0]["walk_max"][a];
+        REQUIRE(hi - lo > 0.02); // the scene is larger than the cube asked for
+        CHECK(ihi - ilo == Approx(0.02).epsilon(1e-12));
+        CHECK(0.5 * (ilo + ihi) == Approx(0.5 * (lo + hi)).margin(1e-15));
+    }
+    checkTickEntry(inner[0], 50);
+}
+
 TEST_CASE("hapto bench tick refuses bad options with exit code 2 and writes nothing") {
     test::TempDir dir;
     const std::string out = (dir / "tick.json").string();
@@ -259,6 +277,14 @@ TEST_CASE("hapto bench tick refuses bad options with exit code 2 and writes noth
         const auto r = test::runHapto("bench tick --ticks 0 --json " + out);
         CHECK(r.exitCode == 2);
         CHECK_THAT(r.output, Catch::Contains("--ticks"));
+    }
+    SECTION("a walk cube of no size") {
+        for (const char* edge : {"0", "-1", "nan"}) {
+            const auto r = test::runHapto(std::string("bench tick --ticks 10 --walk-edge ") + edge +
+                                          " --json " + out);
+            CHECK(r.exitCode == 2);
+            CHECK_THAT(r.output, Catch::Contains("--walk-edge"));
+        }
     }
     SECTION("an unknown index") {
         const auto r = test::runHapto("bench tick --ticks 10 --index kdtree:3 --json " + out);

@@ -323,9 +323,21 @@ struct TickArgs {
     double sleepUs = 1000;
     double warmUs = static_cast<double>(kDefaultWarmUpNs) / 1000.0;
     std::uint64_t seed = 1;
+    double walkEdgeM = 0.0; ///< 0: the walk roams the scene's bounds
     std::string json;
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
 };
+
+/// The box the walk roams: the scene's bounds, or with `edgeM` > 0 their part within the cube
+/// of that edge (m) centred on their centre.
+Aabb walkBox(const Aabb& bounds, double edgeM) {
+    if (edgeM <= 0.0) {
+        return bounds;
+    }
+    const Vec3 half(0.5 * edgeM);
+    return {glm::max(bounds.min, bounds.center() - half),
+            glm::min(bounds.max, bounds.center() + half)};
+}
 
 /// One tick, stage by stage, as Runtime::servoTick and HapticTick::tick run it; the stage
 /// boundaries are steady clock readings (`wake` is the first). What HapticTick does that is
@@ -505,6 +517,7 @@ void runTick(const TickArgs& args) {
     }
     const Scene scene = loadSceneOrDefault(args.scene);
 
+    const Aabb walkIn = walkBox(scene.bounds(), args.walkEdgeM);
     std::vector<TickTarget> targets;
     for (const IndexSpec& spec : specs) {
         TickTarget target;
@@ -517,9 +530,9 @@ void runTick(const TickArgs& args) {
                 DeviceConfig c = defaultDeviceConfigs().front();
                 c.name = "bench";
                 run->device = makeDevice(c, scene);
-                run->walk = std::make_unique<experiments::HandWalk>(scene.bounds(), args.seed);
+                run->walk = std::make_unique<experiments::HandWalk>(walkIn, args.seed);
             } else {
-                run->device = std::make_unique<WalkDevice>(scene.bounds(), args.seed);
+                run->device = std::make_unique<WalkDevice>(walkIn, args.seed);
             }
             if (run->device->open() != DeviceStatus::Ok) {
                 throw std::runtime_error("bench tick: the " + args.device +
@@ -561,8 +574,9 @@ void runTick(const TickArgs& args) {
     std::printf("scene:   %s, %u objects\n",
                 args.scene.empty() ? "(embedded default scene)" : args.scene.c_str(), scene.size());
     std::printf("walk:    %zu ticks per mode of 1 ms, seed %llu, device %s, <= 0.5 m/s, "
-                "mirrored at the bounds\n",
-                args.ticks, static_cast<unsigned long long>(args.seed), args.device.c_str());
+                "mirrored at the faces of [%g %g %g]..[%g %g %g] m\n",
+                args.ticks, static_cast<unsigned long long>(args.seed), args.device.c_str(),
+                walkIn.min.x, walkIn.min.y, walkIn.min.z, walkIn.max.x, walkIn.max.y, walkIn.max.z);
     std::printf("modes:   hot = back to back; sleep = after a %.0f us sleep; sleep+warm = the "
                 "same with the servo loop's warm-up %.1f us before the deadline\n",
                 args.sleepUs, args.warmUs);
@@ -605,6 +619,8 @@ void runTick(const TickArgs& args) {
                            {"sleep_us", run.mode == TickMode::Hot ? 0.0 : args.sleepUs},
                            {"warm_us", run.mode == TickMode::Warm ? args.warmUs : 0.0},
                            {"device", args.device},
+                           {"walk_min", {walkIn.min.x, walkIn.min.y, walkIn.min.z}},
+                           {"walk_max", {walkIn.max.x, walkIn.max.y, walkIn.max.z}},
                            {"stages", stages},
                            {"tick", toJson(q[r][kStageCount])},
                            {"locate_steps_mean", static_cast<double>(run.locateSteps) / n},
@@ -698,9 +714,15 @@ void addBenchCommands(CLI::App& app) {
     tick->add_option("--seed", targs->seed, "Walk seed; same seed, same walk")
         ->capture_default_str()
         ->check(finiteRange(0, kMaxSeed));
+    tick->add_option("--walk-edge", targs->walkEdgeM,
+                     "Keep the walk in the cube of this edge (m) centred on the scene's centre "
+                     "(within the bounds), e.g. to walk the same neighbourhood of a small and a "
+                     "large scene of equal density; default: the whole bounds")
+        ->check(finiteRange(1e-6, 1e4));
     tick->add_option("--json", targs->json,
                      "Also write a JSON array of {index, mode, objects, ticks, sleep_us, warm_us, "
-                     "device, stages: {read, ...: {ns_p50, ns_p99, ns_p999, ns_mean}}, tick: "
+                     "device, walk_min, walk_max, stages: {read, ...: {ns_p50, ns_p99, ns_p999, "
+                     "ns_mean}}, tick: "
                      "{...}, locate_steps_mean, candidates_mean, contact_fraction} to this file");
     tick->callback([targs] { runTick(*targs); });
 }
