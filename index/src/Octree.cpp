@@ -52,6 +52,7 @@ Octree::Octree(const IndexSpec& spec, const Aabb& bounds, std::uint32_t items)
     const Vec3 size = bounds.max - bounds.min;
     for (int l = 0; l <= kMaxDepth + 1; ++l) {
         mStep[l] = Vec3(std::ldexp(size.x, -l), std::ldexp(size.y, -l), std::ldexp(size.z, -l));
+        mInvStep[l] = 1.0 / mStep[l];
     }
 }
 
@@ -92,7 +93,9 @@ bool Octree::holds(std::uint32_t node, const Vec3& p) const noexcept {
 
 std::uint32_t Octree::cellIndex(int level, double v, int axis) const noexcept {
     const std::uint32_t last = (1u << level) - 1;
-    const double t = std::floor((v - bounds().min[axis]) / mStep[level][axis]);
+    // A product with the inverse may land one cell off near a face; the comparisons below
+    // settle on the formula the cell boxes use.
+    const double t = std::floor((v - bounds().min[axis]) * mInvStep[level][axis]);
     std::uint32_t i = static_cast<std::uint32_t>(t < 0.0 ? 0.0 : t > last ? last : t);
     if (i > 0 && v < coord(level, i, axis)) {
         --i;

@@ -134,7 +134,8 @@ private:
     LocateResult followLinks(std::uint32_t leaf, const Vec3& p) const noexcept;
     void buildNodes(const Scene& scene, std::span<const std::uint32_t> items);
 
-    std::array<Vec3, kMaxDepth + 2> mStep{}; // cell size per level (m)
+    std::array<Vec3, kMaxDepth + 2> mStep{};    // cell size per level (m)
+    std::array<Vec3, kMaxDepth + 2> mInvStep{}; // 1 / mStep (1/m)
     std::vector<OctreeNode> mNodes;
     std::vector<std::uint32_t> mGroupParent; // per eight siblings (nodes 1 + 8g ...): parent
     std::vector<std::uint32_t> mSlots;
