@@ -76,15 +76,7 @@ int runMeshes(const MeshesArgs& args) {
                                [](const Scene& scene, Condition) { return meshStart(scene); }});
         steps.push_back(std::move(step));
     }
-    SweepOptions options;
-    options.experiment = "meshes";
-    options.ratesHz = args.ratesHz;
-    options.servo.durationS = args.common.durationS;
-    options.servo.repeats = args.common.repeats;
-    options.servo.realtime = args.common.realtime;
-    options.servo.tail = tailFor(args.common.quick);
-    options.maxIndexMb = args.maxIndexMb;
-    options.verdict = args.verdict;
+    const SweepOptions options = sweepOptionsOf("meshes", args);
 
     Progress progress("meshes", renderers.size() * args.ratesHz.size() * steps.size() * 3);
     const std::vector<SweepRow> rows = runSweep(renderers, steps, options, progress);

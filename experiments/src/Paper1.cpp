@@ -76,15 +76,7 @@ int runPaper1(const Paper1Args& args) {
                                [k](const Scene&, Condition) { return latticeStart(k); }});
         steps.push_back(std::move(step));
     }
-    SweepOptions options;
-    options.experiment = "paper1";
-    options.ratesHz = args.ratesHz;
-    options.servo.durationS = args.common.durationS;
-    options.servo.repeats = args.common.repeats;
-    options.servo.realtime = args.common.realtime;
-    options.servo.tail = tailFor(args.common.quick);
-    options.maxIndexMb = args.maxIndexMb;
-    options.verdict = args.verdict;
+    const SweepOptions options = sweepOptionsOf("paper1", args);
 
     Progress progress("paper1", renderers.size() * args.ratesHz.size() * steps.size() * 3);
     const std::vector<SweepRow> rows = runSweep(renderers, steps, options, progress);

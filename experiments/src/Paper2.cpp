@@ -71,15 +71,7 @@ int runPaper2(const Paper2Args& args) {
         }
         steps.push_back(std::move(step));
     }
-    SweepOptions options;
-    options.experiment = "paper2";
-    options.ratesHz = args.ratesHz;
-    options.servo.durationS = args.common.durationS;
-    options.servo.repeats = args.common.repeats;
-    options.servo.realtime = args.common.realtime;
-    options.servo.tail = tailFor(args.common.quick);
-    options.maxIndexMb = args.maxIndexMb;
-    options.verdict = args.verdict;
+    const SweepOptions options = sweepOptionsOf("paper2", args);
 
     Progress progress("paper2", renderers.size() * args.ratesHz.size() * counts.size() *
                                     static_cast<std::size_t>(args.seeds) * 3);

@@ -22,6 +22,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hapto::experiments {
@@ -57,6 +58,22 @@ struct SweepOptions {
     double skipTickPeriods = 10.0;     ///< Skip a cell whose probed tick exceeds this many periods.
     Verdict verdict = Verdict::Design; ///< What "unstable" means for the stop rule.
 };
+
+/// The sweep options an experiment's arguments give: any `Args` with `ratesHz`, `common`
+/// (CommonArgs: duration, repeats, realtime, quick), `maxIndexMb` and `verdict`.
+/// [control]
+template <class Args> SweepOptions sweepOptionsOf(std::string experiment, const Args& args) {
+    SweepOptions options;
+    options.experiment = std::move(experiment);
+    options.ratesHz = args.ratesHz;
+    options.servo.durationS = args.common.durationS;
+    options.servo.repeats = args.common.repeats;
+    options.servo.realtime = args.common.realtime;
+    options.servo.tail = tailFor(args.common.quick);
+    options.maxIndexMb = args.maxIndexMb;
+    options.verdict = args.verdict;
+    return options;
+}
 
 /// One measured (or skipped) cell: renderer x rate x scene x condition.
 struct SweepRow {
