@@ -4,8 +4,8 @@
 // "takes" moves the ManualClock (ScriptedDevice::useClock). One [realtime] case runs real
 // group threads and checks only what eventually happens.
 
-#include "CubeScene.h"
 #include "ScriptedDevice.h"
+#include "SteppedRig.h"
 #include "TestSupport.h"
 
 #include "hapto/runtime/Runtime.h"
@@ -26,45 +26,17 @@ namespace {
 
 constexpr std::uint64_t kMs = 1'000'000;
 
-/// A stepped runtime of `count` scripted devices over the cube scene, `perThread` to a servo
-/// thread: device i presses into the cube at x = 0.004 i - 0.01.
-struct Rig {
-    ManualClock clock;
-    World world;
-    std::vector<ScriptedDevice*> devices;
-    std::unique_ptr<Runtime> runtime;
-    std::uint64_t t0 = 0;
-
+/// A stepped runtime of `count` scripted 1 kHz devices over the cube scene, `perThread` to a
+/// servo thread: device i presses into the cube at x = 0.004 i - 0.01.
+struct Rig : test::SteppedRig {
     Rig(int count, std::size_t perThread, std::function<void(int, ScriptedDevice&)> setup = {},
         RuntimeOptions options = {})
-        : world(cubeScene(), IndexSpec::parse("octree:2:0.005")) {
-        world.useClock(clock);
-        std::vector<RuntimeDevice> rds;
-        for (int i = 0; i < count; ++i) {
-            auto d = std::make_unique<ScriptedDevice>("d" + std::to_string(i),
-                                                      test::pressIntoCube(0.004 * i - 0.01));
-            d->useClock(&clock);
-            if (setup) {
-                setup(i, *d);
-            }
-            devices.push_back(d.get());
-            DeviceConfig c;
-            c.name = "d" + std::to_string(i);
-            c.kind = DeviceKind::Scripted;
-            c.rateHz = 1000;
-            c.maxForceN = 5.0;
-            rds.push_back({std::move(d), c, nullptr});
-        }
-        options.realtime = false;
+        : SteppedRig(count, 1000.0, std::move(setup), perThreadOptions(options, perThread)) {}
+
+    static RuntimeOptions perThreadOptions(RuntimeOptions options, std::size_t perThread) {
         options.devicesPerThread = perThread;
-        runtime = std::make_unique<Runtime>(world, std::move(rds), options);
+        return options;
     }
-    std::size_t start() {
-        t0 = clock.nowNs();
-        return runtime->startStepped(clock);
-    }
-    void runTo(double ms) { runtime->runUntil(t0 + static_cast<std::uint64_t>(ms * kMs)); }
-    DeviceReport report(std::size_t i) const { return runtime->report().devices.at(i); }
 };
 
 /// The forces device `d` was sent, in order.

@@ -3,8 +3,8 @@
 // gives the same bytes. Time a device "takes" (a stall, a slow tick, an absence) moves the
 // clock (ScriptedDevice::useClock).
 
-#include "CubeScene.h"
 #include "ScriptedDevice.h"
+#include "SteppedRig.h"
 #include "TestSupport.h"
 
 #include "hapto/devices/TraceReader.h"
@@ -28,52 +28,7 @@ namespace {
 
 constexpr std::uint64_t kMs = 1'000'000;
 
-/// A stepped runtime over the cube scene: device i presses into the cube at x = 0.004 i - 0.01.
-struct Rig {
-    ManualClock clock;
-    World world;
-    std::vector<ScriptedDevice*> devices;
-    std::unique_ptr<Runtime> runtime;
-    std::uint64_t t0 = 0; // the session's start
-
-    Rig(int count, double rateHz, std::function<void(int, ScriptedDevice&)> setup = {},
-        RuntimeOptions options = {}, Scene scene = cubeScene(),
-        std::vector<TraceRecorder*> recorders = {})
-        : world(std::move(scene), IndexSpec::parse("octree:2:0.005")) {
-        world.useClock(clock);
-        std::vector<RuntimeDevice> rds;
-        for (int i = 0; i < count; ++i) {
-            auto d = std::make_unique<ScriptedDevice>("d" + std::to_string(i),
-                                                      test::pressIntoCube(0.004 * i - 0.01));
-            d->useClock(&clock);
-            if (setup) {
-                setup(i, *d);
-            }
-            devices.push_back(d.get());
-            DeviceConfig c;
-            c.name = "d" + std::to_string(i);
-            c.kind = DeviceKind::Scripted;
-            c.rateHz = rateHz;
-            c.maxForceN = 5.0;
-            rds.push_back(
-                {std::move(d), c,
-                 static_cast<std::size_t>(i) < recorders.size() ? recorders[i] : nullptr});
-        }
-        options.realtime = false;
-        runtime = std::make_unique<Runtime>(world, std::move(rds), options);
-    }
-    std::size_t start() {
-        t0 = clock.nowNs();
-        return runtime->startStepped(clock);
-    }
-    /// Runs every device on its deadlines until t0 + ms.
-    void runTo(double ms) { runtime->runUntil(t0 + static_cast<std::uint64_t>(ms * kMs)); }
-    DeviceReport report(std::size_t i) const { return runtime->report().devices.at(i); }
-    Vec3 force(std::size_t i) const {
-        const DeviceMetrics& m = runtime->metrics(i);
-        return {m.forceN[0].load(), m.forceN[1].load(), m.forceN[2].load()};
-    }
-};
+using Rig = test::SteppedRig;
 
 /// Every force device `d` was sent after its read number `afterReads` (1-based count).
 std::vector<Vec3> forcesAfter(const ScriptedDevice& d, std::uint64_t afterReads) {
