@@ -187,7 +187,19 @@ std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
                             row.reachedPhase = row.reachedPhase && s.reached.at(0);
                         }
                         row.median = medianOf(row.runs);
-                        if (!row.reachedPhase) {
+                        const auto idle =
+                            std::find_if(row.runs.begin(), row.runs.end(),
+                                         [](const LoadFigures& f) { return f.ticks == 0; });
+                        if (idle != row.runs.end()) {
+                            // Nothing was measured: not a load of zero. Skipped, so it is
+                            // neither stable nor a limit.
+                            row.skipped = true;
+                            row.note = "no tick was measured in run " +
+                                       std::to_string(idle - row.runs.begin() + 1) + " of " +
+                                       std::to_string(row.runs.size()) +
+                                       ": the servo thread did not run in the timed window (an "
+                                       "overloaded machine?)";
+                        } else if (!row.reachedPhase) {
                             row.note = "the hand did not reach its " +
                                        std::string(conditionName(c)) + " phase before timing";
                         } else if (!row.median.fault.empty()) {
