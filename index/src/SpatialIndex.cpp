@@ -148,10 +148,10 @@ std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec) {
     });
     const std::uint64_t cellCount = n * n * n;
     // The counting sort (UniformGrid.cpp): cell offsets and the per-cell counters (which become
-    // the stats' counts); per item its id, pair offset and pair count; per pair its cell and
-    // item.
+    // the stats' counts); per item its id, pair offset, pair count and candidate range (8 bytes
+    // at most); per pair its cell and item.
     return (2 * cellCount + 1) * sizeof(std::uint32_t) + sizeof(std::uint64_t) +
-           count * (2 * sizeof(std::uint32_t) + sizeof(std::uint64_t)) +
+           count * (2 * sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t)) +
            pairs.load() * 2 * sizeof(std::uint32_t);
 }
 

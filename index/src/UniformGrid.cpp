@@ -90,8 +90,10 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
     // The candidate cell range of an item: the cells its AABB reaches, widened by the
     // overlap tolerance, plus the lower neighbour when that touches a cell's lower face
     // exactly (closed cells share faces); overlaps() then decides cell by cell.
+    // Kept per item between the two passes (n <= 256 cells per side fit a byte).
+    static_assert(IndexSpec::kMaxGridCells <= 256);
     struct Range {
-        std::uint32_t lo[3], hi[3];
+        std::uint8_t lo[3], hi[3];
         bool empty;
     };
     const auto rangeOf = [&](const OverlapShape& s) {
@@ -100,26 +102,29 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const Scene& scene, const IndexS
         const double tol = overlapTolerance(s, whole);
         for (int a = 0; a < 3 && !r.empty; ++a) {
             const double lo = s.aabb.min[a] - tol, hi = s.aabb.max[a] + tol;
-            r.lo[a] = g.cellIndex(lo, a);
-            if (r.lo[a] > 0 && lo <= axes[a].coord[r.lo[a]]) {
-                --r.lo[a];
+            std::uint32_t first = g.cellIndex(lo, a);
+            if (first > 0 && lo <= axes[a].coord[first]) {
+                --first;
             }
-            r.hi[a] = g.cellIndex(hi, a);
+            r.lo[a] = static_cast<std::uint8_t>(first);
+            r.hi[a] = static_cast<std::uint8_t>(g.cellIndex(hi, a));
         }
         return r;
     };
+    std::vector<Range> ranges(count);
     const auto rangeSize = [&](std::uint32_t k) -> std::uint64_t {
-        const Range r = rangeOf(OverlapShape::of(scene, items[k]));
-        return r.empty ? 0
-                       : std::uint64_t(r.hi[0] - r.lo[0] + 1) * (r.hi[1] - r.lo[1] + 1) *
-                             (r.hi[2] - r.lo[2] + 1);
+        const Range r = ranges[k] = rangeOf(OverlapShape::of(scene, items[k]));
+        return r.empty
+                   ? 0
+                   : std::uint64_t(r.hi[0] - r.lo[0] + 1) * std::uint64_t(r.hi[1] - r.lo[1] + 1) *
+                         std::uint64_t(r.hi[2] - r.lo[2] + 1);
     };
     const auto forEachCell = [&](std::uint32_t k, auto&& visit) {
-        const OverlapShape s = OverlapShape::of(scene, items[k]);
-        const Range r = rangeOf(s);
+        const Range r = ranges[k];
         if (r.empty) {
             return;
         }
+        const OverlapShape s = OverlapShape::of(scene, items[k]);
         const Axis &ax = axes[0], &ay = axes[1], &az = axes[2];
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z) {
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
