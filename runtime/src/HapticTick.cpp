@@ -7,7 +7,7 @@
 
 namespace hapto {
 
-static_assert(sizeof(HapticTick) == 3072, "update the size in HapticTick.h");
+static_assert(sizeof(HapticTick) == 9728, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
 
 namespace {
@@ -128,7 +128,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
         listed[listedCount++] = missed.leaf;
         ++out.extraLeaves;
     }
-    const GodObjectRenderer start = mRenderer; // a plain copy: no allocation
+    const GodObjectRenderer::State start = mRenderer.state(); // a plain copy: no allocation
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
     std::uint32_t tested = out.render.objectsTested;
     while (listedCount < listed.size()) {
@@ -144,7 +144,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
             break;
         }
         listed[listedCount++] = missed.leaf;
-        mRenderer = start;
+        mRenderer.restore(start);
         out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
         tested += out.render.objectsTested;
         ++out.extraLeaves;
