@@ -62,7 +62,7 @@
 
 namespace hapto {
 
-static_assert(sizeof(GodObjectRenderer) == 8064, "update the size in GodObjectRenderer.h");
+static_assert(sizeof(GodObjectRenderer) == 8576, "update the size in GodObjectRenderer.h");
 static_assert(alignof(GodObjectRenderer) == 64);
 
 namespace {
@@ -418,7 +418,7 @@ struct GodObjectRenderer::Hit {
     std::uint32_t item = 0; ///< A box or sphere slot, or a triangle item.
     int axis = -1;
     double sign = 0.0;
-    std::uint32_t near = kNotCached; ///< A triangle's place in mNearTriangleData, if there.
+    std::uint32_t near = kNotCached; ///< A triangle's place in mTriangleData, if there.
 };
 
 namespace {
@@ -505,6 +505,7 @@ void GodObjectRenderer::reset(const Vec3& devicePosition) noexcept {
     mState.contactCount = 0;
     mNearRadius = -1.0;
     mNearCount = 0;
+    mTriangleCount = 0;
     mNearOverflow = false;
     mNearTriangles = false;
 }
@@ -536,8 +537,8 @@ void GodObjectRenderer::forEachNear(const Scene& scene, const CandidateSet& cand
                                     Fn&& fn) const noexcept {
     if (!mNearOverflow) {
         for (std::uint32_t i = 0; i < mNearCount; ++i) {
-            const std::uint32_t item = mNear[i];
-            fn(item, i < kCachedNear && isTriangleItem(item) ? i : kNotCached);
+            const std::uint32_t cached = mNearCached[i];
+            fn(mNear[i], cached < kCachedTriangles ? cached : kNotCached);
         }
         return;
     }
@@ -566,7 +567,7 @@ double GodObjectRenderer::distanceToSkinOf(const Scene& scene, std::uint32_t ite
     if (near == kNotCached) {
         return itemDistanceToSkin(scene, item, p);
     }
-    const NearTriangle& t = mNearTriangleData[near];
+    const NearTriangle& t = mTriangleData[near];
     return triangleDistanceToSkin(
         t.face, [&]() -> const NearTriangle& { return t; }, p);
 }
@@ -588,16 +589,6 @@ bool GodObjectRenderer::addNear(std::uint32_t item) noexcept {
     return true;
 }
 
-void GodObjectRenderer::addNearTriangle(const Scene& scene, std::uint32_t item,
-                                        const WorldFace& face,
-                                        const std::array<Vec3, 3>& corners) noexcept {
-    if (addNear(item) && mNearCount <= kCachedNear) {
-        const EdgeNormals e = edgeNormals(corners, face.normal);
-        mNearTriangleData[mNearCount - 1] = {
-            face, corners, {e.inward, e.length2}, scene.objectSlotOf(item)};
-    }
-}
-
 void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candidates,
                                   const Vec3& center, double reach,
                                   std::uint32_t& tested) noexcept {
@@ -612,6 +603,7 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
     const double radius = (1.0 + kFrictionCover) * reach + kNearMarginM;
     const double triangleReach = mNearRadius + kSkinM;
     const std::uint32_t n = scene.size();
+    std::uint32_t triangles = 0; // valid triangle candidates so far (an item once)
     for (std::size_t s = 0; s < candidates.count && s < CandidateSet::kMaxSpans; ++s) {
         tested += static_cast<std::uint32_t>(candidates.spans[s].size());
         for (const std::uint32_t item : candidates.spans[s]) {
@@ -630,16 +622,37 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
             if (isTriangleItem(item)) {
                 if (validItem(scene, item)) {
                     mNearTriangles = true;
+                    // The k-th candidate triangle is the same in every list of the tick (the
+                    // same spans, in the same order): what an earlier list read, it reuses.
+                    const std::uint32_t k = triangles++;
+                    NearTriangle* t = k < kCachedTriangles ? &mTriangleData[k] : nullptr;
+                    if (t && (k >= mTriangleCount || t->item != item)) {
+                        *t = {item, 0, false, false, scene.triangleFace(item), {}, {}};
+                        mTriangleCount = k + 1;
+                    }
                     // The distance to the plane bounds the distance to the triangle: most
                     // candidates end at one dot product.
-                    const WorldFace f = scene.triangleFace(item);
+                    const WorldFace f = t ? t->face : scene.triangleFace(item);
                     if (std::abs(glm::dot(f.normal, center) - f.offset) > triangleReach) {
                         continue;
                     }
-                    const std::array<Vec3, 3> v = scene.triangleCorners(item);
-                    if (triangleDistance2(center, v) <= triangleReach * triangleReach) {
-                        addNearTriangle(scene, item, f, v);
+                    if (t && !t->hasCorners) {
+                        t->corners = scene.triangleCorners(item);
+                        t->hasCorners = true;
                     }
+                    const std::array<Vec3, 3> v = t ? t->corners : scene.triangleCorners(item);
+                    if (triangleDistance2(center, v) > triangleReach * triangleReach ||
+                        !addNear(item)) {
+                        continue;
+                    }
+                    if (t && !t->hasEdges) {
+                        const EdgeNormals e = edgeNormals(v, f.normal);
+                        t->edges = {e.inward, e.length2};
+                        t->mesh = scene.objectSlotOf(item);
+                        t->hasEdges = true;
+                    }
+                    mNearCached[mNearCount - 1] =
+                        static_cast<std::uint8_t>(t ? k : kCachedTriangles);
                 }
                 continue;
             }
@@ -656,11 +669,15 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
                 // ball, from the mesh's own frame.
                 mNearTriangles = true;
                 forEachMeshTriangleNear(scene, item, center, mNearRadius, [&](std::uint32_t t) {
-                    addNearTriangle(scene, t, scene.triangleFace(t), scene.triangleCorners(t));
+                    if (addNear(t)) {
+                        mNearCached[mNearCount - 1] = kCachedTriangles;
+                    }
                 });
                 continue;
             }
-            addNear(item);
+            if (addNear(item)) {
+                mNearCached[mNearCount - 1] = kCachedTriangles;
+            }
         }
     }
 }
@@ -671,7 +688,7 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
     forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t near) {
         Entry e;
         if (near != kNotCached) {
-            const NearTriangle& t = mNearTriangleData[near];
+            const NearTriangle& t = mTriangleData[near];
             e = sweepTriangle(
                 t.face, [&]() -> const NearTriangle& { return t; }, from, to);
         } else if (isTriangleItem(item)) {
@@ -746,7 +763,7 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
             }
             pruneNonBinding(p);
             if (isTriangleItem(hit.item)) {
-                const WorldFace tp = hit.near != kNotCached ? mNearTriangleData[hit.near].face
+                const WorldFace tp = hit.near != kNotCached ? mTriangleData[hit.near].face
                                                             : scene.triangleFace(hit.item);
                 if (!addPlane({tp.normal, tp.offset + kSkinM, hit.item, hit.near})) {
                     break;
@@ -755,13 +772,13 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
                 // proxy is on its skin plane, over it grown by the skin, as on a box's edge)
                 // that the goal is behind. Coplanar neighbours give the same plane, which
                 // addPlane keeps once.
-                const std::uint32_t mesh = hit.near != kNotCached ? mNearTriangleData[hit.near].mesh
+                const std::uint32_t mesh = hit.near != kNotCached ? mTriangleData[hit.near].mesh
                                                                   : scene.objectSlotOf(hit.item);
                 forEachNear(scene, candidates, [&](std::uint32_t other, std::uint32_t near) {
                     if (other == hit.item || !isTriangleItem(other)) {
                         return;
                     }
-                    const NearTriangle* t = near != kNotCached ? &mNearTriangleData[near] : nullptr;
+                    const NearTriangle* t = near != kNotCached ? &mTriangleData[near] : nullptr;
                     if ((t ? t->mesh : scene.objectSlotOf(other)) != mesh) {
                         return;
                     }
@@ -849,6 +866,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     ++mState.counters.ticks;
     mNearRadius = -1.0;
     mNearCount = 0;
+    mTriangleCount = 0;
     mNearOverflow = false;
     mNearTriangles = false;
     if (!finite(devicePosition)) {

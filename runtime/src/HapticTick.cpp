@@ -7,7 +7,7 @@
 
 namespace hapto {
 
-static_assert(sizeof(HapticTick) == 9728, "update the size in HapticTick.h");
+static_assert(sizeof(HapticTick) == 10240, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
 
 namespace {

@@ -64,9 +64,10 @@ struct RenderOutput {
 /// Ruspini et al. 1997) and Coulomb friction. One instance per device: it holds that device's
 /// proxy and scratch space, shares nothing, and never allocates after construction.
 ///
-/// Size: 8064 bytes (64-byte aligned; checked by a static_assert in the source file), of which
-/// 1024 are the near-object scratch list and 6656 the copy of its first 32 triangles (plane,
-/// corners, edges: 208 bytes each). A tick solved again restores only the 296-byte State.
+/// Size: 8576 bytes (64-byte aligned; checked by a static_assert in the source file), of which
+/// 1280 are the near-object scratch list and 6912 the tick's copy of its first 32 candidate
+/// triangles (plane, corners, edges: 216 bytes each). A tick solved again restores only the
+/// 296-byte State.
 class alignas(64) GodObjectRenderer {
 public:
     /// Constraint planes solved at once (a corner needs three).
@@ -150,11 +151,17 @@ private:
         Vec3 normal{0.0};
         double offset = 0.0;
         std::uint32_t item = 0;
-        std::uint32_t near = kNotCached; ///< The item's place in mNearTriangleData, if there.
+        std::uint32_t near = kNotCached; ///< The item's place in mTriangleData, if there.
     };
-    /// A near triangle's world plane, corners and mesh slot, made once when the near list is
-    /// built: the solver's passes read this compact array, not the scene's meshes.
+    /// A candidate triangle as the near list reads it: its world plane, read once per tick,
+    /// and for a triangle that got near, its corners, edges and mesh slot; so that a second
+    /// near list (the friction solve's) reads nothing from the scene again, and the solver's
+    /// passes read this compact array, not the scene's meshes.
     struct NearTriangle {
+        std::uint32_t item = 0;
+        std::uint32_t mesh = 0; ///< Its mesh's slot, once `hasEdges`.
+        bool hasCorners = false;
+        bool hasEdges = false;
         WorldFace face;
         std::array<Vec3, 3> corners{};
         /// Its edges in its plane: inward[i] = normal x (corner i+1 - corner i), length2[i] its
@@ -163,11 +170,10 @@ private:
             std::array<Vec3, 3> inward{};
             std::array<double, 3> length2{};
         } edges;
-        std::uint32_t mesh = 0;
     };
-    /// Near-list entries (the first ones) whose triangle is kept in mNearTriangleData; a
-    /// triangle past them is read from the scene, as the raw spans' are.
-    static constexpr std::size_t kCachedNear = 32;
+    /// Candidate triangles (the first ones, in the candidates' order) kept in mTriangleData
+    /// per tick; the near list reads a triangle past them from the scene, as the raw spans'.
+    static constexpr std::size_t kCachedTriangles = 32;
     static constexpr std::uint32_t kNotCached = 0xffffffffu;
     /// Where a solve ended.
     struct Solve {
@@ -193,13 +199,11 @@ private:
     template <class Fn>
     void forEachMeshTriangleNear(const Scene& scene, std::uint32_t slot, const Vec3& center,
                                  double radius, Fn&& fn) const noexcept;
-    /// Distance (m) from p to an item's skin, 0 inside; a cached near triangle's (`near` <
-    /// kCachedNear) from its copy.
+    /// Distance (m) from p to an item's skin, 0 inside; a cached triangle's (`near` <
+    /// kCachedTriangles) from its copy.
     double distanceToSkinOf(const Scene& scene, std::uint32_t item, std::uint32_t near,
                             const Vec3& p) const noexcept;
     bool addNear(std::uint32_t item) noexcept;
-    void addNearTriangle(const Scene& scene, std::uint32_t item, const WorldFace& face,
-                         const std::array<Vec3, 3>& corners) noexcept;
 
     RendererConfig mConfig;
     State mState;
@@ -213,8 +217,10 @@ private:
     bool mNearTriangles = false; ///< The list saw triangles: its triangle ball is the tight one.
     std::uint32_t mNearCount = 0;
     std::array<std::uint32_t, kMaxNearObjects> mNear{};
-    /// mNear[i]'s plane and corners, for a triangle at i < kCachedNear.
-    std::array<NearTriangle, kCachedNear> mNearTriangleData{};
+    /// mNear[i]'s place in mTriangleData, or kNotCached (boxes, spheres, triangles past it).
+    std::array<std::uint8_t, kMaxNearObjects> mNearCached{};
+    std::uint32_t mTriangleCount = 0; ///< mTriangleData entries read this tick.
+    std::array<NearTriangle, kCachedTriangles> mTriangleData{};
 };
 
 } // namespace hapto
