@@ -78,6 +78,10 @@ public:
     /// a pressing tool adds the few triangles around the contact, not every triangle in a
     /// millimetre.
     static constexpr std::size_t kMaxNearObjects = 256;
+    /// Candidate triangles (a tick's first ones, in the candidates' order) whose plane, corners
+    /// and edges the renderer copies once per tick for its near lists and solver passes; a
+    /// triangle past them is read from the scene each time (the same result, more slowly).
+    static constexpr std::size_t kCachedTriangles = 32;
     /// Upper bound for RendererConfig::maxIterations.
     static constexpr std::uint32_t kMaxIterations = 32;
     /// The proxy rides this far (m) outside every surface: a 10 nm skin that closes the cracks
@@ -171,9 +175,6 @@ private:
             std::array<double, 3> length2{};
         } edges;
     };
-    /// Candidate triangles (the first ones, in the candidates' order) kept in mTriangleData
-    /// per tick; the near list reads a triangle past them from the scene, as the raw spans'.
-    static constexpr std::size_t kCachedTriangles = 32;
     static constexpr std::uint32_t kNotCached = 0xffffffffu;
     /// Where a solve ended.
     struct Solve {
