@@ -627,7 +627,11 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
                     const std::uint32_t k = triangles++;
                     NearTriangle* t = k < kCachedTriangles ? &mTriangleData[k] : nullptr;
                     if (t && (k >= mTriangleCount || t->item != item)) {
-                        *t = {item, 0, false, false, scene.triangleFace(item), {}, {}};
+                        // Field by field: the corners and edges are written when first needed.
+                        t->item = item;
+                        t->hasCorners = false;
+                        t->hasEdges = false;
+                        t->face = scene.triangleFace(item);
                         mTriangleCount = k + 1;
                     }
                     // The distance to the plane bounds the distance to the triangle: most
