@@ -645,8 +645,13 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
                         t->hasCorners = true;
                     }
                     const std::array<Vec3, 3> v = t ? t->corners : scene.triangleCorners(item);
-                    if (triangleDistance2(center, v) > triangleReach * triangleReach ||
-                        !addNear(item)) {
+                    // A corner well inside the ball (by far more than rounding) makes the
+                    // triangle near without the closest-point test.
+                    const double r2 = triangleReach * triangleReach;
+                    const bool cornerInside =
+                        std::min({length2(v[0] - center), length2(v[1] - center),
+                                  length2(v[2] - center)}) < r2 * (1.0 - 1e-9);
+                    if ((!cornerInside && triangleDistance2(center, v) > r2) || !addNear(item)) {
                         continue;
                     }
                     if (t && !t->hasEdges) {
