@@ -62,7 +62,7 @@
 
 namespace hapto {
 
-static_assert(sizeof(GodObjectRenderer) == 1408, "update the size in GodObjectRenderer.h");
+static_assert(sizeof(GodObjectRenderer) == 8576, "update the size in GodObjectRenderer.h");
 static_assert(alignof(GodObjectRenderer) == 64);
 
 namespace {
@@ -240,28 +240,45 @@ double triangleDistance2(const Vec3& p, const std::array<Vec3, 3>& v) {
     return length2(p - closestOnTriangle(p, v));
 }
 
-/// How far (m) p's projection onto the plane of triangle v (unit normal n) lies outside the
-/// farthest of its three edge lines; <= 0 over the triangle.
-double outsideEdges(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n) {
+/// A triangle's edges in its plane: inward[i] is perpendicular to the edge v[i] -> v[i+1]
+/// (v's unit normal n crossed with it), points into the triangle and is as long as the edge;
+/// length2[i] is its squared length. Made once per near triangle per tick, or on the spot.
+struct EdgeNormals {
+    std::array<Vec3, 3> inward{};
+    std::array<double, 3> length2{};
+};
+
+EdgeNormals edgeNormals(const std::array<Vec3, 3>& v, const Vec3& n) {
+    EdgeNormals e;
+    for (int i = 0; i < 3; ++i) {
+        e.inward[i] = glm::cross(n, v[(i + 1) % 3] - v[i]);
+        e.length2[i] = glm::dot(e.inward[i], e.inward[i]);
+    }
+    return e;
+}
+
+/// How far (m) p's projection onto the plane of triangle v (edges e: an EdgeNormals, or the
+/// near list's copy of one) lies outside the farthest of its three edge lines; <= 0 over the
+/// triangle.
+double outsideEdges(const Vec3& p, const std::array<Vec3, 3>& v, const auto& e) {
     double worst = -kInf;
     for (int i = 0; i < 3; ++i) {
-        const Vec3 inward = glm::cross(n, v[(i + 1) % 3] - v[i]); // |inward| = the edge's length
-        worst = std::max(worst, -glm::dot(inward, p - v[i]) / glm::length(inward));
+        worst = std::max(worst, -glm::dot(e.inward[i], p - v[i]) / std::sqrt(e.length2[i]));
     }
     return worst;
 }
 
-/// True when p projects into triangle v grown by `margin` (m) across each edge, as a box face's
-/// skin grows across its edges (square corners), with a sliver's sharp corners cut at 1.5 x
-/// margin from the triangle.
+/// True when p projects into triangle v (unit normal n, edges e) grown by `margin` (m) across
+/// each edge, as a box face's skin grows across its edges (square corners), with a sliver's
+/// sharp corners cut at 1.5 x margin from the triangle.
 /// outsideEdges without its square roots: each edge compares squares.
-bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n, double margin) {
+bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n, const auto& e,
+                       double margin) {
     bool over = true; // p projects into the triangle itself
     for (int i = 0; i < 3; ++i) {
-        const Vec3 inward = glm::cross(n, v[(i + 1) % 3] - v[i]);
-        const double out = -glm::dot(inward, p - v[i]); // distance outside x |inward|
+        const double out = -glm::dot(e.inward[i], p - v[i]); // distance outside x |inward|
         if (out > 0.0) {
-            if (out * out > margin * margin * glm::dot(inward, inward)) {
+            if (out * out > margin * margin * e.length2[i]) {
                 return false;
             }
             over = false;
@@ -274,6 +291,22 @@ bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& 
     return triangleDistance2(onPlane, v) <= 2.25 * margin * margin;
 }
 
+bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n, double margin) {
+    return overGrownTriangle(p, v, n, edgeNormals(v, n), margin);
+}
+
+/// A triangle's corners and edges read from the scene (m, world), for one not in the near
+/// list's copy.
+struct FetchedTriangle {
+    std::array<Vec3, 3> corners;
+    EdgeNormals edges;
+};
+
+FetchedTriangle fetchTriangle(const Scene& scene, std::uint32_t item, const Vec3& normal) {
+    const std::array<Vec3, 3> v = scene.triangleCorners(item);
+    return {v, edgeNormals(v, normal)};
+}
+
 /// The swept test of one triangle, entered only from its front (outward) side. The path is
 /// stopped where it would enter the triangle's skin slab (the plane kSkinM in front, shrunk by
 /// kShrinkM) at a point over the triangle grown by kSkinM across its edges (so the skins of
@@ -282,10 +315,11 @@ bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& 
 /// mesh, whatever its dihedral angles). A path that starts behind the triangle's plane, or
 /// does not go deeper, passes.
 ///
-/// The plane comes first (two dot products reject most triangles); the corners are fetched
-/// only for a path that reaches the skin slab.
-Entry sweepTriangle(const Scene& scene, std::uint32_t item, const Vec3& from, const Vec3& to) {
-    const WorldFace tp = scene.triangleFace(item);
+/// The plane comes first (two dot products reject most triangles); the corners and edges
+/// (`geometry()`: the near list's copy, or a FetchedTriangle) are read only for a path that
+/// reaches the skin slab.
+template <class GeometryFn>
+Entry sweepTriangle(const WorldFace& tp, GeometryFn&& geometry, const Vec3& from, const Vec3& to) {
     if (tp.normal == Vec3(0.0)) {
         return {};
     }
@@ -306,10 +340,10 @@ Entry sweepTriangle(const Scene& scene, std::uint32_t item, const Vec3& from, co
         return {};
     }
     const Vec3 d = to - from;
-    const std::array<Vec3, 3> v = scene.triangleCorners(item);
-    bool over = overGrownTriangle(from + t * d, v, tp.normal, kSkinM);
+    const auto& g = geometry();
+    bool over = overGrownTriangle(from + t * d, g.corners, tp.normal, g.edges, kSkinM);
     if (!over && st < 0.0) {
-        over = overGrownTriangle(from + (sf / (sf - st)) * d, v, tp.normal, kOnM);
+        over = overGrownTriangle(from + (sf / (sf - st)) * d, g.corners, tp.normal, g.edges, kOnM);
     }
     if (!over) {
         return {};
@@ -354,16 +388,22 @@ void visitMeshTrianglesNear(const TriangleMesh& mesh, const Aabb& localBox, Fn&&
 
 /// Distance (m) from p to an item's skin, 0 inside. A triangle's skin, like a box face's: the
 /// points within kSkinM of its plane over the triangle grown by kSkinM across its edges.
+template <class GeometryFn>
+double triangleDistanceToSkin(const WorldFace& tp, GeometryFn&& geometry, const Vec3& p) {
+    if (tp.normal == Vec3(0.0)) {
+        return kInf;
+    }
+    const double up = std::max(0.0, std::abs(glm::dot(tp.normal, p) - tp.offset) - kSkinM);
+    const auto& g = geometry();
+    const double out = std::max(0.0, outsideEdges(p, g.corners, g.edges) - kSkinM);
+    return std::sqrt(up * up + out * out);
+}
+
 double itemDistanceToSkin(const Scene& scene, std::uint32_t item, const Vec3& p) {
     if (isTriangleItem(item)) {
         const WorldFace tp = scene.triangleFace(item);
-        if (tp.normal == Vec3(0.0)) {
-            return kInf;
-        }
-        const double up = std::max(0.0, std::abs(glm::dot(tp.normal, p) - tp.offset) - kSkinM);
-        const double out =
-            std::max(0.0, outsideEdges(p, scene.triangleCorners(item), tp.normal) - kSkinM);
-        return std::sqrt(up * up + out * out);
+        return triangleDistanceToSkin(
+            tp, [&] { return fetchTriangle(scene, item, tp.normal); }, p);
     }
     return distanceToSkin(scene.body(item), p);
 }
@@ -378,6 +418,7 @@ struct GodObjectRenderer::Hit {
     std::uint32_t item = 0; ///< A box or sphere slot, or a triangle item.
     int axis = -1;
     double sign = 0.0;
+    std::uint32_t near = kNotCached; ///< A triangle's place in mTriangleData, if there.
 };
 
 namespace {
@@ -457,13 +498,14 @@ GodObjectRenderer::GodObjectRenderer(const RendererConfig& config) : mConfig(con
 }
 
 void GodObjectRenderer::reset(const Vec3& devicePosition) noexcept {
-    mProxy = devicePosition;
-    mLastDevice = devicePosition;
-    mHasLastDevice = finite(devicePosition);
-    mSlipping = false;
-    mContactCount = 0;
+    mState.proxy = devicePosition;
+    mState.lastDevice = devicePosition;
+    mState.hasLastDevice = finite(devicePosition);
+    mState.slipping = false;
+    mState.contactCount = 0;
     mNearRadius = -1.0;
     mNearCount = 0;
+    mTriangleCount = 0;
     mNearOverflow = false;
     mNearTriangles = false;
 }
@@ -495,7 +537,8 @@ void GodObjectRenderer::forEachNear(const Scene& scene, const CandidateSet& cand
                                     Fn&& fn) const noexcept {
     if (!mNearOverflow) {
         for (std::uint32_t i = 0; i < mNearCount; ++i) {
-            fn(mNear[i]);
+            const std::uint32_t cached = mNearCached[i];
+            fn(mNear[i], cached < kCachedTriangles ? cached : kNotCached);
         }
         return;
     }
@@ -507,31 +550,43 @@ void GodObjectRenderer::forEachNear(const Scene& scene, const CandidateSet& cand
         for (const std::uint32_t item : candidates.spans[s]) {
             if (isTriangleItem(item)) {
                 if (validItem(scene, item)) {
-                    fn(item);
+                    fn(item, kNotCached);
                 }
             } else if (item < n && scene.object(item).shape == Shape::Mesh) {
-                forEachMeshTriangleNear(scene, item, mNearCenter, mNearRadius, fn);
+                forEachMeshTriangleNear(scene, item, mNearCenter, mNearRadius,
+                                        [&](std::uint32_t t) { fn(t, kNotCached); });
             } else if (item < n) {
-                fn(item);
+                fn(item, kNotCached);
             }
         }
     }
 }
 
-void GodObjectRenderer::addNear(std::uint32_t item) noexcept {
+double GodObjectRenderer::distanceToSkinOf(const Scene& scene, std::uint32_t item,
+                                           std::uint32_t near, const Vec3& p) const noexcept {
+    if (near == kNotCached) {
+        return itemDistanceToSkin(scene, item, p);
+    }
+    const NearTriangle& t = mTriangleData[near];
+    return triangleDistanceToSkin(
+        t.face, [&]() -> const NearTriangle& { return t; }, p);
+}
+
+bool GodObjectRenderer::addNear(std::uint32_t item) noexcept {
     if (mNearOverflow) {
-        return;
+        return false;
     }
     for (std::uint32_t k = 0; k < mNearCount; ++k) {
         if (mNear[k] == item) {
-            return;
+            return false;
         }
     }
     if (mNearCount == kMaxNearObjects) {
         mNearOverflow = true;
-        return;
+        return false;
     }
     mNear[mNearCount++] = item;
+    return true;
 }
 
 void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candidates,
@@ -548,23 +603,65 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
     const double radius = (1.0 + kFrictionCover) * reach + kNearMarginM;
     const double triangleReach = mNearRadius + kSkinM;
     const std::uint32_t n = scene.size();
+    std::uint32_t triangles = 0; // valid triangle candidates so far (an item once)
     for (std::size_t s = 0; s < candidates.count && s < CandidateSet::kMaxSpans; ++s) {
         tested += static_cast<std::uint32_t>(candidates.spans[s].size());
         for (const std::uint32_t item : candidates.spans[s]) {
             if (mNearOverflow) {
                 break;
             }
+            // Neighbouring leaves share the triangles that straddle them: an item an earlier
+            // span listed was decided there (the same test gives the same answer). Leaf lists
+            // are sorted; an unsorted span (the moving list) is only ever not found in.
+            if (std::any_of(candidates.spans.begin(), candidates.spans.begin() + s,
+                            [&](const std::span<const std::uint32_t> earlier) {
+                                return std::binary_search(earlier.begin(), earlier.end(), item);
+                            })) {
+                continue;
+            }
             if (isTriangleItem(item)) {
                 if (validItem(scene, item)) {
                     mNearTriangles = true;
+                    // The k-th candidate triangle is the same in every list of the tick (the
+                    // same spans, in the same order): what an earlier list read, it reuses.
+                    const std::uint32_t k = triangles++;
+                    NearTriangle* t = k < kCachedTriangles ? &mTriangleData[k] : nullptr;
+                    if (t && (k >= mTriangleCount || t->item != item)) {
+                        // Field by field: the corners and edges are written when first needed.
+                        t->item = item;
+                        t->hasCorners = false;
+                        t->hasEdges = false;
+                        t->face = scene.triangleFace(item);
+                        mTriangleCount = k + 1;
+                    }
                     // The distance to the plane bounds the distance to the triangle: most
                     // candidates end at one dot product.
-                    const WorldFace f = scene.triangleFace(item);
-                    if (std::abs(glm::dot(f.normal, center) - f.offset) <= triangleReach &&
-                        triangleDistance2(center, scene.triangleCorners(item)) <=
-                            triangleReach * triangleReach) {
-                        addNear(item);
+                    const WorldFace f = t ? t->face : scene.triangleFace(item);
+                    if (std::abs(glm::dot(f.normal, center) - f.offset) > triangleReach) {
+                        continue;
                     }
+                    if (t && !t->hasCorners) {
+                        t->corners = scene.triangleCorners(item);
+                        t->hasCorners = true;
+                    }
+                    const std::array<Vec3, 3> v = t ? t->corners : scene.triangleCorners(item);
+                    // A corner well inside the ball (by far more than rounding) makes the
+                    // triangle near without the closest-point test.
+                    const double r2 = triangleReach * triangleReach;
+                    const bool cornerInside =
+                        std::min({length2(v[0] - center), length2(v[1] - center),
+                                  length2(v[2] - center)}) < r2 * (1.0 - 1e-9);
+                    if ((!cornerInside && triangleDistance2(center, v) > r2) || !addNear(item)) {
+                        continue;
+                    }
+                    if (t && !t->hasEdges) {
+                        const EdgeNormals e = edgeNormals(v, f.normal);
+                        t->edges = {e.inward, e.length2};
+                        t->mesh = scene.objectSlotOf(item);
+                        t->hasEdges = true;
+                    }
+                    mNearCached[mNearCount - 1] =
+                        static_cast<std::uint8_t>(t ? k : kCachedTriangles);
                 }
                 continue;
             }
@@ -580,11 +677,16 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
                 // A moving mesh (or an index that holds whole meshes): its triangles near the
                 // ball, from the mesh's own frame.
                 mNearTriangles = true;
-                forEachMeshTriangleNear(scene, item, center, mNearRadius,
-                                        [&](std::uint32_t t) { addNear(t); });
+                forEachMeshTriangleNear(scene, item, center, mNearRadius, [&](std::uint32_t t) {
+                    if (addNear(t)) {
+                        mNearCached[mNearCount - 1] = kCachedTriangles;
+                    }
+                });
                 continue;
             }
-            addNear(item);
+            if (addNear(item)) {
+                mNearCached[mNearCount - 1] = kCachedTriangles;
+            }
         }
     }
 }
@@ -592,17 +694,23 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
 GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const CandidateSet& candidates,
                                                 const Vec3& from, const Vec3& to) const noexcept {
     Hit best;
-    forEachNear(scene, candidates, [&](std::uint32_t item) {
+    forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t near) {
         Entry e;
-        if (isTriangleItem(item)) {
-            e = sweepTriangle(scene, item, from, to);
+        if (near != kNotCached) {
+            const NearTriangle& t = mTriangleData[near];
+            e = sweepTriangle(
+                t.face, [&]() -> const NearTriangle& { return t; }, from, to);
+        } else if (isTriangleItem(item)) {
+            const WorldFace tp = scene.triangleFace(item);
+            e = sweepTriangle(
+                tp, [&] { return fetchTriangle(scene, item, tp.normal); }, from, to);
         } else {
             const RenderBody& o = scene.body(item);
             e = o.shape == Shape::Sphere ? sweepSphere(o.center, o.halfExtents.x, from, to)
                                          : sweepBox(o, from, to);
         }
         if (e.found && e.t < best.t) {
-            best = {true, e.t, e.tStop, item, e.axis, e.sign};
+            best = {true, e.t, e.tStop, item, e.axis, e.sign, near};
         }
     });
     return best;
@@ -612,7 +720,7 @@ bool GodObjectRenderer::covered(const Scene& scene, const CandidateSet& candidat
                                 const Vec3& probe, std::uint32_t self) const noexcept {
     bool inside = false;
     // Boxes and spheres only: flush meshes are not looked for (see DESIGN, "Triangles").
-    forEachNear(scene, candidates, [&](std::uint32_t item) {
+    forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t) {
         if (!inside && item != self && !isTriangleItem(item)) {
             inside = insideSkin(scene.body(item), probe);
         }
@@ -664,30 +772,36 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
             }
             pruneNonBinding(p);
             if (isTriangleItem(hit.item)) {
-                const WorldFace tp = scene.triangleFace(hit.item);
-                if (!addPlane({tp.normal, tp.offset + kSkinM, hit.item})) {
+                const WorldFace tp = hit.near != kNotCached ? mTriangleData[hit.near].face
+                                                            : scene.triangleFace(hit.item);
+                if (!addPlane({tp.normal, tp.offset + kSkinM, hit.item, hit.near})) {
                     break;
                 }
                 // On an edge or a vertex: every other triangle of the same mesh there (the
                 // proxy is on its skin plane, over it grown by the skin, as on a box's edge)
                 // that the goal is behind. Coplanar neighbours give the same plane, which
                 // addPlane keeps once.
-                const std::uint32_t mesh = scene.objectSlotOf(hit.item);
-                forEachNear(scene, candidates, [&](std::uint32_t other) {
-                    if (other == hit.item || !isTriangleItem(other) ||
-                        scene.objectSlotOf(other) != mesh) {
+                const std::uint32_t mesh = hit.near != kNotCached ? mTriangleData[hit.near].mesh
+                                                                  : scene.objectSlotOf(hit.item);
+                forEachNear(scene, candidates, [&](std::uint32_t other, std::uint32_t near) {
+                    if (other == hit.item || !isTriangleItem(other)) {
                         return;
                     }
-                    const WorldFace op = scene.triangleFace(other);
+                    const NearTriangle* t = near != kNotCached ? &mTriangleData[near] : nullptr;
+                    if ((t ? t->mesh : scene.objectSlotOf(other)) != mesh) {
+                        return;
+                    }
+                    const WorldFace op = t ? t->face : scene.triangleFace(other);
                     const double offset = op.offset + kSkinM;
                     if (op.normal == Vec3(0.0) ||
                         glm::dot(op.normal, goal) >= offset - kFeasibleM ||
                         glm::dot(op.normal, p) < offset - kOnM ||
-                        !overGrownTriangle(p, scene.triangleCorners(other), op.normal,
-                                           kSkinM + kOnM)) {
+                        !(t ? overGrownTriangle(p, t->corners, op.normal, t->edges, kSkinM + kOnM)
+                            : overGrownTriangle(p, scene.triangleCorners(other), op.normal,
+                                                kSkinM + kOnM))) {
                         return;
                     }
-                    addPlane({op.normal, offset, other});
+                    addPlane({op.normal, offset, other, near});
                 });
                 continue;
             }
@@ -738,7 +852,9 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
         // Drop planes whose object the proxy has slid off; then sweep on toward the goal.
         std::uint32_t kept = 0;
         for (std::uint32_t i = 0; i < s.planeCount; ++i) {
-            if (itemDistanceToSkin(scene, s.planes[i].item, p) <= kOnM) {
+            const Plane& plane = s.planes[i];
+            const double away = distanceToSkinOf(scene, plane.item, plane.near, p);
+            if (away <= kOnM) {
                 s.planes[kept++] = s.planes[i];
             }
         }
@@ -756,35 +872,36 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
                                        const Vec3& devicePosition, const Vec3& deviceVelocity,
                                        double dtSeconds) noexcept {
     RenderOutput out;
-    ++mCounters.ticks;
+    ++mState.counters.ticks;
     mNearRadius = -1.0;
     mNearCount = 0;
+    mTriangleCount = 0;
     mNearOverflow = false;
     mNearTriangles = false;
     if (!finite(devicePosition)) {
         out.status = RenderStatus::NonFiniteInput;
-        out.proxy = mProxy;
-        ++mCounters.nonFiniteInput;
+        out.proxy = mState.proxy;
+        ++mState.counters.nonFiniteInput;
         return out;
     }
-    if (!finite(mProxy)) {
+    if (!finite(mState.proxy)) {
         reset(devicePosition);
     }
     Vec3 velocity = deviceVelocity;
     if (!finite(velocity)) {
         velocity = Vec3(0.0);
-        if (mHasLastDevice && dtSeconds > 0.0 && std::isfinite(dtSeconds)) {
-            velocity = (devicePosition - mLastDevice) / dtSeconds;
+        if (mState.hasLastDevice && dtSeconds > 0.0 && std::isfinite(dtSeconds)) {
+            velocity = (devicePosition - mState.lastDevice) / dtSeconds;
             if (!finite(velocity)) {
                 velocity = Vec3(0.0);
             }
         }
     }
-    mLastDevice = devicePosition;
-    mHasLastDevice = true;
+    mState.lastDevice = devicePosition;
+    mState.hasLastDevice = true;
 
     const Vec3 goal = devicePosition;
-    Vec3 start = mProxy;
+    Vec3 start = mState.proxy;
     std::uint32_t tested = 0;
     // Every point the proxy visits while solving toward g lies within |start - g| of g.
     auto ensureNear = [&](const Vec3& g, double need) {
@@ -801,9 +918,9 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     // A touched object that moved carries the proxy with it: friction holds in the object's
     // frame, so an object that is pushed, carried or grasped takes its contact point along.
     // A touched triangle carries the proxy with its mesh's pose.
-    for (std::uint32_t i = 0; i < mContactCount; ++i) {
-        const std::uint32_t item = mContactSlots[i];
-        const ContactPose& was = mContactPoses[i];
+    for (std::uint32_t i = 0; i < mState.contactCount; ++i) {
+        const std::uint32_t item = mState.contactSlots[i];
+        const State::ContactPose& was = mState.contactPoses[i];
         if (!validItem(scene, item) || scene.object(scene.objectSlotOf(item)).id != was.id) {
             continue; // the world was re-indexed and the item now names another object
         }
@@ -817,14 +934,15 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
 
     // A touched object that moved into the proxy pushes it back out to its surface (a touched
     // mesh has carried the proxy in its own frame above, so it stays on its skin).
-    if (mContactCount > 0) {
-        forEachNear(scene, candidates, [&](std::uint32_t slot) {
+    if (mState.contactCount > 0) {
+        forEachNear(scene, candidates, [&](std::uint32_t slot, std::uint32_t) {
             if (isTriangleItem(slot)) {
                 return;
             }
             const RenderBody& o = scene.body(slot);
-            if (std::find(mContactSlots.begin(), mContactSlots.begin() + mContactCount, slot) !=
-                    mContactSlots.begin() + mContactCount &&
+            if (std::find(mState.contactSlots.begin(),
+                          mState.contactSlots.begin() + mState.contactCount,
+                          slot) != mState.contactSlots.begin() + mState.contactCount &&
                 insideSkin(o, start)) {
                 start = pushOut(o, start);
             }
@@ -853,22 +971,23 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     const double penetration = glm::length(toFree);
     if (freeContacts > 0 && penetration > 0.0 && (muStatic > 0.0 || muDynamic > 0.0)) {
         const Vec3 n = toFree / penetration;
-        const Vec3 anchor = mContactCount > 0 ? start : (free.touched ? free.firstTouch : start);
-        const double mu = mSlipping ? muDynamic : muStatic;
+        const Vec3 anchor =
+            mState.contactCount > 0 ? start : (free.touched ? free.firstTouch : start);
+        const double mu = mState.slipping ? muDynamic : muStatic;
         const Vec3 rel = anchor - goal;
         const double normal = glm::dot(n, rel);
         const double tangential = glm::length(rel - normal * n);
         // The anchor must still rest on something (an object may have moved away under it).
         bool anchorTouches = false;
-        forEachNear(scene, candidates, [&](std::uint32_t item) {
-            anchorTouches = anchorTouches || itemDistanceToSkin(scene, item, anchor) <= kOnM;
+        forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t near) {
+            anchorTouches = anchorTouches || distanceToSkinOf(scene, item, near, anchor) <= kOnM;
         });
         if (anchorTouches && normal > 0.0 && tangential <= mu * normal + 1e-12) {
             stuck = true;
-            mSlipping = false;
+            mState.slipping = false;
             fin.proxy = anchor;
         } else {
-            mSlipping = true;
+            mState.slipping = true;
             const Vec3 lag = anchor - free.proxy;
             const Vec3 lagT = lag - glm::dot(n, lag) * n;
             const double lagLen = glm::length(lagT);
@@ -910,7 +1029,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
             }
         }
     } else {
-        mSlipping = false;
+        mState.slipping = false;
     }
 
     out.proxy = fin.proxy;
@@ -920,28 +1039,28 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     out.objectsTested = tested;
     if (mNearOverflow) {
         out.status = RenderStatus::NearListFull;
-        ++mCounters.nearListFull;
+        ++mState.counters.nearListFull;
     } else if (candidates.overflowed) {
         out.status = RenderStatus::CandidatesDropped;
     }
     if (candidates.overflowed) {
-        ++mCounters.candidatesDropped;
+        ++mState.counters.candidatesDropped;
     }
     if (!finite(out.force) || !finite(out.proxy)) {
         out.status = RenderStatus::NonFiniteOutput;
-        ++mCounters.nonFiniteOutput;
+        ++mState.counters.nonFiniteOutput;
         out.force = Vec3(0.0);
         out.proxy = finite(start) ? start : goal;
         out.contactCount = 0;
         out.sliding = false;
     }
 
-    mProxy = out.proxy;
-    mContactCount = out.contactCount;
+    mState.proxy = out.proxy;
+    mState.contactCount = out.contactCount;
     for (std::uint32_t i = 0; i < out.contactCount; ++i) {
         const SceneObject& o = scene.object(scene.objectSlotOf(out.contacts[i].slot));
-        mContactSlots[i] = out.contacts[i].slot;
-        mContactPoses[i] = {o.id, o.center, o.rotation};
+        mState.contactSlots[i] = out.contacts[i].slot;
+        mState.contactPoses[i] = {o.id, o.center, o.rotation};
     }
     return out;
 }

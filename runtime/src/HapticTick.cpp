@@ -7,7 +7,7 @@
 
 namespace hapto {
 
-static_assert(sizeof(HapticTick) == 3072, "update the size in HapticTick.h");
+static_assert(sizeof(HapticTick) == 10240, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
 
 namespace {
@@ -119,21 +119,24 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
         mRenderer.inContact() ? p - glm::dot(p - from, mSlideNormal) * mSlideNormal : from;
     std::array<std::uint32_t, 2 + kExtraLeaves> listed{atDevice.leaf, atProxy.leaf};
     std::size_t listedCount = 2;
+    bool slideListed = false; // every leaf of the slide is listed (and stays so as more are)
     while (listedCount < listed.size() && mRenderer.inContact()) {
         const LocateResult missed = firstUnlistedLeaf(
             mProxyCursor, from, slide, std::span<const std::uint32_t>(listed.data(), listedCount));
-        if (missed.leaf == kNoLeaf || !mCandidates.add(missed.candidates)) {
+        slideListed = missed.leaf == kNoLeaf;
+        if (slideListed || !mCandidates.add(missed.candidates)) {
             break;
         }
         listed[listedCount++] = missed.leaf;
         ++out.extraLeaves;
     }
-    const GodObjectRenderer start = mRenderer; // a plain copy: no allocation
+    const GodObjectRenderer::State start = mRenderer.state(); // a plain copy: no allocation
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
     std::uint32_t tested = out.render.objectsTested;
     while (listedCount < listed.size()) {
         const std::span<const std::uint32_t> known(listed.data(), listedCount);
-        LocateResult missed = firstUnlistedLeaf(mProxyCursor, from, slide, known);
+        LocateResult missed =
+            slideListed ? LocateResult{} : firstUnlistedLeaf(mProxyCursor, from, slide, known);
         if (missed.leaf == kNoLeaf) {
             missed = firstUnlistedLeaf(mProxyCursor, slide, out.render.proxy, known);
         }
@@ -144,7 +147,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
             break;
         }
         listed[listedCount++] = missed.leaf;
-        mRenderer = start;
+        mRenderer.restore(start);
         out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
         tested += out.render.objectsTested;
         ++out.extraLeaves;

@@ -413,3 +413,97 @@ TEST_CASE("random walks around rotated closed meshes: the proxy never inside, al
     INFO("multi-contact ticks " << multiTicks);
     CHECK(multiTicks > 0); // ... at edges and vertices too
 }
+
+TEST_CASE("the near list's copy of a triangle renders exactly as the scene's triangle does") {
+    // The renderer copies the plane, corners and edges of a tick's first candidate triangles
+    // (GodObjectRenderer::kCachedTriangles) and reads any past them from the scene. Two
+    // renderers follow one walk over a fine rotated torus with friction: one is handed the
+    // triangles near the device point (its near triangles are copies), the other the same
+    // after 40 far triangles of another mesh (rejected, but they take the copied places, so
+    // its near triangles are read from the scene). Every output must be the same, bit for bit.
+    const Rig rig(
+        {makeMesh(1, Vec3(0.0), torusMesh(0.02, 0.008, 128, 48), tilt(), material(kK, 0.5, 0.3)),
+         makeMesh(2, Vec3(0.5, 0.0, 0.0), gridMesh(0.01, 10), Quat(1, 0, 0, 0), material(kK))});
+    std::vector<std::uint32_t> far;
+    for (const std::uint32_t item : rig.items) {
+        if (isTriangleItem(item) && rig.scene.objectSlotOf(item) == 1 && far.size() < 40) {
+            far.push_back(item);
+        }
+    }
+    REQUIRE(far.size() > GodObjectRenderer::kCachedTriangles);
+    hapto::Random rng(7);
+    const Vec3 onRing = tilt() * Vec3(0.02, 0.0, 0.0); // the walk is drawn to the tube's core
+    GodObjectRenderer copied;
+    GodObjectRenderer read;
+    Vec3 p(0.0, 0.0, 0.05);
+    Vec3 v(0.0);
+    copied.reset(p);
+    read.reset(p);
+    std::uint64_t contactTicks = 0;
+    for (int tick = 0; tick < 3000; ++tick) {
+        v += Vec3(rng.normal(), rng.normal(), rng.normal()) * 0.05 + (onRing - p) * 0.5;
+        if (glm::length(v) > 0.5) {
+            v = 0.5 * glm::normalize(v);
+        }
+        p += v * 1e-3;
+        std::vector<std::uint32_t> near;
+        for (const std::uint32_t item : rig.items) {
+            if (isTriangleItem(item) && rig.scene.objectSlotOf(item) == 0) {
+                const std::array<Vec3, 3> c = rig.scene.triangleCorners(item);
+                if (glm::length((c[0] + c[1] + c[2]) / 3.0 - p) < 0.006) {
+                    near.push_back(item);
+                }
+            }
+        }
+        CandidateSet nearOnly;
+        nearOnly.add(near);
+        CandidateSet farFirst;
+        farFirst.add(far);
+        farFirst.add(near);
+        const RenderOutput a = copied.update(rig.scene, nearOnly, p, v, 1e-3);
+        const RenderOutput b = read.update(rig.scene, farFirst, p, v, 1e-3);
+        INFO("tick " << tick);
+        REQUIRE(a.proxy == b.proxy);
+        REQUIRE(a.force == b.force);
+        REQUIRE(a.contactCount == b.contactCount);
+        REQUIRE(a.iterations == b.iterations);
+        contactTicks += a.contactCount > 0;
+    }
+    CHECK(contactTicks >
+          300); // the walk swings through the tube: in contact on 451 of the 3000 ticks
+}
+
+TEST_CASE("a renderer put back to its State renders the tick again exactly") {
+    // HapticTick solves a tick again from the renderer's State (not a copy of the whole
+    // renderer): the second update must give what the first gave.
+    const Rig rig(
+        {makeMesh(1, Vec3(0.0), torusMesh(0.02, 0.008, 64, 24), tilt(), material(kK, 0.5, 0.3))});
+    const CandidateSet c = rig.byItems();
+    GodObjectRenderer r;
+    // Down onto the tube's top (the torus stands in its local x-y plane), 4 mm in, and along
+    // the ring over its facets' edges and vertices.
+    std::vector<Vec3> corners{Vec3(0.02, 0.0, 0.03), Vec3(0.02, 0.0, 0.004), Vec3(0.0, 0.02, 0.004),
+                              Vec3(-0.02, 0.0, 0.006)};
+    for (Vec3& corner : corners) {
+        corner = tilt() * corner;
+    }
+    const std::vector<Vec3> path = polyline(corners, 200);
+    r.reset(path.front());
+    std::uint64_t contactTicks = 0;
+    for (std::size_t i = 1; i < path.size(); ++i) {
+        const GodObjectRenderer::State before = r.state();
+        const RenderOutput first = r.update(rig.scene, c, path[i], Vec3(NAN), 1e-3);
+        const GodObjectRenderer::State after = r.state();
+        r.restore(before);
+        const RenderOutput again = r.update(rig.scene, c, path[i], Vec3(NAN), 1e-3);
+        INFO("tick " << i);
+        REQUIRE(again.proxy == first.proxy);
+        REQUIRE(again.force == first.force);
+        REQUIRE(again.contactCount == first.contactCount);
+        REQUIRE(r.state().proxy == after.proxy);
+        REQUIRE(r.state().slipping == after.slipping);
+        REQUIRE(r.counters().ticks == after.counters.ticks);
+        contactTicks += first.contactCount > 0;
+    }
+    CHECK(contactTicks > 350);
+}

@@ -64,8 +64,10 @@ struct RenderOutput {
 /// Ruspini et al. 1997) and Coulomb friction. One instance per device: it holds that device's
 /// proxy and scratch space, shares nothing, and never allocates after construction.
 ///
-/// Size: 1408 bytes (64-byte aligned; checked by a static_assert in the source file), of which
-/// 1024 are the near-object scratch list.
+/// Size: 8576 bytes (64-byte aligned; checked by a static_assert in the source file), of which
+/// 1280 are the near-object scratch list and 6912 the tick's copy of its first 32 candidate
+/// triangles (plane, corners, edges: 216 bytes each). A tick solved again restores only the
+/// 296-byte State.
 class alignas(64) GodObjectRenderer {
 public:
     /// Constraint planes solved at once (a corner needs three).
@@ -76,6 +78,10 @@ public:
     /// a pressing tool adds the few triangles around the contact, not every triangle in a
     /// millimetre.
     static constexpr std::size_t kMaxNearObjects = 256;
+    /// Candidate triangles (a tick's first ones, in the candidates' order) whose plane, corners
+    /// and edges the renderer copies once per tick for its near lists and solver passes; a
+    /// triangle past them is read from the scene each time (the same result, more slowly).
+    static constexpr std::size_t kCachedTriangles = 32;
     /// Upper bound for RendererConfig::maxIterations.
     static constexpr std::uint32_t kMaxIterations = 32;
     /// The proxy rides this far (m) outside every surface: a 10 nm skin that closes the cracks
@@ -109,13 +115,38 @@ public:
                         double dtSeconds) noexcept;
 
     /// The proxy position (m, world). [servo]
-    const Vec3& proxy() const noexcept { return mProxy; }
+    const Vec3& proxy() const noexcept { return mState.proxy; }
     /// Fault counters since construction. [servo] (copy them out to share)
-    const RenderCounters& counters() const noexcept { return mCounters; }
+    const RenderCounters& counters() const noexcept { return mState.counters; }
     /// True while the last tick ended in contact. [servo]
-    bool inContact() const noexcept { return mContactCount > 0; }
+    bool inContact() const noexcept { return mState.contactCount > 0; }
     /// The configuration. [any thread]
     const RendererConfig& config() const noexcept { return mConfig; }
+
+    /// What carries over from one tick to the next (the proxy, the friction and contact state,
+    /// the counters), without the per-tick scratch: a tick solved again restores it. [servo]
+    struct State {
+        RenderCounters counters;       ///< Fault counters since construction.
+        Vec3 proxy{0.0};               ///< God-object position (m).
+        Vec3 lastDevice{0.0};          ///< Device position of the previous tick (m).
+        bool hasLastDevice = false;    ///< lastDevice is set.
+        bool slipping = false;         ///< Friction state: kinetic (true) or static (false).
+        std::uint8_t contactCount = 0; ///< Last tick's contacts.
+        std::array<std::uint32_t, kMaxContacts> contactSlots{}; ///< Last tick's touched items.
+        /// Pose of a touched object at the end of the last tick, to carry the proxy when it
+        /// moves.
+        struct ContactPose {
+            ObjectId id = 0;
+            Vec3 center{0.0};
+            Quat rotation{1, 0, 0, 0};
+        };
+        std::array<ContactPose, kMaxContacts> contactPoses{};
+    };
+    /// The state that the next update() starts from. [servo]
+    const State& state() const noexcept { return mState; }
+    /// Puts back a state taken with state(): the next update() runs as if the updates since
+    /// had not happened. [servo]
+    void restore(const State& state) noexcept { mState = state; }
 
 private:
     /// A constraint half-space {x : dot(normal, x) >= offset}, from one object's face or one
@@ -124,7 +155,27 @@ private:
         Vec3 normal{0.0};
         double offset = 0.0;
         std::uint32_t item = 0;
+        std::uint32_t near = kNotCached; ///< The item's place in mTriangleData, if there.
     };
+    /// A candidate triangle as the near list reads it: its world plane, read once per tick,
+    /// and for a triangle that got near, its corners, edges and mesh slot; so that a second
+    /// near list (the friction solve's) reads nothing from the scene again, and the solver's
+    /// passes read this compact array, not the scene's meshes.
+    struct NearTriangle {
+        std::uint32_t item = 0;
+        std::uint32_t mesh = 0; ///< Its mesh's slot, once `hasEdges`.
+        bool hasCorners = false;
+        bool hasEdges = false;
+        WorldFace face;
+        std::array<Vec3, 3> corners{};
+        /// Its edges in its plane: inward[i] = normal x (corner i+1 - corner i), length2[i] its
+        /// squared length.
+        struct Edges {
+            std::array<Vec3, 3> inward{};
+            std::array<double, 3> length2{};
+        } edges;
+    };
+    static constexpr std::uint32_t kNotCached = 0xffffffffu;
     /// Where a solve ended.
     struct Solve {
         Vec3 proxy{0.0};
@@ -149,23 +200,14 @@ private:
     template <class Fn>
     void forEachMeshTriangleNear(const Scene& scene, std::uint32_t slot, const Vec3& center,
                                  double radius, Fn&& fn) const noexcept;
-    void addNear(std::uint32_t item) noexcept;
+    /// Distance (m) from p to an item's skin, 0 inside; a cached triangle's (`near` <
+    /// kCachedTriangles) from its copy.
+    double distanceToSkinOf(const Scene& scene, std::uint32_t item, std::uint32_t near,
+                            const Vec3& p) const noexcept;
+    bool addNear(std::uint32_t item) noexcept;
 
     RendererConfig mConfig;
-    RenderCounters mCounters;
-    Vec3 mProxy{0.0};      ///< God-object position (m).
-    Vec3 mLastDevice{0.0}; ///< Device position of the previous tick (m).
-    bool mHasLastDevice = false;
-    bool mSlipping = false; ///< Friction state: kinetic (true) or static (false).
-    std::uint8_t mContactCount = 0;
-    std::array<std::uint32_t, kMaxContacts> mContactSlots{}; ///< Last tick's touched items.
-    /// Pose of a touched object at the end of the last tick, to carry the proxy when it moves.
-    struct ContactPose {
-        ObjectId id = 0;
-        Vec3 center{0.0};
-        Quat rotation{1, 0, 0, 0};
-    };
-    std::array<ContactPose, kMaxContacts> mContactPoses{};
+    State mState;
 
     // Per-tick scratch: the deduplicated candidates that can matter this tick.
     Vec3 mNearCenter{0.0};
@@ -176,6 +218,10 @@ private:
     bool mNearTriangles = false; ///< The list saw triangles: its triangle ball is the tight one.
     std::uint32_t mNearCount = 0;
     std::array<std::uint32_t, kMaxNearObjects> mNear{};
+    /// mNear[i]'s place in mTriangleData, or kNotCached (boxes, spheres, triangles past it).
+    std::array<std::uint8_t, kMaxNearObjects> mNearCached{};
+    std::uint32_t mTriangleCount = 0; ///< mTriangleData entries read this tick.
+    std::array<NearTriangle, kCachedTriangles> mTriangleData{};
 };
 
 } // namespace hapto

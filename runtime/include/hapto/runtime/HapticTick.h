@@ -53,8 +53,8 @@ struct TickOutput {
 /// device, used by one thread at a time. The caller owns the snapshot (it stays valid for the
 /// tick) and the device side: reading, the frames, and what to do with the force.
 ///
-/// Size: 3072 bytes, 64-byte aligned (checked by a static_assert in the source file), of
-/// which 1408 are the renderer and 1288 the effect set (8 effects of 160 bytes).
+/// Size: 10240 bytes, 64-byte aligned (checked by a static_assert in the source file), of
+/// which 8576 are the renderer and 1288 the effect set (8 effects of 160 bytes).
 class alignas(64) HapticTick {
 public:
     /// Leaves the proxy may slide into in one tick, each solved again with its items
