@@ -63,7 +63,7 @@ struct alignas(64) ServoState {
     ServoState(const RendererConfig& renderer, const SafetyConfig& safety)
         : haptic(renderer, safety) {}
 };
-static_assert(sizeof(ServoState) == 10624, "update the size in the note above");
+static_assert(sizeof(ServoState) == 12416, "update the size in the note above");
 
 /// The cold record of a channel.
 struct ChannelRecord {

@@ -62,7 +62,7 @@
 
 namespace hapto {
 
-static_assert(sizeof(GodObjectRenderer) == 8576, "update the size in GodObjectRenderer.h");
+static_assert(sizeof(GodObjectRenderer) == 10176, "update the size in GodObjectRenderer.h");
 static_assert(alignof(GodObjectRenderer) == 64);
 
 namespace {
@@ -730,9 +730,10 @@ bool GodObjectRenderer::covered(const Scene& scene, const CandidateSet& candidat
 
 GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
                                                   const CandidateSet& candidates, const Vec3& start,
-                                                  const Vec3& goal) const noexcept {
+                                                  const Vec3& goal) noexcept {
     Solve s;
     Vec3 p = start;
+    visit(p);
 
     // Drops planes the proxy is not on (within kOnM).
     auto pruneNonBinding = [&](const Vec3& at) {
@@ -766,6 +767,7 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
         const Hit hit = sweep(scene, candidates, p, target);
         if (hit.found) {
             p += hit.tStop * (target - p);
+            visit(p);
             if (!s.touched) {
                 s.touched = true;
                 s.firstTouch = p;
@@ -845,6 +847,7 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
             continue;
         }
         p = target;
+        visit(p);
         pruneNonBinding(p);
         if (it + 1 >= mConfig.maxIterations) {
             break;
@@ -878,6 +881,8 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     mTriangleCount = 0;
     mNearOverflow = false;
     mNearTriangles = false;
+    mVisitedCount = 0;
+    mVisitedSecond = 0;
     if (!finite(devicePosition)) {
         out.status = RenderStatus::NonFiniteInput;
         out.proxy = mState.proxy;
@@ -899,6 +904,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     }
     mState.lastDevice = devicePosition;
     mState.hasLastDevice = true;
+    visit(mState.proxy);
 
     const Vec3 goal = devicePosition;
     Vec3 start = mState.proxy;
@@ -951,6 +957,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     }
 
     const Solve free = solve(scene, candidates, start, goal);
+    mVisitedSecond = mVisitedCount;
     Solve fin = free;
     std::uint32_t iterations = free.iterations;
 

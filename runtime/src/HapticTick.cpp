@@ -7,7 +7,7 @@
 
 namespace hapto {
 
-static_assert(sizeof(HapticTick) == 10240, "update the size in HapticTick.h");
+static_assert(sizeof(HapticTick) == 12032, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
 
 namespace {
@@ -50,6 +50,25 @@ LocateResult firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
         t = std::max(exit, t) + 1e-9 / length; // a nanometre past the face
         if (t > 1.0) {
             return {};
+        }
+    }
+    return {};
+}
+
+/// The first leaf not in `listed` along any segment of the renderer's visited paths (where the
+/// proxy went in its last update), or kNoLeaf. [servo]
+LocateResult firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& renderer,
+                                  std::span<const std::uint32_t> listed) noexcept {
+    for (int which = 0; which < 2; ++which) {
+        const std::span<const Vec3> path = renderer.visitedPath(which);
+        for (std::size_t i = 1; i < path.size(); ++i) {
+            if (path[i] == path[i - 1]) {
+                continue;
+            }
+            const LocateResult missed = firstUnlistedLeaf(walker, path[i - 1], path[i], listed);
+            if (missed.leaf != kNoLeaf) {
+                return missed;
+            }
         }
     }
     return {};
@@ -108,23 +127,21 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     // proxy visits this tick: a proxy sliding over fine triangles (a mesh whose leaves are
     // smaller than one tick's motion, with the device in an empty leaf under the surface)
     // can slide off the triangles it knows, over a leaf nobody listed, and through the
-    // surface. So the ways the proxy can have gone are walked leaf by leaf: from its start
-    // along last tick's contact plane to the device point's projection on it (a slide), and
-    // from there and from the start to where it ended; at the first leaf that was not a
-    // candidate the tick is solved again from the same start with that leaf's items too, up
-    // to kExtraLeaves times. The slide is known before solving, so its leaves are listed
-    // first: a slide over small leaves usually solves once.
+    // surface. So the way the proxy went is walked leaf by leaf: every segment of the
+    // renderer's visited paths (its start, each solver pass's end); at the first leaf that was
+    // not a candidate the tick is solved again from the same start with that leaf's items
+    // too, up to kExtraLeaves times. The likely slide (from the start along last tick's
+    // contact plane to the device point's projection on it) is known before solving, so its
+    // leaves are listed first: a slide over small leaves usually solves once.
     const Vec3 from = mRenderer.proxy();
     const Vec3 slide =
         mRenderer.inContact() ? p - glm::dot(p - from, mSlideNormal) * mSlideNormal : from;
     std::array<std::uint32_t, 2 + kExtraLeaves> listed{atDevice.leaf, atProxy.leaf};
     std::size_t listedCount = 2;
-    bool slideListed = false; // every leaf of the slide is listed (and stays so as more are)
     while (listedCount < listed.size() && mRenderer.inContact()) {
         const LocateResult missed = firstUnlistedLeaf(
             mProxyCursor, from, slide, std::span<const std::uint32_t>(listed.data(), listedCount));
-        slideListed = missed.leaf == kNoLeaf;
-        if (slideListed || !mCandidates.add(missed.candidates)) {
+        if (missed.leaf == kNoLeaf || !mCandidates.add(missed.candidates)) {
             break;
         }
         listed[listedCount++] = missed.leaf;
@@ -133,17 +150,12 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     const GodObjectRenderer::State start = mRenderer.state(); // a plain copy: no allocation
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
     std::uint32_t tested = out.render.objectsTested;
-    while (listedCount < listed.size()) {
+    bool covered = false; // every leaf of the proxy's path is listed
+    for (;;) {
         const std::span<const std::uint32_t> known(listed.data(), listedCount);
-        LocateResult missed =
-            slideListed ? LocateResult{} : firstUnlistedLeaf(mProxyCursor, from, slide, known);
-        if (missed.leaf == kNoLeaf) {
-            missed = firstUnlistedLeaf(mProxyCursor, slide, out.render.proxy, known);
-        }
-        if (missed.leaf == kNoLeaf) {
-            missed = firstUnlistedLeaf(mProxyCursor, from, out.render.proxy, known);
-        }
-        if (missed.leaf == kNoLeaf || !mCandidates.add(missed.candidates)) {
+        const LocateResult missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, known);
+        covered = missed.leaf == kNoLeaf;
+        if (covered || listedCount == listed.size() || !mCandidates.add(missed.candidates)) {
             break;
         }
         listed[listedCount++] = missed.leaf;
@@ -151,6 +163,22 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
         out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
         tested += out.render.objectsTested;
         ++out.extraLeaves;
+    }
+    // Out of room while the path still crosses a leaf no span lists (a very fast hand over
+    // very small leaves): the proxy must not move through space whose items the renderer has
+    // not seen. Solve again toward a goal pulled back from the device point toward the start,
+    // halving, until the path stays in listed leaves; the last try is the start itself (the
+    // proxy stays, no force this tick). The force is then the pulled-back goal's: weaker,
+    // never a fall through the surface.
+    Vec3 goal = p;
+    const std::span<const std::uint32_t> known(listed.data(), listedCount);
+    for (int k = 0; !covered && k < kPullBacks; ++k) {
+        goal = k + 1 < kPullBacks ? from + 0.5 * (goal - from) : from;
+        mRenderer.restore(start);
+        out.render = mRenderer.update(*snapshot.scene, mCandidates, goal, v, dtS);
+        tested += out.render.objectsTested;
+        ++out.pullBacks;
+        covered = firstUnlistedOnPaths(mProxyCursor, mRenderer, known).leaf == kNoLeaf;
     }
     out.render.objectsTested = tested;
     if (out.render.contactCount > 0) {

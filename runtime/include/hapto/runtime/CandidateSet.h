@@ -8,14 +8,14 @@
 
 namespace hapto {
 
-/// Up to six spans of candidate items (object slots and triangle items of `scene`): the device
-/// point's leaf, the proxy's leaf, the snapshot's moving objects, and up to three leaves the
-/// proxy slid into during the tick (HapticTick solves again with each). The spans
+/// Up to sixteen spans of candidate items (object slots and triangle items of `scene`): the
+/// device point's leaf, the proxy's leaf, the snapshot's moving objects, and up to thirteen
+/// leaves the proxy slid into during the tick (HapticTick solves again with each). The spans
 /// are views; whoever fills the set keeps the storage alive for the tick. Slots may repeat
 /// across (and within) spans: the renderer treats duplicates as one object.
 struct CandidateSet {
     /// How many spans fit.
-    static constexpr std::size_t kMaxSpans = 6;
+    static constexpr std::size_t kMaxSpans = 16;
 
     std::array<std::span<const std::uint32_t>, kMaxSpans>
         spans{};             ///< The spans; first `count` used.

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 namespace hapto {
 
@@ -64,10 +65,10 @@ struct RenderOutput {
 /// Ruspini et al. 1997) and Coulomb friction. One instance per device: it holds that device's
 /// proxy and scratch space, shares nothing, and never allocates after construction.
 ///
-/// Size: 8576 bytes (64-byte aligned; checked by a static_assert in the source file), of which
-/// 1280 are the near-object scratch list and 6912 the tick's copy of its first 32 candidate
-/// triangles (plane, corners, edges: 216 bytes each). A tick solved again restores only the
-/// 296-byte State.
+/// Size: 10176 bytes (64-byte aligned; checked by a static_assert in the source file), of which
+/// 1280 are the near-object scratch list, 6912 the tick's copy of its first 32 candidate
+/// triangles (plane, corners, edges: 216 bytes each) and 1608 the points the proxy visited
+/// (visitedPath). A tick solved again restores only the 296-byte State.
 class alignas(64) GodObjectRenderer {
 public:
     /// Constraint planes solved at once (a corner needs three).
@@ -84,6 +85,9 @@ public:
     static constexpr std::size_t kCachedTriangles = 32;
     /// Upper bound for RendererConfig::maxIterations.
     static constexpr std::uint32_t kMaxIterations = 32;
+    /// Points visitedPath() can hold: the tick's start, and each of two solves' start and
+    /// passes.
+    static constexpr std::size_t kMaxVisited = 2 * (kMaxIterations + 1) + 1;
     /// The proxy rides this far (m) outside every surface: a 10 nm skin that closes the cracks
     /// between flush objects. It adds stiffness x 1e-8 m to each force (8 µN at 800 N/m).
     static constexpr double kSkinM = 1e-8;
@@ -116,6 +120,16 @@ public:
 
     /// The proxy position (m, world). [servo]
     const Vec3& proxy() const noexcept { return mState.proxy; }
+    /// Where the proxy went during the last update() (m, world), as two polylines: path 0 is
+    /// the proxy at the tick's start, then the frictionless solve's start and the end of each
+    /// of its passes; path 1 the friction solve's start and passes (empty when there was
+    /// none). The proxy moved only along these segments, so a caller that listed every leaf
+    /// they cross gave the renderer every item the proxy could reach. [servo]
+    std::span<const Vec3> visitedPath(int which) const noexcept {
+        return which == 0 ? std::span<const Vec3>(mVisited.data(), mVisitedSecond)
+                          : std::span<const Vec3>(mVisited.data() + mVisitedSecond,
+                                                  mVisitedCount - mVisitedSecond);
+    }
     /// Fault counters since construction. [servo] (copy them out to share)
     const RenderCounters& counters() const noexcept { return mState.counters; }
     /// True while the last tick ended in contact. [servo]
@@ -189,8 +203,15 @@ private:
 
     void buildNear(const Scene& scene, const CandidateSet& candidates, const Vec3& center,
                    double radius, std::uint32_t& tested) noexcept;
+    /// Solves toward `goal` from `start`, adding start and each pass's end to the visited
+    /// points.
     Solve solve(const Scene& scene, const CandidateSet& candidates, const Vec3& start,
-                const Vec3& goal) const noexcept;
+                const Vec3& goal) noexcept;
+    void visit(const Vec3& p) noexcept {
+        if (mVisitedCount < kMaxVisited) {
+            mVisited[mVisitedCount++] = p;
+        }
+    }
     Hit sweep(const Scene& scene, const CandidateSet& candidates, const Vec3& from,
               const Vec3& to) const noexcept;
     bool covered(const Scene& scene, const CandidateSet& candidates, const Vec3& probe,
@@ -222,6 +243,10 @@ private:
     std::array<std::uint8_t, kMaxNearObjects> mNearCached{};
     std::uint32_t mTriangleCount = 0; ///< mTriangleData entries read this tick.
     std::array<NearTriangle, kCachedTriangles> mTriangleData{};
+    // Per-tick scratch: where the proxy went (visitedPath).
+    std::uint32_t mVisitedCount = 0;
+    std::uint32_t mVisitedSecond = 0; ///< Where the friction solve's points begin.
+    std::array<Vec3, kMaxVisited> mVisited{};
 };
 
 } // namespace hapto

@@ -33,6 +33,10 @@ struct TickOutput {
                                   ///< listed: the slide's, before solving, and those the
                                   ///< solved proxy reached, each solved again
                                   ///< (HapticTick::kExtraLeaves at most).
+    /// Times the goal was pulled back toward the proxy's start because the proxy's path still
+    /// crossed a leaf no span listed after kExtraLeaves (HapticTick::kPullBacks at most; the
+    /// last keeps the proxy where it was, with no force this tick).
+    std::uint8_t pullBacks = 0;
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
 };
 
@@ -53,13 +57,16 @@ struct TickOutput {
 /// device, used by one thread at a time. The caller owns the snapshot (it stays valid for the
 /// tick) and the device side: reading, the frames, and what to do with the force.
 ///
-/// Size: 10240 bytes, 64-byte aligned (checked by a static_assert in the source file), of
-/// which 8576 are the renderer and 1288 the effect set (8 effects of 160 bytes).
+/// Size: 12032 bytes, 64-byte aligned (checked by a static_assert in the source file), of
+/// which 10176 are the renderer and 1288 the effect set (8 effects of 160 bytes).
 class alignas(64) HapticTick {
 public:
     /// Leaves the proxy may slide into in one tick, each solved again with its items
     /// (CandidateSet has a span for each: device, proxy, moving, and these).
     static constexpr std::size_t kExtraLeaves = CandidateSet::kMaxSpans - 3;
+    /// Goals pulled back (halving toward the proxy's start, then the start itself) when the
+    /// proxy's path crosses more unlisted leaves than kExtraLeaves.
+    static constexpr int kPullBacks = 4;
 
     /// Checks both configurations; throws std::invalid_argument when one is invalid. [control]
     explicit HapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
