@@ -202,6 +202,21 @@ TEST_CASE("the tick adds its effects and its hook to the render force, each repo
     CHECK(bad.forceN == Vec3(0.2, 0, 0));
 }
 
+namespace {
+
+/// The smallest distance from the centre to a facet plane of a mesh centred on the origin,
+/// at most r (m): how deep below a sphere of radius r its facets reach.
+double nearestFacetPlane(const TriangleMesh& mesh, double r) {
+    double nearest = r;
+    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
+        const auto [v0, v1, v2] = mesh.corners(t);
+        nearest = std::min(nearest, glm::dot(glm::normalize(glm::cross(v1 - v0, v2 - v0)), v0));
+    }
+    return nearest;
+}
+
+} // namespace
+
 TEST_CASE("a hand sliding over a fine mesh whose leaves are smaller than one tick's motion stays "
           "on the surface: the leaves the proxy slides over are rendered too") {
     // An icosphere of 327 680 triangles (edges about 0.45 mm) in an octree of 0.5 mm leaves,
@@ -239,13 +254,7 @@ TEST_CASE("a hand sliding over a fine mesh whose leaves are smaller than one tic
     }
     // The facets lie inside the sphere: the deepest the proxy may rest is the nearest facet
     // plane's distance below r.
-    double nearestPlane = r;
-    const TriangleMesh& mesh = *scene.object(0).mesh;
-    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
-        const auto [v0, v1, v2] = mesh.corners(t);
-        nearestPlane =
-            std::min(nearestPlane, glm::dot(glm::normalize(glm::cross(v1 - v0, v2 - v0)), v0));
-    }
+    const double nearestPlane = nearestFacetPlane(*scene.object(0).mesh, r);
     INFO("ticks in contact " << touching << " of " << ticks << ", deepest proxy " << deepest
                              << ", facet sag " << r - nearestPlane);
     CHECK(touching == ticks);                 // the device 1 mm inside is always held
@@ -284,14 +293,7 @@ DeepPress pressDeepAndFast(double stepM, const char* spec) {
         }
     }
     DeepPress got;
-    double nearestPlane = r;
-    const TriangleMesh& mesh = *scene.object(0).mesh;
-    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
-        const auto [v0, v1, v2] = mesh.corners(t);
-        nearestPlane =
-            std::min(nearestPlane, glm::dot(glm::normalize(glm::cross(v1 - v0, v2 - v0)), v0));
-    }
-    got.facetSag = r - nearestPlane;
+    got.facetSag = r - nearestFacetPlane(*scene.object(0).mesh, r);
     World world(scene, IndexSpec::parse(spec));
     HapticTick tick;
     for (std::size_t i = 0; i < path.size(); ++i) {

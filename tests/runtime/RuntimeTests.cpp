@@ -45,12 +45,7 @@ struct Rig {
             devices.push_back(d.get());
             auto wrapped = std::make_unique<FaultInjectingDevice>(std::move(d));
             injectors.push_back(wrapped.get());
-            DeviceConfig c;
-            c.name = "d" + std::to_string(i);
-            c.kind = DeviceKind::Scripted;
-            c.rateHz = rateHz;
-            c.maxForceN = 5.0;
-            rds.push_back({std::move(wrapped), c, nullptr});
+            rds.push_back({std::move(wrapped), test::scriptedConfig(i, rateHz), nullptr});
         }
         options.realtime = false; // tests share a noisy machine; SCHED_FIFO is for sessions
         runtime = std::make_unique<Runtime>(world, std::move(rds), options);

@@ -4,6 +4,7 @@
 /// tick, an absence) moves that clock on instead of sleeping: the runtime's step mode.
 
 #include "hapto/devices/Device.h"
+#include "hapto/devices/DeviceConfig.h"
 #include "hapto/runtime/ManualClock.h"
 
 #include <atomic>
@@ -12,6 +13,7 @@
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -185,6 +187,17 @@ private:
     std::atomic<std::int64_t> mLastWriteNs{0};
     bool mOpen = false, mClosed = false;
 };
+
+/// The configuration the runtime tests give scripted device i: named "d<i>", at `rateHz`,
+/// forces clamped at 5 N.
+inline DeviceConfig scriptedConfig(int i, double rateHz) {
+    DeviceConfig c;
+    c.name = "d" + std::to_string(i);
+    c.kind = DeviceKind::Scripted;
+    c.rateHz = rateHz;
+    c.maxForceN = 5.0;
+    return c;
+}
 
 /// A path that starts 1 cm above the top face of a 5 cm cube at the origin and presses 2 mm
 /// into it after 50 ticks, then holds.

@@ -41,13 +41,8 @@ struct SteppedRig {
                 setup(i, *d);
             }
             devices.push_back(d.get());
-            DeviceConfig c;
-            c.name = "d" + std::to_string(i);
-            c.kind = DeviceKind::Scripted;
-            c.rateHz = rateHz;
-            c.maxForceN = 5.0;
             rds.push_back(
-                {std::move(d), c,
+                {std::move(d), scriptedConfig(i, rateHz),
                  static_cast<std::size_t>(i) < recorders.size() ? recorders[i] : nullptr});
         }
         options.realtime = false;
