@@ -18,7 +18,8 @@ namespace {
 /// cursor near a (the proxy's): each step crosses to the next leaf by its links, not from the
 /// root. [servo]
 LocateResult firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
-                               std::span<const std::uint32_t> listed) noexcept {
+                               std::span<const std::uint32_t> listed,
+                               Aabb* lastBox = nullptr) noexcept {
     const SpatialIndex& index = *walker.index();
     const Vec3 d = b - a;
     const double length = glm::length(d);
@@ -45,6 +46,9 @@ LocateResult firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
             }
         }
         if (exit >= 1.0) {
+            if (lastBox) {
+                *lastBox = box; // b's leaf, listed
+            }
             return {};
         }
         t = std::max(exit, t) + 1e-9 / length; // a nanometre past the face
@@ -61,11 +65,16 @@ LocateResult firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer&
                                   std::span<const std::uint32_t> listed) noexcept {
     for (int which = 0; which < 2; ++which) {
         const std::span<const Vec3> path = renderer.visitedPath(which);
+        // The listed leaf box the last segment ended in: a segment inside it (a box is
+        // convex) needs no walk.
+        Aabb box{Vec3(1.0), Vec3(-1.0)};
         for (std::size_t i = 1; i < path.size(); ++i) {
-            if (path[i] == path[i - 1]) {
+            if (path[i] == path[i - 1] || (box.contains(path[i - 1]) && box.contains(path[i]))) {
                 continue;
             }
-            const LocateResult missed = firstUnlistedLeaf(walker, path[i - 1], path[i], listed);
+            box = Aabb{Vec3(1.0), Vec3(-1.0)};
+            const LocateResult missed =
+                firstUnlistedLeaf(walker, path[i - 1], path[i], listed, &box);
             if (missed.leaf != kNoLeaf) {
                 return missed;
             }
