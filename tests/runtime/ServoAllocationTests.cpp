@@ -169,9 +169,8 @@ TEST_CASE("servo threads make no heap allocation while running, across snapshot 
     runtime.stop();
     const RunReport r = runtime.report();
     for (const DeviceReport& d : r.devices) {
-        CHECK(d.ticks > 0);
         CHECK(d.fault.empty());
-        CHECK(d.snapshotsSeen >= 5);
+        CHECK(d.snapshotsSeen >= 5); // a device sees snapshots only by ticking
     }
     CHECK(hooks[0].calls.load() > 0);
     CHECK(hooks[1].calls.load() > 0);
@@ -199,6 +198,15 @@ std::vector<DeviceConfig> fiveHands() {
     return configs;
 }
 
+/// fiveHands() opened over `scene`, ready for a Runtime.
+std::vector<RuntimeDevice> fiveHandDevices(const Scene& scene) {
+    std::vector<RuntimeDevice> devices;
+    for (const DeviceConfig& c : fiveHands()) {
+        devices.push_back({makeDevice(c, scene), c, nullptr});
+    }
+    return devices;
+}
+
 } // namespace
 
 TEST_CASE("grouped servos make no heap allocation, across snapshot updates (step mode)") {
@@ -207,10 +215,7 @@ TEST_CASE("grouped servos make no heap allocation, across snapshot updates (step
     World world(scene, IndexSpec::parse("octree:2:0.005"));
     world.useClock(clock);
     world.setRestDelay(std::chrono::milliseconds(5));
-    std::vector<RuntimeDevice> devices;
-    for (const DeviceConfig& c : fiveHands()) {
-        devices.push_back({makeDevice(c, scene), c, nullptr});
-    }
+    std::vector<RuntimeDevice> devices = fiveHandDevices(scene);
     RuntimeOptions opt;
     opt.realtime = false;
     opt.devicesPerThread = 3; // a group of three and a group of two
@@ -244,10 +249,7 @@ TEST_CASE("grouped servo threads make no heap allocation while running", "[realt
     const Scene scene = makeDefaultScene();
     World world(scene, IndexSpec::parse("octree:2:0.005"));
     world.setRestDelay(std::chrono::milliseconds(5));
-    std::vector<RuntimeDevice> devices;
-    for (const DeviceConfig& c : fiveHands()) {
-        devices.push_back({makeDevice(c, scene), c, nullptr});
-    }
+    std::vector<RuntimeDevice> devices = fiveHandDevices(scene);
     RuntimeOptions opt;
     opt.realtime = false;
     opt.devicesPerThread = 3;
@@ -275,9 +277,8 @@ TEST_CASE("grouped servo threads make no heap allocation while running", "[realt
     }
     runtime.stop();
     for (const DeviceReport& d : runtime.report().devices) {
-        CHECK(d.ticks > 0);
         CHECK(d.fault.empty());
-        CHECK(d.snapshotsSeen >= 5);
+        CHECK(d.snapshotsSeen >= 5); // a device sees snapshots only by ticking
     }
     CHECK(gAllAllocations.load() > before);
     CHECK(gServoAllocations.load() == servoBefore);
