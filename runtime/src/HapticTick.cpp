@@ -12,25 +12,39 @@ static_assert(alignof(HapticTick) == 64);
 
 namespace {
 
+/// What a walk along a path found: the first leaf no span lists, if any.
+struct Unlisted {
+    LocateResult at; ///< That leaf (at.leaf == kNoLeaf: every leaf on the way is listed).
+    /// The walk stopped before the end without knowing (more than kMaxWalk leaves on one
+    /// segment, which only rounding that keeps finding the same face could make): the path
+    /// counts as not covered.
+    bool unknown = false;
+    bool covered() const noexcept { return at.leaf == kNoLeaf && !unknown; }
+};
+
+/// The most leaves one segment's walk visits (each listed but the last; at most 2 +
+/// HapticTick::kExtraLeaves are).
+constexpr int kMaxWalk = 64;
+
 /// The first leaf that the segment a -> b passes through and that is not in `listed`, walking
-/// from a leaf to the next at the point the segment leaves each box; kNoLeaf when there is
-/// none (or the walk leaves the bounds, or takes more than 64 leaves). `walker` is a copy of a
-/// cursor near a (the proxy's): each step crosses to the next leaf by its links, not from the
-/// root. [servo]
-LocateResult firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
-                               std::span<const std::uint32_t> listed,
-                               Aabb* lastBox = nullptr) noexcept {
+/// from a leaf to the next at the point the segment leaves each box; none when there is none
+/// or the walk leaves the index's bounds (no item is indexed outside them), `unknown` after
+/// kMaxWalk leaves. `walker` is a copy of a cursor near a (the proxy's): each step crosses to
+/// the next leaf by its links, not from the root. [servo]
+Unlisted firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
+                           std::span<const std::uint32_t> listed,
+                           Aabb* lastBox = nullptr) noexcept {
     const SpatialIndex& index = *walker.index();
     const Vec3 d = b - a;
     const double length = glm::length(d);
     double t = 0.0;
-    for (int walked = 0; walked < 64; ++walked) {
+    for (int walked = 0; walked < kMaxWalk; ++walked) {
         const LocateResult at = walker.locate(a + t * d);
         if (at.outside) {
             return {};
         }
         if (std::find(listed.begin(), listed.end(), at.leaf) == listed.end()) {
-            return at;
+            return {at};
         }
         if (!(length > 0.0)) {
             return {};
@@ -56,13 +70,13 @@ LocateResult firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
             return {};
         }
     }
-    return {};
+    return {{}, true};
 }
 
 /// The first leaf not in `listed` along any segment of the renderer's visited paths (where the
-/// proxy went in its last update), or kNoLeaf. [servo]
-LocateResult firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& renderer,
-                                  std::span<const std::uint32_t> listed) noexcept {
+/// proxy went in its last update), if any. [servo]
+Unlisted firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& renderer,
+                              std::span<const std::uint32_t> listed) noexcept {
     for (int which = 0; which < 2; ++which) {
         const std::span<const Vec3> path = renderer.visitedPath(which);
         // The listed leaf box the last segment ended in: a segment inside it (a box is
@@ -73,9 +87,8 @@ LocateResult firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer&
                 continue;
             }
             box = Aabb{Vec3(1.0), Vec3(-1.0)};
-            const LocateResult missed =
-                firstUnlistedLeaf(walker, path[i - 1], path[i], listed, &box);
-            if (missed.leaf != kNoLeaf) {
+            const Unlisted missed = firstUnlistedLeaf(walker, path[i - 1], path[i], listed, &box);
+            if (!missed.covered()) {
                 return missed;
             }
         }
@@ -148,37 +161,40 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     std::array<std::uint32_t, 2 + kExtraLeaves> listed{atDevice.leaf, atProxy.leaf};
     std::size_t listedCount = 2;
     while (listedCount < listed.size() && mRenderer.inContact()) {
-        const LocateResult missed = firstUnlistedLeaf(
+        const Unlisted missed = firstUnlistedLeaf(
             mProxyCursor, from, slide, std::span<const std::uint32_t>(listed.data(), listedCount));
-        if (missed.leaf == kNoLeaf || !mCandidates.add(missed.candidates)) {
+        if (missed.at.leaf == kNoLeaf || !mCandidates.add(missed.at.candidates)) {
             break;
         }
-        listed[listedCount++] = missed.leaf;
+        listed[listedCount++] = missed.at.leaf;
         ++out.extraLeaves;
     }
     const GodObjectRenderer::State start = mRenderer.state(); // a plain copy: no allocation
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
+    out.solves = 1;
     std::uint32_t tested = out.render.objectsTested;
     bool covered = false; // every leaf of the proxy's path is listed
     for (;;) {
         const std::span<const std::uint32_t> known(listed.data(), listedCount);
-        const LocateResult missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, known);
-        covered = missed.leaf == kNoLeaf;
-        if (covered || listedCount == listed.size() || !mCandidates.add(missed.candidates)) {
+        const Unlisted missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, known);
+        covered = missed.covered();
+        if (covered || missed.unknown || listedCount == listed.size() ||
+            !mCandidates.add(missed.at.candidates)) {
             break;
         }
-        listed[listedCount++] = missed.leaf;
+        listed[listedCount++] = missed.at.leaf;
         mRenderer.restore(start);
         out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
         tested += out.render.objectsTested;
         ++out.extraLeaves;
+        ++out.solves;
     }
     // Out of room while the path still crosses a leaf no span lists (a very fast hand over
-    // very small leaves): the proxy must not move through space whose items the renderer has
-    // not seen. Solve again toward a goal pulled back from the device point toward the start,
-    // halving, until the path stays in listed leaves; the last try is the start itself (the
-    // proxy stays, no force this tick). The force is then the pulled-back goal's: weaker,
-    // never a fall through the surface.
+    // very small leaves), or a walk that could not finish: the proxy must not move through space
+    // whose items the renderer has not seen. Solve again toward a goal pulled back from the device
+    // point toward the start, halving, until the path stays in listed leaves; the last try is the
+    // start itself (the proxy stays, no force this tick). The force is then the pulled-back goal's:
+    // weaker, never a fall through the surface.
     Vec3 goal = p;
     const std::span<const std::uint32_t> known(listed.data(), listedCount);
     for (int k = 0; !covered && k < kPullBacks; ++k) {
@@ -187,7 +203,8 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
         out.render = mRenderer.update(*snapshot.scene, mCandidates, goal, v, dtS);
         tested += out.render.objectsTested;
         ++out.pullBacks;
-        covered = firstUnlistedOnPaths(mProxyCursor, mRenderer, known).leaf == kNoLeaf;
+        ++out.solves;
+        covered = firstUnlistedOnPaths(mProxyCursor, mRenderer, known).covered();
     }
     out.render.objectsTested = tested;
     if (out.render.contactCount > 0) {

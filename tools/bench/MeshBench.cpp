@@ -19,8 +19,11 @@
 //   mesh-tick  the servo path's full tick (HapticTick: locate, candidates, god-object render,
 //              safety) along the same loop; manual time per tick; counters p50_ns, p99_ns,
 //              contact (the share of ticks in contact), and per tick: tested (candidate items
-//              examined), passes (solver passes) and extra_leaves (leaves listed beyond the
+//              examined), passes (the last solve's solver passes), solves (the renderer's
+//              solves: 1 + re-solves + pull-backs) and extra_leaves (leaves listed beyond the
 //              device's and the proxy's).
+//   mesh-tick-slow  the same at 0.1 mm steps (0.1 m/s): a hand feeling the surface, which
+//              crosses a fifth as many facets per tick.
 //
 //   hapto_bench --benchmark_filter='^mesh-' --benchmark_min_time=0.5
 
@@ -53,10 +56,11 @@
 namespace hapto::bench {
 namespace {
 
-constexpr double kSphereSizeM = 0.2; // diameter
-constexpr double kPressM = 0.001;    // the path runs this far inside the surface
-constexpr double kNearM = 0.002;     // r: "near" for the baselines
-constexpr double kStepM = 0.0005;    // path spacing: 0.5 m/s at 1 kHz
+constexpr double kSphereSizeM = 0.2;  // diameter
+constexpr double kPressM = 0.001;     // the path runs this far inside the surface
+constexpr double kNearM = 0.002;      // r: "near" for the baselines
+constexpr double kStepM = 0.0005;     // path spacing: 0.5 m/s at 1 kHz
+constexpr double kSlowStepM = 0.0001; // mesh-tick-slow's: 0.1 m/s, a hand feeling a surface
 constexpr std::size_t kPathPoints = 4096;
 
 /// The sphere scene of about n triangles, made once per n.
@@ -75,9 +79,14 @@ const Scene& meshScene(std::size_t n) {
 
 /// A touch and slide on the sphere's top, as a loop: down the +z axis from 1 cm above the pole
 /// to kPressM inside, a slide along a wavy great circle through the pole (+-0.3 rad, back and
-/// forth) kPressM inside, and back out along the radius; kStepM apart.
-const std::vector<Vec3>& slidePath() {
-    static const std::vector<Vec3> path = [] {
+/// forth) kPressM inside, and back out along the radius; `step` apart (kStepM unless given).
+const std::vector<Vec3>& slidePath(double step = kStepM) {
+    static std::map<double, std::vector<Vec3>> paths;
+    auto found = paths.find(step);
+    if (found != paths.end()) {
+        return found->second;
+    }
+    const std::vector<Vec3> path = [step] {
         std::vector<Vec3> p;
         const double outside = 0.5 * kSphereSizeM + 0.01, inside = 0.5 * kSphereSizeM - kPressM;
         // A wavy line over the sphere, every point at distance r from its centre (kPressM
@@ -85,10 +94,10 @@ const std::vector<Vec3>& slidePath() {
         const auto onRadius = [](double a, double r) {
             return r * glm::normalize(Vec3(std::sin(a), 0.3 * std::sin(2.0 * a), std::cos(a)));
         };
-        for (double r = outside; r > inside; r -= kStepM) {
+        for (double r = outside; r > inside; r -= step) {
             p.push_back(onRadius(0.0, r));
         }
-        const double dA = kStepM / inside;
+        const double dA = step / inside;
         double a = 0.0, dir = 1.0;
         while (p.size() < kPathPoints) {
             p.push_back(onRadius(a, inside));
@@ -97,12 +106,12 @@ const std::vector<Vec3>& slidePath() {
                 dir = -dir;
             }
         }
-        for (double r = inside; r < outside; r += kStepM) {
+        for (double r = inside; r < outside; r += step) {
             p.push_back(onRadius(a, r));
         }
         return p;
     }();
-    return path;
+    return paths.emplace(step, path).first->second;
 }
 
 IndexSpec meshSpec(bool grid) {
@@ -327,10 +336,10 @@ void buildMesh(benchmark::State& state, std::size_t n, int which) {
     state.counters["triangles"] = scene.triangleCount();
 }
 
-void tickMesh(benchmark::State& state, std::size_t n, bool grid) {
+void tickMesh(benchmark::State& state, std::size_t n, bool grid, double step) {
     World world(meshScene(n), meshSpec(grid));
     HapticTick tick;
-    const std::vector<Vec3>& path = slidePath();
+    const std::vector<Vec3>& path = slidePath(step);
     std::vector<double> ns;
     ns.reserve(1 << 20);
     std::size_t i = 0;
@@ -338,6 +347,7 @@ void tickMesh(benchmark::State& state, std::size_t n, bool grid) {
     double tested = 0;
     double passes = 0;
     double extra = 0;
+    double solves = 0;
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
         const TickOutput out = tick.tick(world.current(), path[i], Vec3(0.0), 1e-3, Vec3(0.0));
@@ -352,6 +362,7 @@ void tickMesh(benchmark::State& state, std::size_t n, bool grid) {
         tested += out.render.objectsTested;
         passes += out.render.iterations;
         extra += out.extraLeaves;
+        solves += out.solves;
         i = (i + 1) % path.size();
     }
     std::sort(ns.begin(), ns.end());
@@ -365,6 +376,7 @@ void tickMesh(benchmark::State& state, std::size_t n, bool grid) {
     state.counters["tested"] = benchmark::Counter(tested, benchmark::Counter::kAvgIterations);
     state.counters["passes"] = benchmark::Counter(passes, benchmark::Counter::kAvgIterations);
     state.counters["extra_leaves"] = benchmark::Counter(extra, benchmark::Counter::kAvgIterations);
+    state.counters["solves"] = benchmark::Counter(solves, benchmark::Counter::kAvgIterations);
     state.counters["triangles"] = meshScene(n).triangleCount();
 }
 
@@ -398,7 +410,10 @@ void registerMeshBenchmarks() {
         RegisterBenchmark(("mesh-near/" + sn + "hapto-grid").c_str(), nearHapto, n, true);
         RegisterBenchmark(("mesh-near/" + sn + "bullet-bvh").c_str(), nearBullet, n);
         RegisterBenchmark(("mesh-near/" + sn + "fcl-obbrss").c_str(), nearFcl, n);
-        RegisterBenchmark(("mesh-tick/" + sn + "hapto-octree").c_str(), tickMesh, n, false)
+        RegisterBenchmark(("mesh-tick/" + sn + "hapto-octree").c_str(), tickMesh, n, false, kStepM)
+            ->UseManualTime();
+        RegisterBenchmark(("mesh-tick-slow/" + sn + "hapto-octree").c_str(), tickMesh, n, false,
+                          kSlowStepM)
             ->UseManualTime();
     }
 }

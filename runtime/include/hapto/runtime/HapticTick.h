@@ -37,6 +37,9 @@ struct TickOutput {
     /// crossed a leaf no span listed after kExtraLeaves (HapticTick::kPullBacks at most; the
     /// last keeps the proxy where it was, with no force this tick).
     std::uint8_t pullBacks = 0;
+    /// Times the renderer solved this tick: 1, plus one per leaf the solved proxy reached,
+    /// plus one per pull-back.
+    std::uint8_t solves = 0;
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
 };
 
