@@ -6,9 +6,12 @@
 #include <cerrno>
 #include <cstring>
 #include <ctime>
+#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
 #include <sys/prctl.h>
+#include <unistd.h>
+#include <utility>
 
 namespace hapto::rt {
 namespace {
@@ -63,6 +66,48 @@ RealtimeGrant makeCurrentThreadRealtime(int priority, int cpu) {
         }
     }
     return g;
+}
+
+WakeLatencyHold::WakeLatencyHold(std::int32_t us, std::string_view path) : mUs(us) {
+    const std::string file(path);
+    if (us < 0) {
+        mNote = file + ": a wake-up latency is at least 0 us, not " + std::to_string(us);
+        return;
+    }
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) {
+        mNote = file + ": " + std::strerror(errno) +
+                "; idle CPUs keep their usual wake-up latency (run as root to hold it)";
+        return;
+    }
+    // The request is the binary s32 itself (the interface also takes a "0x%08x" string).
+    if (::write(fd, &us, sizeof us) != static_cast<ssize_t>(sizeof us)) {
+        mNote = file + ": writing " + std::to_string(us) + " us failed: " + std::strerror(errno);
+        ::close(fd);
+        return;
+    }
+    mFd = fd;
+}
+
+WakeLatencyHold::~WakeLatencyHold() {
+    if (mFd >= 0) {
+        ::close(mFd); // the kernel drops the request
+    }
+}
+
+WakeLatencyHold::WakeLatencyHold(WakeLatencyHold&& other) noexcept
+    : mFd(std::exchange(other.mFd, -1)), mUs(other.mUs), mNote(std::move(other.mNote)) {}
+
+WakeLatencyHold& WakeLatencyHold::operator=(WakeLatencyHold&& other) noexcept {
+    if (this != &other) {
+        if (mFd >= 0) {
+            ::close(mFd);
+        }
+        mFd = std::exchange(other.mFd, -1);
+        mUs = other.mUs;
+        mNote = std::move(other.mNote);
+    }
+    return *this;
 }
 
 bool inServoLoop() noexcept {

@@ -91,6 +91,7 @@ RunReport Runtime::report() const {
     const std::uint64_t end = stoppedAt ? stoppedAt : now();
     r.durationS = mStartNs ? static_cast<double>(end - mStartNs) * 1e-9 : 0.0;
     r.realtimeNote = mRealtimeNote;
+    r.wakeLatencyUs = mHeldWakeLatencyUs;
     return r;
 }
 
@@ -161,6 +162,9 @@ std::string reportToJson(const RunReport& r) {
                {"cores", r.cores},
                {"stable", r.stable},
                {"duration_s", r.durationS}};
+    if (r.wakeLatencyUs >= 0) {
+        total["wake_latency_us"] = r.wakeLatencyUs;
+    }
     json out{{"devices", devices}, {"total", total}};
     if (!r.realtimeNote.empty()) {
         out["realtime_note"] = r.realtimeNote;

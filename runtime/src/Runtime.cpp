@@ -126,6 +126,13 @@ std::size_t Runtime::openAll() {
 }
 
 std::size_t Runtime::start() {
+    if (mOptions.wakeLatencyUs >= 0) {
+        mWakeLatency = rt::WakeLatencyHold(mOptions.wakeLatencyUs);
+        mHeldWakeLatencyUs = mWakeLatency.held() ? mWakeLatency.us() : -1;
+        if (!mWakeLatency.held()) {
+            mRealtimeNote += (mRealtimeNote.empty() ? "" : "; ") + mWakeLatency.note();
+        }
+    }
     const std::size_t started = openAll();
     for (auto& chp : mChannels) {
         if (chp->record.opened) {
@@ -206,6 +213,7 @@ void Runtime::stop() {
             }
         }
     }
+    mWakeLatency = rt::WakeLatencyHold(); // every servo thread has stopped: idle CPUs may sleep
     std::uint64_t none = 0;
     if (mStartNs != 0) {
         mStopNs.compare_exchange_strong(none, now());

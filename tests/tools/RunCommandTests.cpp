@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <unistd.h>
 
 using namespace hapto::test;
 using nlohmann::json;
@@ -156,4 +157,27 @@ TEST_CASE("hapto run refuses bad input with exit code 2 and says where") {
     r = runHapto("run --scene " + (dir / "missing.json").string());
     CHECK(r.exitCode == 2);
     CHECK_THAT(r.output, Catch::Contains("missing.json"));
+    r = runHapto("run --wake-latency-us -5");
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("--wake-latency-us"));
+    r = runHapto("run --wake-latency-us 0.5");
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("--wake-latency-us"));
+}
+
+TEST_CASE("hapto run --wake-latency-us holds the request while the hands run, or says why not") {
+    TempDir dir;
+    const CommandResult r = runHapto("run --duration 0.3 --no-realtime --quiet --wake-latency-us 0 "
+                                     "--report " +
+                                     (dir / "r.json").string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    const json j = json::parse(readFile(dir / "r.json"));
+    if (::access("/dev/cpu_dma_latency", W_OK) == 0) {
+        CHECK(j["total"]["wake_latency_us"] == 0);
+        CHECK_THAT(r.output, Catch::Contains("wake latency: idle CPUs held to 0 us"));
+    } else {
+        CHECK_FALSE(j["total"].contains("wake_latency_us"));
+        CHECK_THAT(j["realtime_note"].get<std::string>(), Catch::Contains("/dev/cpu_dma_latency"));
+    }
 }

@@ -44,6 +44,7 @@ struct RunArgs {
     double warmUs = static_cast<double>(kDefaultWarmUpNs) / 1000.0;
     int missLimit = 3;
     std::size_t devicesPerThread = 1;
+    std::int32_t wakeLatencyUs = -1;
     double reopenMs = 1000;
     bool quiet = false;
     ViewArgs view;
@@ -68,6 +69,10 @@ void printSummary(const RunReport& r) {
         "total: load %.2f%% of one core summed over %zu devices, %.2f%% per core (%d cores); %s\n",
         100 * r.loadSum, r.devices.size(), 100 * r.loadPerCore, r.cores,
         r.stable ? "stable" : "NOT stable");
+    if (r.wakeLatencyUs >= 0) {
+        std::printf("wake latency: idle CPUs held to %d us while the devices ran\n",
+                    static_cast<int>(r.wakeLatencyUs));
+    }
     if (!r.realtimeNote.empty()) {
         std::printf("note: %s\n", r.realtimeNote.c_str());
     }
@@ -156,6 +161,7 @@ int runSession(const RunArgs& a) {
     opt.missLimit = a.missLimit;
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
     opt.devicesPerThread = a.devicesPerThread;
+    opt.wakeLatencyUs = a.wakeLatencyUs;
     Runtime runtime(world, std::move(devices), opt);
     // A second signal while the orderly stop below is under way (or blocked): zero force
     // now, from the signal thread, and exit.
@@ -275,6 +281,12 @@ void addRunCommands(CLI::App& app) {
                     "those due); 1 = one servo thread per device")
         ->capture_default_str()
         ->check(finiteRange(1, static_cast<double>(kMaxSessionDevices)));
+    cmd->add_option("--wake-latency-us", a->wakeLatencyUs,
+                    "While the devices run, ask the kernel that no idle CPU take longer than this "
+                    "to wake (/dev/cpu_dma_latency, as cyclictest does; needs root): 0 keeps idle "
+                    "CPUs polling, which cuts the tail of a tick after its sleep (docs/results/"
+                    "tick.md) and makes every idle core spin; unset = no request (us)")
+        ->check(finiteRange(0, 1e6));
     cmd->add_flag("--quiet", a->quiet, "No live lines on the terminal");
     addViewOptions(cmd, a->view);
     cmd->callback([a] {

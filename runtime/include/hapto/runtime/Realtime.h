@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace hapto::rt {
 
@@ -28,6 +29,40 @@ struct RealtimeGrant {
 /// `cpu` (-1: no pinning).
 /// Never fails: returns what was granted. Call at thread start, before the loop. [control]
 RealtimeGrant makeCurrentThreadRealtime(int priority, int cpu);
+
+/// A request to the kernel's CPU latency QoS that no idle CPU take longer than `us`
+/// microseconds to start running again, held while this object lives. Linux's interface
+/// (Documentation/power/pm_qos_interface.rst, "From user space"): a process that holds
+/// /dev/cpu_dma_latency open has a request registered; writing an s32 sets its value; closing
+/// the file removes it. With 0, the cpuidle governor picks only states that wake at once (on
+/// this VM's haltpoll driver: POLL, never the halt that exits to the host), as cyclictest does
+/// by default. The price: idle CPUs spin instead of sleeping, on every core, while it is held.
+/// Move-only. [control]
+class WakeLatencyHold {
+public:
+    static constexpr std::string_view kDefaultPath = "/dev/cpu_dma_latency";
+
+    WakeLatencyHold() = default;
+    /// Opens `path` and writes `us` (>= 0) as a native s32. On failure nothing is held and
+    /// note() says what and why ("/dev/cpu_dma_latency: Permission denied ..."). Never throws
+    /// on an I/O error.
+    explicit WakeLatencyHold(std::int32_t us, std::string_view path = kDefaultPath);
+    ~WakeLatencyHold();
+    WakeLatencyHold(WakeLatencyHold&& other) noexcept;
+    WakeLatencyHold& operator=(WakeLatencyHold&& other) noexcept;
+    WakeLatencyHold(const WakeLatencyHold&) = delete;
+    WakeLatencyHold& operator=(const WakeLatencyHold&) = delete;
+
+    bool held() const noexcept { return mFd >= 0; }
+    std::int32_t us() const noexcept { return mUs; }
+    /// Why nothing is held, for people; empty when held (or never asked).
+    const std::string& note() const noexcept { return mNote; }
+
+private:
+    int mFd = -1;
+    std::int32_t mUs = -1;
+    std::string mNote;
+};
 
 /// True on a servo thread between loop entry and exit: what allocation-counting tests use to
 /// tell servo-path allocations from set-up ones. [any thread]

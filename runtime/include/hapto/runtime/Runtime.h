@@ -10,6 +10,7 @@
 #include "hapto/runtime/ForceSafety.h"
 #include "hapto/runtime/GodObjectRenderer.h"
 #include "hapto/runtime/ManualClock.h"
+#include "hapto/runtime/Realtime.h"
 #include "hapto/runtime/ServoLoop.h"
 #include "hapto/runtime/TickHook.h"
 #include "hapto/runtime/World.h"
@@ -71,6 +72,13 @@ struct RuntimeOptions {
     /// default, and the design): one servo thread per device. The constructor throws
     /// std::invalid_argument for K = 0 or K > 1 with a device of another kind.
     std::size_t devicesPerThread = 1;
+    /// >= 0: while the servo threads run (start() to stop()), hold a CPU latency request of
+    /// this many microseconds (rt::WakeLatencyHold): 0 keeps idle CPUs polling, so a servo
+    /// thread's wake-up from its sleep does not wait for a halted CPU. -1 (the default): no
+    /// request; idle CPUs spinning costs power and, on a VM, the host's CPU. Not in step mode.
+    /// A request that cannot be held (not root, no such file) is reported in
+    /// RunReport::realtimeNote and the run goes on without it.
+    std::int32_t wakeLatencyUs = -1;
 };
 
 /// One device as the runtime drives it.
@@ -113,6 +121,8 @@ struct RunReport {
     bool stable = false;      ///< Every device stable.
     double durationS = 0;     ///< Wall time from start to stop (s).
     std::string realtimeNote; ///< Why SCHED_FIFO or pinning was not granted, if not.
+    /// The CPU latency request held during the run (us; RuntimeOptions::wakeLatencyUs), or -1.
+    std::int32_t wakeLatencyUs = -1;
 };
 
 /// Runs D servo threads (or D / K, RuntimeOptions::devicesPerThread) and a supervisor. Construct,
@@ -270,6 +280,8 @@ private:
     std::uint64_t mStartNs = 0;
     std::atomic<std::uint64_t> mStopNs{0};
     std::string mRealtimeNote;
+    rt::WakeLatencyHold mWakeLatency;     // held from start() to stop() when asked for
+    std::int32_t mHeldWakeLatencyUs = -1; // what it held (us), for the report
     std::thread mSupervisor;
     std::atomic<bool> mStopping{false};
     std::mutex mWakeMutex; // with mWake: stop() interrupts supervision's waits
