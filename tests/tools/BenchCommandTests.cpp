@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iterator>
 #include <string>
+#include <unistd.h>
 
 using namespace hapto;
 using nlohmann::json;
@@ -159,8 +160,8 @@ json runTickJson(const test::TempDir& dir, const std::string& args) {
 void checkTickEntry(const json& e, std::size_t ticks) {
     INFO(e.dump());
     for (const char* key :
-         {"index", "mode", "objects", "ticks", "sleep_us", "warm_us", "device", "stages", "tick",
-          "locate_steps_mean", "candidates_mean", "contact_fraction"}) {
+         {"index", "mode", "objects", "ticks", "sleep_us", "warm_us", "wake_latency_us", "device",
+          "stages", "tick", "locate_steps_mean", "candidates_mean", "contact_fraction"}) {
         CHECK(e.contains(key));
     }
     CHECK(e["ticks"] == ticks);
@@ -220,6 +221,35 @@ TEST_CASE("hapto bench tick --json reports every stage of every mode for every i
     }
 }
 
+TEST_CASE("hapto bench tick --wake-latency-us adds the sleep modes with the request held") {
+    test::TempDir dir;
+    const std::string out = (dir / "tick.json").string();
+    const auto r = test::runHapto("bench tick --ticks 100 --sleep-us 100 --warm-us 10 "
+                                  "--wake-latency-us 0 --json " +
+                                  out);
+    INFO(r.output);
+    if (::access("/dev/cpu_dma_latency", W_OK) != 0) {
+        // Not root, or no PM QoS here: the run stops and says what it could not hold.
+        CHECK(r.exitCode != 0);
+        CHECK_THAT(r.output, Catch::Contains("/dev/cpu_dma_latency"));
+        CHECK_FALSE(std::filesystem::exists(out));
+        return;
+    }
+    REQUIRE(r.exitCode == 0);
+    const json j = json::parse(test::readFile(out));
+    REQUIRE(j.size() == 5);
+    const char* modes[] = {"hot", "sleep", "sleep+warm", "sleep+lat", "sleep+warm+lat"};
+    for (std::size_t i = 0; i < j.size(); ++i) {
+        CHECK(j[i]["mode"] == modes[i]);
+        CHECK(j[i]["wake_latency_us"] == (i < 3 ? -1 : 0));
+        CHECK(j[i]["sleep_us"].get<double>() == (i == 0 ? 0.0 : 100.0));
+        CHECK(j[i]["warm_us"].get<double>() == (i == 2 || i == 4 ? 10.0 : 0.0));
+        checkTickEntry(j[i], 100);
+        CHECK(j[i]["candidates_mean"] == j[0]["candidates_mean"]); // the same walk
+    }
+    CHECK_THAT(r.output, Catch::Contains("sleep+warm+lat"));
+}
+
 TEST_CASE("hapto bench tick drives a simulated hand's reads and writes, and prints a table") {
     test::TempDir dir;
     const json j = runTickJson(dir, "--device sim --ticks 200 --sleep-us 100 --warm-us 10");
@@ -272,6 +302,11 @@ TEST_CASE("hapto bench tick refuses bad options with exit code 2 and writes noth
         const auto r = test::runHapto("bench tick --ticks 10 --device falcon --json " + out);
         CHECK(r.exitCode == 2);
         CHECK_THAT(r.output, Catch::Contains("--device"));
+    }
+    SECTION("a negative wake latency") {
+        const auto r = test::runHapto("bench tick --ticks 10 --wake-latency-us -1 --json " + out);
+        CHECK(r.exitCode == 2);
+        CHECK_THAT(r.output, Catch::Contains("--wake-latency-us"));
     }
     SECTION("no ticks") {
         const auto r = test::runHapto("bench tick --ticks 0 --json " + out);

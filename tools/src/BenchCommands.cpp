@@ -249,6 +249,8 @@ constexpr std::size_t kStageCount = kStages.size();
 /// warm-up before the deadline.
 enum class TickMode : std::uint8_t { Hot, Sleep, Warm };
 constexpr std::array<const char*, 3> kModeNames{"hot", "sleep", "sleep+warm"};
+/// The same sleep modes with a CPU wake-latency request held (--wake-latency-us).
+constexpr std::array<const char*, 3> kHeldModeNames{"", "sleep+lat", "sleep+warm+lat"};
 
 /// A device that plays the hand walk: read() hands over the walk's next point (device frame =
 /// world frame), write() keeps the force. Kind "scripted": made by this program, never by a
@@ -296,6 +298,7 @@ struct alignas(64) TickPieces {
 /// One (index, mode) being driven: its device, its tick state, its per-stage samples (ns).
 struct TickRun {
     TickMode mode = TickMode::Hot;
+    bool holdLatency = false; // hold --wake-latency-us while it ticks
     std::unique_ptr<Device> device;
     std::unique_ptr<experiments::HandWalk> walk; // the point, when the device is a sim hand
     std::unique_ptr<TickPieces> pieces;
@@ -323,7 +326,8 @@ struct TickArgs {
     double sleepUs = 1000;
     double warmUs = static_cast<double>(kDefaultWarmUpNs) / 1000.0;
     std::uint64_t seed = 1;
-    double walkEdgeM = 0.0; ///< 0: the walk roams the scene's bounds
+    double walkEdgeM = 0.0;          ///< 0: the walk roams the scene's bounds
+    std::int32_t wakeLatencyUs = -1; ///< >= 0: also the sleep modes with this request held
     std::string json;
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
 };
@@ -438,12 +442,27 @@ void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs,
     run.contactTicks += out.contactCount > 0 ? 1 : 0;
 }
 
+/// "hot", "sleep", "sleep+warm", "sleep+lat", "sleep+warm+lat".
+const char* modeName(const TickRun& run) {
+    const auto m = static_cast<std::size_t>(run.mode);
+    return run.holdLatency ? kHeldModeNames[m] : kModeNames[m];
+}
+
 /// Runs `count` ticks of `run` from sample `at` on, started as its mode says.
 void driveTicks(TickRun& run, World& world, std::size_t at, std::size_t count,
                 const TickArgs& args) {
     const auto sleepNs = static_cast<std::uint64_t>(args.sleepUs * 1000.0);
     const auto warmNs = static_cast<std::uint64_t>(args.warmUs * 1000.0);
     const double dtS = 1e-3;
+    // Held for this block only (the request takes effect at the CPUs' next idle entry), so
+    // the runs with and without it take turns like every other pair of runs.
+    rt::WakeLatencyHold hold;
+    if (run.holdLatency) {
+        hold = rt::WakeLatencyHold(args.wakeLatencyUs);
+        if (!hold.held()) {
+            throw std::runtime_error("bench tick: --wake-latency-us: " + hold.note());
+        }
+    }
     for (std::size_t k = at; k < at + count; ++k) {
         std::uint64_t wake = rt::nowNs();
         if (run.mode != TickMode::Hot) {
@@ -523,9 +542,15 @@ void runTick(const TickArgs& args) {
         TickTarget target;
         target.spec = spec;
         target.world = std::make_unique<World>(scene, spec);
-        for (const TickMode mode : {TickMode::Hot, TickMode::Sleep, TickMode::Warm}) {
+        std::vector<std::pair<TickMode, bool>> modes{
+            {TickMode::Hot, false}, {TickMode::Sleep, false}, {TickMode::Warm, false}};
+        if (args.wakeLatencyUs >= 0) {
+            modes.insert(modes.end(), {{TickMode::Sleep, true}, {TickMode::Warm, true}});
+        }
+        for (const auto& [mode, held] : modes) {
             auto run = std::make_unique<TickRun>();
             run->mode = mode;
+            run->holdLatency = held;
             if (args.device == "sim") {
                 DeviceConfig c = defaultDeviceConfigs().front();
                 c.name = "bench";
@@ -580,14 +605,18 @@ void runTick(const TickArgs& args) {
     std::printf("modes:   hot = back to back; sleep = after a %.0f us sleep; sleep+warm = the "
                 "same with the servo loop's warm-up %.1f us before the deadline\n",
                 args.sleepUs, args.warmUs);
+    if (args.wakeLatencyUs >= 0) {
+        std::printf("         +lat = the same while /dev/cpu_dma_latency holds %d us\n",
+                    static_cast<int>(args.wakeLatencyUs));
+    }
     std::printf("timing:  steady clock at each stage boundary (%zu readings per tick, one costs "
                 "~%.0f ns); nearest-rank quantiles over every tick; runs interleaved in blocks "
                 "of %zu ticks\n",
                 kStageCount + 1, clockOverheadNs(), kTickBlock);
     for (const TickTarget& target : targets) {
         std::printf("\nindex %s\n%-12s", target.spec.toString().c_str(), "stage");
-        for (const char* mode : kModeNames) {
-            std::printf(" | %-10s %7s %7s %8s", mode, "p50 ns", "p99 ns", "p99.9 ns");
+        for (const auto& run : target.runs) {
+            std::printf(" | %-10s %7s %7s %8s", modeName(*run), "p50 ns", "p99 ns", "p99.9 ns");
         }
         std::printf("\n");
         std::vector<std::array<Quantiles, kStageCount + 1>> q(target.runs.size());
@@ -613,11 +642,12 @@ void runTick(const TickArgs& args) {
                 stages[kStages[s]] = toJson(q[r][s]);
             }
             out.push_back({{"index", target.spec.toString()},
-                           {"mode", kModeNames[static_cast<std::size_t>(run.mode)]},
+                           {"mode", modeName(run)},
                            {"objects", scene.size()},
                            {"ticks", run.ticks},
                            {"sleep_us", run.mode == TickMode::Hot ? 0.0 : args.sleepUs},
                            {"warm_us", run.mode == TickMode::Warm ? args.warmUs : 0.0},
+                           {"wake_latency_us", run.holdLatency ? args.wakeLatencyUs : -1},
                            {"device", args.device},
                            {"walk_min", {walkIn.min.x, walkIn.min.y, walkIn.min.z}},
                            {"walk_max", {walkIn.max.x, walkIn.max.y, walkIn.max.z}},
@@ -719,8 +749,15 @@ void addBenchCommands(CLI::App& app) {
                      "(within the bounds), e.g. to walk the same neighbourhood of a small and a "
                      "large scene of equal density; default: the whole bounds")
         ->check(finiteRange(1e-6, 1e4));
+    tick->add_option("--wake-latency-us", targs->wakeLatencyUs,
+                     "Also run the two sleep modes while a CPU wake-latency request of this "
+                     "many us is held (/dev/cpu_dma_latency, needs root; hapto run "
+                     "--wake-latency-us), as modes sleep+lat and sleep+warm+lat, interleaved "
+                     "with the others; 0 keeps idle CPUs polling")
+        ->check(finiteRange(0, 1e6));
     tick->add_option("--json", targs->json,
                      "Also write a JSON array of {index, mode, objects, ticks, sleep_us, warm_us, "
+                     "wake_latency_us (-1: none), "
                      "device, walk_min, walk_max, stages: {read, ...: {ns_p50, ns_p99, ns_p999, "
                      "ns_mean}}, tick: "
                      "{...}, locate_steps_mean, candidates_mean, contact_fraction} to this file");
