@@ -44,6 +44,21 @@ bool canHold() {
     return ::access(kQos.c_str(), W_OK) == 0;
 }
 
+/// One scripted hand pressing into the cube, on its own servo thread, under `options`
+/// (normal scheduling).
+struct OneHand {
+    World world{test::cubeScene(), IndexSpec::parse("octree:2:0.005")};
+    std::unique_ptr<Runtime> runtime;
+
+    explicit OneHand(RuntimeOptions options) {
+        std::vector<RuntimeDevice> rds;
+        rds.push_back({std::make_unique<test::ScriptedDevice>("d0", test::pressIntoCube(0.0)),
+                       test::scriptedConfig(0, 1000.0), nullptr});
+        options.realtime = false;
+        runtime = std::make_unique<Runtime>(world, std::move(rds), options);
+    }
+};
+
 } // namespace
 
 TEST_CASE("a wake-latency hold writes its request as an s32 and names what failed") {
@@ -101,14 +116,10 @@ TEST_CASE("a wake-latency hold is a request the kernel keeps while it is held") 
 
 TEST_CASE("a session asked to hold a wake latency holds it while its servo threads run",
           "[realtime]") {
-    World world(test::cubeScene(), IndexSpec::parse("octree:2:0.005"));
-    std::vector<RuntimeDevice> rds;
-    rds.push_back({std::make_unique<test::ScriptedDevice>("d0", test::pressIntoCube(0.0)),
-                   test::scriptedConfig(0, 1000.0), nullptr});
     RuntimeOptions opt;
-    opt.realtime = false;
     opt.wakeLatencyUs = 3;
-    Runtime runtime(world, std::move(rds), opt);
+    OneHand hand(opt);
+    Runtime& runtime = *hand.runtime;
     REQUIRE(runtime.start() == 1);
     if (canHold()) {
         const std::optional<std::int32_t> inForce = readS32(kQos);
@@ -130,13 +141,8 @@ TEST_CASE("a session asked to hold a wake latency holds it while its servo threa
 }
 
 TEST_CASE("a session holds no wake latency unless asked", "[realtime]") {
-    World world(test::cubeScene(), IndexSpec::parse("octree:2:0.005"));
-    std::vector<RuntimeDevice> rds;
-    rds.push_back({std::make_unique<test::ScriptedDevice>("d0", test::pressIntoCube(0.0)),
-                   test::scriptedConfig(0, 1000.0), nullptr});
-    RuntimeOptions opt;
-    opt.realtime = false;
-    Runtime runtime(world, std::move(rds), opt);
+    OneHand hand(RuntimeOptions{});
+    Runtime& runtime = *hand.runtime;
     REQUIRE(runtime.start() == 1);
     runtime.stop();
     const RunReport r = runtime.report();

@@ -749,12 +749,9 @@ void addBenchCommands(CLI::App& app) {
                      "(within the bounds), e.g. to walk the same neighbourhood of a small and a "
                      "large scene of equal density; default: the whole bounds")
         ->check(finiteRange(1e-6, 1e4));
-    tick->add_option("--wake-latency-us", targs->wakeLatencyUs,
-                     "Also run the two sleep modes while a CPU wake-latency request of this "
-                     "many us is held (/dev/cpu_dma_latency, needs root; hapto run "
-                     "--wake-latency-us), as modes sleep+lat and sleep+warm+lat, interleaved "
-                     "with the others; 0 keeps idle CPUs polling")
-        ->check(finiteRange(0, 1e6));
+    addWakeLatencyOption(tick, targs->wakeLatencyUs,
+                         "the two sleep modes run again, as sleep+lat and sleep+warm+lat, "
+                         "interleaved with the others (hapto run --wake-latency-us)");
     tick->add_option("--json", targs->json,
                      "Also write a JSON array of {index, mode, objects, ticks, sleep_us, warm_us, "
                      "wake_latency_us (-1: none), "

@@ -89,6 +89,17 @@ CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes) {
         ->check(finiteRange(1, kMaxIndexMbOption));
 }
 
+CLI::Option* addWakeLatencyOption(CLI::App* cmd, std::int32_t& us, const std::string& what) {
+    return cmd
+        ->add_option("--wake-latency-us", us,
+                     "Ask the kernel that no idle CPU take longer than this to wake (us) while " +
+                         what +
+                         " (/dev/cpu_dma_latency, as cyclictest does; needs root): 0 keeps idle "
+                         "CPUs polling instead of halting, which cuts the tail of a tick after "
+                         "its sleep (docs/results/tick.md) and makes every idle core spin")
+        ->check(finiteRange(0, 1e6));
+}
+
 CLI::Option* addViewBindOption(CLI::App* cmd, ViewArgs& args) {
     return cmd
         ->add_option("--view-bind", args.bindAddress,

@@ -46,6 +46,9 @@ CLI::Option* addRealtimeFlag(CLI::App* cmd, bool& realtime, const std::string& w
 CLI::Option* addIndexOption(CLI::App* cmd, std::string& spec);
 /// Adds `--max-index-mb MB`, the most memory an index build may take. [control]
 CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes);
+/// Adds `--wake-latency-us US` (0 or more; unset leaves `us` at -1): a CPU wake-latency
+/// request (rt::WakeLatencyHold) held while `what`. [control]
+CLI::Option* addWakeLatencyOption(CLI::App* cmd, std::int32_t& us, const std::string& what);
 
 /// The view's default port (`--view` without a port).
 inline constexpr int kDefaultViewPort = 8340;

@@ -281,12 +281,7 @@ void addRunCommands(CLI::App& app) {
                     "those due); 1 = one servo thread per device")
         ->capture_default_str()
         ->check(finiteRange(1, static_cast<double>(kMaxSessionDevices)));
-    cmd->add_option("--wake-latency-us", a->wakeLatencyUs,
-                    "While the devices run, ask the kernel that no idle CPU take longer than this "
-                    "to wake (/dev/cpu_dma_latency, as cyclictest does; needs root): 0 keeps idle "
-                    "CPUs polling, which cuts the tail of a tick after its sleep (docs/results/"
-                    "tick.md) and makes every idle core spin; unset = no request (us)")
-        ->check(finiteRange(0, 1e6));
+    addWakeLatencyOption(cmd, a->wakeLatencyUs, "the devices run (unset: no request)");
     cmd->add_flag("--quiet", a->quiet, "No live lines on the terminal");
     addViewOptions(cmd, a->view);
     cmd->callback([a] {
