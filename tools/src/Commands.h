@@ -5,8 +5,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include <span>
 #include <string>
 #include <vector>
+
+namespace hapto::experiments {
+struct PlotSpec;
+}
 
 namespace hapto::cli {
 
@@ -23,10 +28,22 @@ void addTraceCommands(CLI::App& app);
 /// `hapto report plot`: a `hapto run --report` JSON file drawn per device. [control]
 void addReportCommands(CLI::App& app);
 
-/// Refuses, before any work, a plot output `out` not ending in .png or .svg or not writable,
-/// and a `script` output (may be empty) that is `out` or not writable. Throws InputError.
+/// Where a plot command writes: the plot, OUT.png or OUT.svg, and optionally its gnuplot script.
+struct PlotOutputs {
+    std::string out;
+    std::string script; ///< Empty: not kept.
+
+    /// Refuses, before any work, a plot not ending in .png or .svg or not writable, a script
+    /// that is the plot or not writable, and either being one of `inputs` (each called
+    /// `inputName` in the message). Throws InputError. [control]
+    void check(std::span<const std::string> inputs, const std::string& inputName) const;
+    /// Draws `spec` there with gnuplot (atomically) and says so on standard error. [control]
+    void draw(const experiments::PlotSpec& spec) const;
+};
+
+/// Adds the required `-o,--output OUT.png|OUT.svg` and `--script F` to a plot command.
 /// [control]
-void checkPlotOutputs(const std::string& out, const std::string& script);
+void addPlotOutputOptions(CLI::App* cmd, PlotOutputs& outputs);
 
 /// `hapto bench query` and `hapto bench tick`: per-query cost of indices and the servo tick's
 /// stages along a hand-speed walk. [control]

@@ -133,15 +133,10 @@ experiments::PlotSpec reportPlot(const std::string& path, const std::vector<Repo
     return spec;
 }
 
-void plotReport(const std::string& path, const std::string& out, const std::string& script) {
-    refuseSameFile(out, "-o", path, "the report");
-    if (!script.empty()) {
-        refuseSameFile(script, "--script", path, "the report");
-    }
-    checkPlotOutputs(out, script);
+void plotReport(const std::string& path, const PlotOutputs& outputs) {
+    outputs.check(std::span(&path, 1), "the report");
     const std::vector<ReportDevice> devices = readReport(path);
-    experiments::drawPlotFile(reportPlot(path, devices), out, script);
-    std::cerr << "wrote " << out << (script.empty() ? "" : " and " + script) << "\n";
+    outputs.draw(reportPlot(path, devices));
 }
 
 } // namespace
@@ -154,12 +149,10 @@ void addReportCommands(CLI::App& app) {
         "plot", "Draw a run report as PNG or SVG with gnuplot: tick time (% of the period), "
                 "wake-up lateness and contact and missed ticks, per device");
     auto path = std::make_shared<std::string>();
-    auto out = std::make_shared<std::string>();
-    auto script = std::make_shared<std::string>();
+    auto outputs = std::make_shared<PlotOutputs>();
     cmd->add_option("report", *path, "The report (hapto run --report FILE.json)")->required();
-    cmd->add_option("-o,--output", *out, "The plot: OUT.png or OUT.svg")->required();
-    cmd->add_option("--script", *script, "Also keep the gnuplot script, data inline");
-    cmd->callback([path, out, script] { plotReport(*path, *out, *script); });
+    addPlotOutputOptions(cmd, *outputs);
+    cmd->callback([path, outputs] { plotReport(*path, *outputs); });
 }
 
 } // namespace hapto::cli

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <vector>
@@ -274,6 +275,36 @@ void convertScene(const ConvertOptions& o) {
               << (binary ? "binary" : "JSON") << ")\n";
 }
 
+/// Adds `--size`, the cubes' edge (m). [control]
+void addCubeSizeOption(CLI::App* cmd, double& size) {
+    cmd->add_option("--size", size, "Cube edge (m)")
+        ->capture_default_str()
+        ->check(finiteRange(1e-6, 1e3));
+}
+
+/// Adds `--seed`, `--workspace` and `--size`, the options every random cube generator shares
+/// (RandomOptions, ClusterOptions). [control]
+template <class Options> void addRandomCubeOptions(CLI::App* cmd, Options& o) {
+    cmd->add_option("--seed", o.seed, "Random seed; same seed, same file")
+        ->capture_default_str()
+        ->check(finiteRange(0, kMaxSeed));
+    cmd->add_option("--workspace", o.workspace, "Edge of the work cube (m)")
+        ->capture_default_str()
+        ->check(finiteRange(1e-6, 1e4));
+    addCubeSizeOption(cmd, o.cubeSize);
+}
+
+/// Adds the required `-o,--output F` ('-' for standard output) and the callback that writes the
+/// scene `make()` generates there, after refusing an output that must not be written. [control]
+void addGeneratedSceneOutput(CLI::App* cmd, std::function<Scene()> make) {
+    auto out = std::make_shared<std::string>();
+    cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")->required();
+    cmd->callback([out, make = std::move(make)] {
+        checkSceneOutput(*out);
+        writeScene(make(), *out);
+    });
+}
+
 } // namespace
 
 void addSceneCommands(CLI::App& app) {
@@ -286,22 +317,14 @@ void addSceneCommands(CLI::App& app) {
             "grid", "Experiment 1: K x K x K cubes on a regular lattice with gaps, bounds a little "
                     "larger than the lattice");
         auto opt = std::make_shared<LatticeOptions>();
-        auto out = std::make_shared<std::string>();
         cmd->add_option("--per-side", opt->perSide, "K, cubes per lattice side")
             ->required()
             ->check(finiteRange(1, 100000));
-        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
-            ->capture_default_str()
-            ->check(finiteRange(1e-6, 1e3));
+        addCubeSizeOption(cmd, opt->cubeSize);
         cmd->add_option("--gap", opt->gap, "Free space between neighbouring cubes (m)")
             ->capture_default_str()
             ->check(finiteRange(0, 1e3));
-        cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
-            ->required();
-        cmd->callback([opt, out] {
-            checkSceneOutput(*out);
-            writeScene(makeLatticeScene(*opt), *out);
-        });
+        addGeneratedSceneOutput(cmd, [opt] { return makeLatticeScene(*opt); });
     }
     // random
     {
@@ -309,30 +332,16 @@ void addSceneCommands(CLI::App& app) {
             "random", "Experiment 2: N cubes placed uniformly at random in a work cube centred on "
                       "the origin; bounds are the work cube");
         auto opt = std::make_shared<RandomOptions>();
-        auto out = std::make_shared<std::string>();
         cmd->add_option("--count", opt->count, "Number of cubes (e.g. 200 or 1e6)")
             ->required()
             ->transform(wholeNumber(0, 4e9));
-        cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
-            ->capture_default_str()
-            ->check(finiteRange(0, kMaxSeed));
-        cmd->add_option("--workspace", opt->workspace, "Edge of the work cube (m)")
-            ->capture_default_str()
-            ->check(finiteRange(1e-6, 1e4));
-        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
-            ->capture_default_str()
-            ->check(finiteRange(1e-6, 1e3));
+        addRandomCubeOptions(cmd, *opt);
         cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
         cmd->add_option("--keep-clear", opt->keepClear,
                         "No object within this distance of the centre, where cursors start (m)")
             ->capture_default_str()
             ->check(finiteRange(0, 1e4));
-        cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
-            ->required();
-        cmd->callback([opt, out] {
-            checkSceneOutput(*out);
-            writeScene(makeRandomScene(*opt), *out);
-        });
+        addGeneratedSceneOutput(cmd, [opt] { return makeRandomScene(*opt); });
     }
     // cluster
     {
@@ -340,45 +349,25 @@ void addSceneCommands(CLI::App& app) {
             "cluster", "A strongly non-uniform scene: N cubes in C Gaussian clusters (a uniform "
                        "grid does badly here)");
         auto opt = std::make_shared<ClusterOptions>();
-        auto out = std::make_shared<std::string>();
         cmd->add_option("--count", opt->count, "Number of cubes (e.g. 1e5)")
             ->required()
             ->transform(wholeNumber(0, 4e9));
         cmd->add_option("--clusters", opt->clusters, "Number of clusters")
             ->capture_default_str()
             ->check(finiteRange(1, 1000000));
-        cmd->add_option("--seed", opt->seed, "Random seed; same seed, same file")
-            ->capture_default_str()
-            ->check(finiteRange(0, kMaxSeed));
-        cmd->add_option("--workspace", opt->workspace, "Edge of the work cube (m)")
-            ->capture_default_str()
-            ->check(finiteRange(1e-6, 1e4));
-        cmd->add_option("--size", opt->cubeSize, "Cube edge (m)")
-            ->capture_default_str()
-            ->check(finiteRange(1e-6, 1e3));
+        addRandomCubeOptions(cmd, *opt);
         cmd->add_option("--spread", opt->spread, "Standard deviation of each cluster (m)")
             ->capture_default_str()
             ->check(finiteRange(0, 1e4));
         cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
-        cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
-            ->required();
-        cmd->callback([opt, out] {
-            checkSceneOutput(*out);
-            writeScene(makeClusterScene(*opt), *out);
-        });
+        addGeneratedSceneOutput(cmd, [opt] { return makeClusterScene(*opt); });
     }
     // default
     {
         auto* cmd = scene->add_subcommand(
             "default", "Write the embedded default scene (200 random 5 cm cubes, seed 2004, 4 cm "
                        "clear around the centre)");
-        auto out = std::make_shared<std::string>();
-        cmd->add_option("-o,--output", *out, "Output scene file ('-' for standard output)")
-            ->required();
-        cmd->callback([out] {
-            checkSceneOutput(*out);
-            writeScene(makeDefaultScene(), *out);
-        });
+        addGeneratedSceneOutput(cmd, [] { return makeDefaultScene(); });
     }
     // mesh
     {

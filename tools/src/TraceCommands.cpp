@@ -239,22 +239,20 @@ experiments::PlotSpec tracePlot(const std::vector<std::string>& paths) {
     return spec;
 }
 
-void plotTraces(const std::vector<std::string>& paths, const std::string& out,
-                const std::string& script) {
-    for (const std::string& path : paths) {
-        refuseSameFile(out, "-o", path, "a trace");
-        if (!script.empty()) {
-            refuseSameFile(script, "--script", path, "a trace");
-        }
-    }
-    checkPlotOutputs(out, script);
-    experiments::drawPlotFile(tracePlot(paths), out, script);
-    std::cerr << "wrote " << out << (script.empty() ? "" : " and " + script) << "\n";
+void plotTraces(const std::vector<std::string>& paths, const PlotOutputs& outputs) {
+    outputs.check(paths, "a trace");
+    outputs.draw(tracePlot(paths));
 }
 
 } // namespace
 
-void checkPlotOutputs(const std::string& out, const std::string& script) {
+void PlotOutputs::check(std::span<const std::string> inputs, const std::string& inputName) const {
+    for (const std::string& input : inputs) {
+        refuseSameFile(out, "-o", input, inputName);
+        if (!script.empty()) {
+            refuseSameFile(script, "--script", input, inputName);
+        }
+    }
     const std::string ext = std::filesystem::path(out).extension().string();
     if (ext != ".png" && ext != ".svg") {
         throw InputError(out + ": -o names the plot, a file ending in .png or .svg");
@@ -264,6 +262,16 @@ void checkPlotOutputs(const std::string& out, const std::string& script) {
         refuseSameFile(script, "--script", out, "the plot");
         checkOutputFile(script, "--script");
     }
+}
+
+void PlotOutputs::draw(const experiments::PlotSpec& spec) const {
+    experiments::drawPlotFile(spec, out, script);
+    std::cerr << "wrote " << out << (script.empty() ? "" : " and " + script) << "\n";
+}
+
+void addPlotOutputOptions(CLI::App* cmd, PlotOutputs& outputs) {
+    cmd->add_option("-o,--output", outputs.out, "The plot: OUT.png or OUT.svg")->required();
+    cmd->add_option("--script", outputs.script, "Also keep the gnuplot script, data inline");
 }
 
 void addTraceCommands(CLI::App& app) {
@@ -291,12 +299,10 @@ void addTraceCommands(CLI::App& app) {
             "plot", "Draw traces (one per device) as PNG or SVG with gnuplot: position, proxy "
                     "and force (device frame) and tick time against time, shaded in contact");
         auto paths = std::make_shared<std::vector<std::string>>();
-        auto out = std::make_shared<std::string>();
-        auto script = std::make_shared<std::string>();
+        auto outputs = std::make_shared<PlotOutputs>();
         cmd->add_option("traces", *paths, "The trace files (one line colour each)")->required();
-        cmd->add_option("-o,--output", *out, "The plot: OUT.png or OUT.svg")->required();
-        cmd->add_option("--script", *script, "Also keep the gnuplot script, data inline");
-        cmd->callback([paths, out, script] { plotTraces(*paths, *out, *script); });
+        addPlotOutputOptions(cmd, *outputs);
+        cmd->callback([paths, outputs] { plotTraces(*paths, *outputs); });
     }
 }
 
