@@ -186,25 +186,7 @@ std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
                                 figuresOf(s.report.devices.at(0), options.servo.tail));
                             row.reachedPhase = row.reachedPhase && s.reached.at(0);
                         }
-                        row.median = medianOf(row.runs);
-                        const auto idle =
-                            std::find_if(row.runs.begin(), row.runs.end(),
-                                         [](const LoadFigures& f) { return f.ticks == 0; });
-                        if (idle != row.runs.end()) {
-                            // Nothing was measured: not a load of zero. Skipped, so it is
-                            // neither stable nor a limit.
-                            row.skipped = true;
-                            row.note = "no tick was measured in run " +
-                                       std::to_string(idle - row.runs.begin() + 1) + " of " +
-                                       std::to_string(row.runs.size()) +
-                                       ": the servo thread did not run in the timed window (an "
-                                       "overloaded machine?)";
-                        } else if (!row.reachedPhase) {
-                            row.note = "the hand did not reach its " +
-                                       std::string(conditionName(c)) + " phase before timing";
-                        } else if (!row.median.fault.empty()) {
-                            row.note = "fault: " + row.median.fault;
-                        }
+                        concludeRow(row);
                         if (!row.stable(options.verdict)) {
                             unstableHere.insert({r.name, rate});
                         }
@@ -219,6 +201,27 @@ std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
         }
     }
     return rows;
+}
+
+void concludeRow(SweepRow& row) {
+    row.median = medianOf(row.runs);
+    const auto idle = std::find_if(row.runs.begin(), row.runs.end(),
+                                   [](const LoadFigures& f) { return f.ticks == 0; });
+    if (row.runs.empty() || idle != row.runs.end()) {
+        // Nothing was measured: not a load of zero. Skipped, so it is neither stable nor a limit.
+        row.skipped = true;
+        row.note = row.runs.empty() ? "no run was made"
+                                    : "no tick was measured in run " +
+                                          std::to_string(idle - row.runs.begin() + 1) + " of " +
+                                          std::to_string(row.runs.size()) +
+                                          ": the servo thread did not run in the timed window "
+                                          "(an overloaded machine?)";
+    } else if (!row.reachedPhase) {
+        row.note = "the hand did not reach its " + std::string(conditionName(row.condition)) +
+                   " phase before timing";
+    } else if (!row.median.fault.empty()) {
+        row.note = "fault: " + row.median.fault;
+    }
 }
 
 std::vector<SweepLimit> sweepLimits(const std::vector<SweepRenderer>& renderers,

@@ -100,3 +100,48 @@ TEST_CASE("sweep limits: largest size with every scene stable, first size with o
     CHECK_FALSE(rows[0].stable(Verdict::Load));
     CHECK_FALSE(sweepLimits(renderers, {1000}, rows, Verdict::Load)[0].maxStableObjects);
 }
+
+TEST_CASE("a sweep cell in which a run measured no tick is skipped, never a load of zero") {
+    const std::vector<SweepRenderer> renderers = {{"octree", IndexSpec::brute(), ""}};
+    SweepRow idle = row("octree", 10, 1, 20);
+    idle.runs = {figures(1, 2, 3), LoadFigures{}, figures(1, 2, 3)}; // run 2 ticked nothing
+    concludeRow(idle);
+    CHECK(idle.skipped);
+    CHECK_THAT(idle.note, Catch::Contains("no tick was measured in run 2 of 3"));
+    CHECK_FALSE(idle.stable(Verdict::Load));
+    CHECK_FALSE(idle.stable(Verdict::Design));
+    // It is not the largest stable size, though its other runs were light.
+    const std::vector<SweepRow> rows = {row("octree", 5, 1, 20), idle};
+    const auto limits = sweepLimits(renderers, {1000}, rows, Verdict::Load);
+    CHECK(limits[0].maxStableObjects == 5u);
+    CHECK(limits[0].firstUnstableObjects == 10u);
+
+    SweepRow none = row("octree", 10, 1, 20);
+    none.runs.clear();
+    concludeRow(none);
+    CHECK(none.skipped);
+    CHECK_THAT(none.note, Catch::Contains("no run"));
+}
+
+TEST_CASE("a measured sweep cell takes its runs' medians and notes a missed phase or a fault") {
+    SweepRow r = row("octree", 10, 1, 20);
+    r.runs = {figures(1, 2, 10), figures(1, 2, 30), figures(1, 2, 20)};
+    r.condition = Condition::Sliding;
+    concludeRow(r);
+    CHECK_FALSE(r.skipped);
+    CHECK(r.median.p999Pct == 20);
+    CHECK(r.note.empty());
+    CHECK(r.stable(Verdict::Design));
+
+    r.reachedPhase = false;
+    concludeRow(r);
+    CHECK_FALSE(r.skipped);
+    CHECK_THAT(r.note, Catch::Contains("did not reach its sliding phase"));
+
+    r.reachedPhase = true;
+    r.runs[0].fault = "read-failed";
+    r.runs[1].fault = "read-failed";
+    concludeRow(r);
+    CHECK_THAT(r.note, Catch::Contains("fault: read-failed"));
+    CHECK_FALSE(r.stable(Verdict::Load));
+}

@@ -114,6 +114,12 @@ struct SweepLimit {
     std::size_t largestMeasuredObjects = 0; ///< The largest size measured at all.
 };
 
+/// Finishes a measured row from its runs: the medians, and what was odd. A row with no run, or
+/// with a run that measured no tick, is skipped with a note saying which (nothing was measured:
+/// that is not a load of zero); otherwise a hand that did not reach its condition's phase, or
+/// a fault, is noted. [any thread]
+void concludeRow(SweepRow& row);
+
 /// Runs the sweep; rows in measurement order. [control]
 std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
                                const std::vector<SweepStep>& steps, const SweepOptions& options,
