@@ -714,7 +714,8 @@ void addBenchCommands(CLI::App& app) {
         "seeded hand walk as bench query, each tick started three ways, side by side in one "
         "run: back to back (hot), after a --sleep-us sleep (a real 1 kHz servo), and after the "
         "same sleep with the servo loop's warm-up --warm-us before the deadline (hapto run "
-        "--warm-us). The stages are the public pieces Runtime::servoTick and HapticTick::tick "
+        "--warm-us); with --wake-latency-us, both sleep modes again while a CPU wake-latency "
+        "request is held. The stages are the public pieces Runtime::servoTick and HapticTick::tick "
         "call, in their order, with a steady clock reading at each boundary; the re-solve "
         "HapticTick runs when the proxy slides into an unlisted leaf is not run. Reports each "
         "stage's and the whole tick's median, p99 and p99.9 (ns).");
