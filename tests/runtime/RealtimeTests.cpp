@@ -16,11 +16,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cstring>
 #include <fstream>
 #include <optional>
-#include <thread>
 #include <unistd.h>
 
 using namespace hapto;

@@ -53,7 +53,9 @@ public:
     WakeLatencyHold(const WakeLatencyHold&) = delete;
     WakeLatencyHold& operator=(const WakeLatencyHold&) = delete;
 
+    /// The kernel holds the request now. [control]
     bool held() const noexcept { return mFd >= 0; }
+    /// The request asked for (us; -1 when none was), held or not. [control]
     std::int32_t us() const noexcept { return mUs; }
     /// Why nothing is held, for people; empty when held (or never asked).
     const std::string& note() const noexcept { return mNote; }
