@@ -207,9 +207,10 @@ std::vector<Vec3> connect(const Scene& scene, const Vec3& a, const Vec3& b) {
     return {b};
 }
 
-// True when a hand can stand `kStandOffM` off object `slot` along `out` and move in to it.
-bool reachableSide(const Scene& scene, std::uint32_t slot, const Vec3& surface, const Vec3& out) {
-    const Vec3 standOff = surface + out * kStandOffM;
+// True when a hand can stand `standOffM` off object `slot` along `out` and move in to it.
+bool reachableSide(const Scene& scene, std::uint32_t slot, const Vec3& surface, const Vec3& out,
+                   double standOffM = kStandOffM) {
+    const Vec3 standOff = surface + out * standOffM;
     Aabb around = Aabb::empty();
     around.expand(standOff);
     around.expand(surface);
@@ -226,6 +227,49 @@ double surfaceAlong(const SceneObject& o, const Vec3& out) {
         (o.contains(o.center + out * mid) ? in : outT) = mid;
     }
     return outT;
+}
+
+// True when the waypoints from a keep kFreeMarginM from every solid (connect's result is not,
+// when it found no free path).
+bool freePath(const Scene& scene, const Vec3& a, const std::vector<Vec3>& waypoints) {
+    Vec3 p = a;
+    for (const Vec3& q : waypoints) {
+        Aabb around = Aabb::empty();
+        around.expand(p);
+        around.expand(q);
+        if (!detail::segmentClear(scene, detail::objectsNear(scene, around, 0.02), p, q,
+                                  kFreeMarginM)) {
+            return false;
+        }
+        p = q;
+    }
+    return true;
+}
+
+// A point straight above p (y up, as in scene files' grasp scenes) from which a hand moves
+// straight down to p keeping half the free margin, and that keeps the full margin itself: above
+// the tops of the objects within 2 cm of that vertical; nothing if there is none below the
+// scene's top.
+std::optional<Vec3> clearAbove(const Scene& scene, const Vec3& p) {
+    const Aabb column{p - Vec3(0.02, 0.0, 0.02),
+                      Vec3(p.x + 0.02, scene.bounds().max.y, p.z + 0.02)};
+    double top = p.y;
+    for (const std::uint32_t slot : detail::objectsNear(scene, column, 0.0)) {
+        top = std::max(top, scene.object(slot).aabb().max.y);
+    }
+    const Vec3 above(p.x, top + 2.0 * kFreeMarginM, p.z);
+    if (above.y > scene.bounds().max.y) {
+        return std::nullopt;
+    }
+    Aabb around = Aabb::empty();
+    around.expand(p);
+    around.expand(above);
+    const std::vector<std::uint32_t> near = detail::objectsNear(scene, around, 0.02);
+    if (!detail::segmentClear(scene, near, above, above, kFreeMarginM) ||
+        !detail::segmentClear(scene, near, above, p, kFreeMarginM * 0.5)) {
+        return std::nullopt;
+    }
+    return above;
 }
 
 void approach(Builder& plan, const Scene& scene, const Vec3& to) {
@@ -495,10 +539,30 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
             const Vec3 out(side, 0.0, 0.0);
             const Vec3 surface = o.center + out * surfaceAlong(o, out);
             contactNormal = out;
-            const Vec3 standOff = surface + out * kStandOffM;
+            // The stand-off: 2 cm out, or as far as the hand can stand where something else is
+            // nearer (a flat object lying 1.5 cm from a wall), down to the hand's free margin.
+            double standOffM = kStandOffM;
+            for (const double d : {kStandOffM, 0.015, 0.01, kFreeMarginM}) {
+                if (reachableSide(scene, *slot, surface, out, d)) {
+                    standOffM = d;
+                    break;
+                }
+            }
+            const Vec3 standOff = surface + out * standOffM;
             const Vec3 squeezed = surface - out * depth;
-            // Approach legs share the fixed approach time in proportion to their length.
-            const std::vector<Vec3> legs = connect(scene, startWorld, standOff);
+            // Approach legs share the fixed approach time in proportion to their length: a free
+            // path if there is one; else to above the stand-off, clear of everything near it,
+            // and straight down into it (the way into a narrow gap beside the object).
+            std::vector<Vec3> legs = connect(scene, startWorld, standOff);
+            if (!freePath(scene, startWorld, legs)) {
+                if (const std::optional<Vec3> above = clearAbove(scene, standOff)) {
+                    std::vector<Vec3> down = connect(scene, startWorld, *above);
+                    if (freePath(scene, startWorld, down)) {
+                        down.push_back(standOff);
+                        legs = std::move(down);
+                    }
+                }
+            }
             double total = 0.0;
             Vec3 p = startWorld;
             for (const Vec3& q : legs) {

@@ -371,6 +371,49 @@ TEST_CASE("sim grasp: two hands squeeze one object from -x and +x, lift, carry, 
     CHECK(sl.buttons == 0u);
 }
 
+TEST_CASE("sim grasp: a flat object lying 1.5 cm from a wall is reached without entering the "
+          "wall: the hand stands off nearer and comes down into the gap") {
+    // A 1.5 cm slab on the floor (like a torus lying flat), its +x face 1.5 cm from a 2 cm
+    // ridge: the usual 2 cm stand-off on the +x side would be inside the ridge.
+    const Scene scene({Vec3(-0.15, -0.10, -0.15), Vec3(0.15)},
+                      {makeBox(0, Vec3(-0.05, -0.0925, 0), Vec3(0.03, 0.0075, 0.03)),
+                       makeBox(1, Vec3(0, -0.09, 0), Vec3(0.005, 0.01, 0.04))});
+    const SceneObject& slab = scene.object(0);
+    const SceneObject& ridge = scene.object(1);
+    DeviceConfig lc = simConfig("grasp-left", 1, Vec3(-0.12, -0.04, 0));
+    DeviceConfig rc = simConfig("grasp-right", 2, Vec3(0.04, -0.04, 0));
+    sim(lc).object = 0;
+    sim(rc).object = 0;
+    SimDevice l(lc, scene), r(rc, scene);
+    REQUIRE(l.open() == DeviceStatus::Ok);
+    REQUIRE(r.open() == DeviceStatus::Ok);
+    DeviceState sl, sr;
+    int inRidge = 0;
+    int inSlabBeforeReach = 0;
+    Vec3 squeezeL(0.0), squeezeR(0.0);
+    for (int i = 0; i < 4500; ++i) {
+        REQUIRE(l.read(sl) == DeviceStatus::Ok);
+        REQUIRE(r.read(sr) == DeviceStatus::Ok);
+        inRidge += ridge.contains(l.handPositionWorld()) + ridge.contains(r.handPositionWorld());
+        if (l.phase() == ScriptPhase::Approach) {
+            inSlabBeforeReach +=
+                slab.contains(l.handPositionWorld()) + slab.contains(r.handPositionWorld());
+        }
+        if (std::abs(l.timeS() - 4.4) < 1e-9) {
+            squeezeL = l.handPositionWorld();
+            squeezeR = r.handPositionWorld();
+        }
+    }
+    CHECK(inRidge == 0);
+    CHECK(inSlabBeforeReach == 0);
+    // Squeezing: each hand just inside its own side, at the slab's mid-height.
+    CHECK(slab.contains(squeezeL));
+    CHECK(slab.contains(squeezeR));
+    CHECK(squeezeL.x < slab.center.x);
+    CHECK(squeezeR.x > slab.center.x);
+    CHECK(std::abs(squeezeR.y - slab.center.y) < 0.002);
+}
+
 TEST_CASE("sim: any number of devices run side by side without sharing state") {
     const Scene scene = makeDefaultScene();
     std::vector<std::unique_ptr<Device>> devices;

@@ -197,12 +197,17 @@ int runDemo(const DemoArgs& a) {
                            [&](std::uint32_t item) { return s.scene->objectSlotOf(item) == slot; });
     };
     const bool foundNew = foundAt(probeOf(*world.current().scene));
-    const bool foundOld =
-        glm::length(endPosition - startPosition) > 1e-6 && foundAt(probeOf(scene));
-    std::printf("weight %.3f N (%.1f g); the index finds it at its new place: %s, at its old "
-                "place: %s\n",
-                grasp.massKg() * 9.81, grasp.massKg() * 1000, foundNew ? "yes" : "no",
-                foundOld ? "yes" : "no");
+    const bool moved = glm::length(endPosition - startPosition) > 1e-6;
+    const bool foundOld = moved ? foundAt(probeOf(scene)) : foundNew; // one place if it stayed
+    if (moved) {
+        std::printf("weight %.3f N (%.1f g); the index finds it at its new place: %s, at its "
+                    "old place: %s\n",
+                    grasp.massKg() * 9.81, grasp.massKg() * 1000, foundNew ? "yes" : "no",
+                    foundOld ? "yes" : "no");
+    } else {
+        std::printf("weight %.3f N (%.1f g); it did not move; the index finds it there: %s\n",
+                    grasp.massKg() * 9.81, grasp.massKg() * 1000, foundNew ? "yes" : "no");
+    }
     nlohmann::json devicesJson = nlohmann::json::array();
     for (int i = 0; i < 2; ++i) {
         const DeviceReport& d = r.devices[i];
