@@ -2,13 +2,13 @@
 """CPU per device-tick, kernel included, against the number of simulated hands in `hapto run`.
 
     many_devices.py HAPTO [--counts 1,8,32,64,128] [--per-thread 1,16] [--duration 12]
-                          [--rate 1000] [--json OUT.json]
+                          [--rate 1000] [--warm-us default,0,5] [--json OUT.json]
 
 For every count N and every devices-per-thread K it writes a device file of N simulated hands
 (script "walk", distinct seeds, spread 1 cm apart), runs
 
     HAPTO run --devices FILE --rate RATE --duration D --report R.json --quiet
-              [--devices-per-thread K]
+              [--devices-per-thread K] [--warm-us W]
 
 and reads, twice (4 s after the start, when the scene, the index and the opens are done and
 TBB's workers have gone back to sleep, and 1 s before the end), the process's CPU time (user
@@ -30,6 +30,7 @@ a time, so two runs never share the cores; other processes on the machine still 
 """
 
 import argparse
+import itertools
 import json
 import os
 import subprocess
@@ -88,7 +89,7 @@ def process_cpu(pid):
     return int(fields[11]) / CLK_TCK, int(fields[12]) / CLK_TCK
 
 
-def run_one(hapto, count, per_thread, duration, rate, scratch):
+def run_one(hapto, count, per_thread, warm_us, duration, rate, scratch):
     devices = os.path.join(scratch, f"devices-{count}.json")
     report = os.path.join(scratch, f"report-{count}-{per_thread}.json")
     device_file(devices, count, rate)
@@ -96,6 +97,8 @@ def run_one(hapto, count, per_thread, duration, rate, scratch):
            "--report", report, "--quiet"]
     if per_thread != 1:
         cmd += ["--devices-per-thread", str(per_thread)]
+    if warm_us is not None:
+        cmd += ["--warm-us", str(warm_us)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     time.sleep(WARMUP_S)
     t0 = time.monotonic()
@@ -133,6 +136,7 @@ def run_one(hapto, count, per_thread, duration, rate, scratch):
     return {
         "devices": count,
         "devices_per_thread": per_thread,
+        "warm_us": warm_us,  # None: the runtime's default
         "servo_threads": servo_threads,
         "window_s": round(window, 3),
         "cpu_per_device_tick_us": round(cpu / ticks * 1e6, 3),
@@ -159,33 +163,45 @@ def main():
     ap.add_argument("--per-thread", default="1")
     ap.add_argument("--duration", type=float, default=12.0)
     ap.add_argument("--rate", type=float, default=1000.0)
+    ap.add_argument("--warm-us", default="default",
+                    help="servo warm-ups to run, us; 'default' passes none (the runtime's)")
     ap.add_argument("--json")
     a = ap.parse_args()
+    try:
+        warms = [None if w == "default" else float(w) for w in a.warm_us.split(",")]
+    except ValueError:
+        sys.exit(f"--warm-us: expected a comma-separated list of numbers or 'default', got "
+                 f"'{a.warm_us}'")
     if a.duration < WARMUP_S + 3:
         sys.exit(f"--duration: at least {WARMUP_S + 3} s ({WARMUP_S} s of start-up and 1 s at "
                  "the end are left out)")
     rows = []
     with tempfile.TemporaryDirectory() as scratch:
-        print(f"{'N':>4} {'K':>3} {'thr':>4} {'cpu/tick':>8} {'servo':>6} {'tick':>6} "
+        print(f"{'N':>4} {'K':>3} {'warm':>5} {'thr':>4} {'cpu/tick':>8} {'servo':>6} {'tick':>6} "
               f"{'share':>6} {'servo':>6} {'other':>6} {'vol/tk':>6} {'inv/tk':>6} "
               f"{'missed':>7} {'stable':>7}   (us per device-tick; shares of all cores)")
-        for count in [int(c) for c in a.counts.split(",")]:
-            for per_thread in [int(k) for k in a.per_thread.split(",")]:
-                w = run_one(a.hapto, count, per_thread, a.duration, a.rate, scratch)
-                rows.append(w)
-                print(f"{count:>4} {per_thread:>3} {w['servo_threads']:>4} "
-                      f"{w['cpu_per_device_tick_us']:>8.2f} "
-                      f"{w['servo_cpu_per_device_tick_us']:>6.2f} {w['tick_itself_us']:>6.2f} "
-                      f"{100 * w['process_share_of_cores']:>5.1f}% "
-                      f"{100 * w['servo_share_of_cores']:>5.1f}% "
-                      f"{100 * w['other_threads_cpu_share']:>5.1f}% "
-                      f"{w['voluntary_switches_per_device_tick']:>6.3f} "
-                      f"{w['involuntary_switches_per_device_tick']:>6.3f} "
-                      f"{w['missed_deadlines']:>7} {w['stable_devices']:>3}/{count:<3}",
-                      flush=True)
+        counts = [int(c) for c in a.counts.split(",")]
+        per_threads = [int(k) for k in a.per_thread.split(",")]
+        for count, per_thread, warm in itertools.product(counts, per_threads, warms):
+            w = run_one(a.hapto, count, per_thread, warm, a.duration, a.rate, scratch)
+            rows.append(w)
+            warm_text = "dflt" if warm is None else f"{warm:g}"
+            print(f"{count:>4} {per_thread:>3} {warm_text:>5} {w['servo_threads']:>4} "
+                  f"{w['cpu_per_device_tick_us']:>8.2f} "
+                  f"{w['servo_cpu_per_device_tick_us']:>6.2f} {w['tick_itself_us']:>6.2f} "
+                  f"{100 * w['process_share_of_cores']:>5.1f}% "
+                  f"{100 * w['servo_share_of_cores']:>5.1f}% "
+                  f"{100 * w['other_threads_cpu_share']:>5.1f}% "
+                  f"{w['voluntary_switches_per_device_tick']:>6.3f} "
+                  f"{w['involuntary_switches_per_device_tick']:>6.3f} "
+                  f"{w['missed_deadlines']:>7} {w['stable_devices']:>3}/{count:<3}",
+                  flush=True)
     if a.json:
-        with open(a.json, "w") as f:
+        # Written beside the target and renamed into place: a run that fails loses nothing.
+        tmp = a.json + ".tmp"
+        with open(tmp, "w") as f:
             json.dump({"cores": os.cpu_count(), "rate_hz": a.rate, "runs": rows}, f, indent=1)
+        os.replace(tmp, a.json)
 
 
 if __name__ == "__main__":

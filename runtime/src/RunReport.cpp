@@ -92,6 +92,8 @@ RunReport Runtime::report() const {
     r.durationS = mStartNs ? static_cast<double>(end - mStartNs) * 1e-9 : 0.0;
     r.realtimeNote = mRealtimeNote;
     r.wakeLatencyUs = mHeldWakeLatencyUs;
+    r.warmUpNs = mGroups.empty() ? mWarmUpNs : 0; // groups never warm up
+    r.warmUpAutomatic = !mOptions.warmUpNs.has_value();
     return r;
 }
 
@@ -162,6 +164,8 @@ std::string reportToJson(const RunReport& r) {
                {"cores", r.cores},
                {"stable", r.stable},
                {"duration_s", r.durationS}};
+    total["warm_up_us"] = static_cast<double>(r.warmUpNs) / 1000.0;
+    total["warm_up_automatic"] = r.warmUpAutomatic;
     if (r.wakeLatencyUs >= 0) {
         total["wake_latency_us"] = r.wakeLatencyUs;
     }

@@ -298,7 +298,7 @@ void Runtime::servoMain(Channel& ch) {
     s.deadlineNs = rt::nowNs() + s.periodNs;
 
     rt::setInServoLoop(true);
-    const std::uint64_t warmNs = std::min(mOptions.warmUpNs, s.periodNs / 2); // documented
+    const std::uint64_t warmNs = std::min(mWarmUpNs, s.periodNs / 2); // documented
     while (!s.stop.load(std::memory_order_acquire)) {
         if (warmNs > 0 && s.deadlineNs > warmNs) {
             // Wake warmNs early (after spinning the part of --spin-us before that, if longer),
@@ -328,7 +328,7 @@ bool Runtime::step(std::size_t i, std::uint64_t nowNs) {
     }
     mClock->set(nowNs);
     rt::setInServoLoop(true);
-    if (mOptions.warmUpNs > 0) {
+    if (mWarmUpNs > 0) {
         (void)warm(ch); // the step mode has no sleep to wake from; it warms up so tests cover it
     }
     const bool ticked = !s.stop.load(std::memory_order_acquire) && servoTick(ch, nowNs);

@@ -141,7 +141,7 @@ TEST_CASE("servo threads make no heap allocation while running, across snapshot 
     opt.realtime = false;
     // Each wake-up comes early, touches the tick's working set and spins to the deadline.
     opt.warmUpNs = GENERATE(std::uint64_t{0}, std::uint64_t{50'000});
-    INFO("warm-up " << opt.warmUpNs << " ns");
+    INFO("warm-up " << *opt.warmUpNs << " ns");
     Runtime runtime(world, std::move(devices), opt);
     PullToOther hooks[2];
     for (std::size_t i = 0; i < 2; ++i) {

@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <thread>
 
 using namespace hapto;
 using hapto::test::cubeScene;
@@ -157,6 +158,49 @@ TEST_CASE("step mode: the warm-up before each tick changes no force, bit for bit
         }
     }
     CHECK(pressing > 100); // the hands press into the cube: the forces compared are not all zero
+}
+
+TEST_CASE("the warm-up is the runtime's choice unless set: on while every servo thread can have "
+          "a core of its own, off when they share, as set when set, never in servo groups") {
+    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const auto report = [](int devices, RuntimeOptions opt) {
+        Rig rig(devices, 1000.0, {}, opt);
+        rig.start();
+        rig.runTo(5.0);
+        rig.runtime->stop();
+        return rig.runtime->report();
+    };
+    SECTION("as many devices as cores: the default warm-up") {
+        const RunReport r = report(cores, {});
+        CHECK(r.warmUpNs == kDefaultWarmUpNs);
+        CHECK(r.warmUpAutomatic);
+        CHECK(r.cores == cores);
+        const auto j = nlohmann::json::parse(reportToJson(r));
+        CHECK(j["total"]["warm_up_us"].get<double>() == kDefaultWarmUpNs / 1000.0);
+        CHECK(j["total"]["warm_up_automatic"] == true);
+    }
+    SECTION("one device more than cores: off") {
+        const RunReport r = report(cores + 1, {});
+        CHECK(r.warmUpNs == 0);
+        CHECK(r.warmUpAutomatic);
+        CHECK(nlohmann::json::parse(reportToJson(r))["total"]["warm_up_us"].get<double>() == 0.0);
+    }
+    SECTION("set: as set, however many devices") {
+        RuntimeOptions opt;
+        opt.warmUpNs = 7'000;
+        const RunReport r = report(cores + 1, opt);
+        CHECK(r.warmUpNs == 7'000);
+        CHECK_FALSE(r.warmUpAutomatic);
+        opt.warmUpNs = 0;
+        CHECK(report(1, opt).warmUpNs == 0);
+    }
+    SECTION("servo groups never warm up, even when asked") {
+        RuntimeOptions opt;
+        opt.devicesPerThread = 2;
+        CHECK(report(2, opt).warmUpNs == 0);
+        opt.warmUpNs = 7'000;
+        CHECK(report(2, opt).warmUpNs == 0);
+    }
 }
 
 TEST_CASE("step mode: each injected fault zeroes that device in the tick it happens, and the "

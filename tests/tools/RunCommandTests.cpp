@@ -32,6 +32,27 @@ TEST_CASE("hapto run writes a report with every field for both default hands") {
         CHECK(d["faults"] == 0);
     }
     CHECK(j["total"].contains("load_per_core"));
+    // The warm-up, unset: on while the two hands' threads can each have a core, else off.
+    const bool ownCores = j["total"]["cores"].get<int>() >= 2;
+    CHECK(j["total"]["warm_up_us"].get<double>() == (ownCores ? 5.0 : 0.0));
+    CHECK(j["total"]["warm_up_automatic"] == true);
+    CHECK_THAT(r.output, Catch::Contains(ownCores ? "warm-up: 5 us before each deadline"
+                                                  : "warm-up: off, as the servo threads share"));
+}
+
+TEST_CASE("hapto run --warm-us sets the warm-up, 0 turns it off, and the report says so") {
+    TempDir dir;
+    for (const char* us : {"0", "7.5"}) {
+        INFO(us);
+        const CommandResult r =
+            runHapto("run --duration 0.2 --no-realtime --quiet --warm-us " + std::string(us) +
+                     " --report " + (dir / "r.json").string());
+        INFO(r.output);
+        REQUIRE(r.exitCode == 0);
+        const json j = json::parse(readFile(dir / "r.json"));
+        CHECK(j["total"]["warm_up_us"].get<double>() == std::stod(us));
+        CHECK(j["total"]["warm_up_automatic"] == false);
+    }
 }
 
 TEST_CASE("a session recorded with --record replays as a device and exports as CSV") {

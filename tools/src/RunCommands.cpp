@@ -41,7 +41,7 @@ struct RunArgs {
     std::string record;
     bool realtime = true;
     double spinUs = 0;
-    double warmUs = static_cast<double>(kDefaultWarmUpNs) / 1000.0;
+    double warmUs = -1; ///< < 0: unset, the runtime chooses (RuntimeOptions::warmUpNs)
     int missLimit = 3;
     std::size_t devicesPerThread = 1;
     std::int32_t wakeLatencyUs = -1;
@@ -69,6 +69,13 @@ void printSummary(const RunReport& r) {
         "total: load %.2f%% of one core summed over %zu devices, %.2f%% per core (%d cores); %s\n",
         100 * r.loadSum, r.devices.size(), 100 * r.loadPerCore, r.cores,
         r.stable ? "stable" : "NOT stable");
+    if (r.warmUpNs > 0) {
+        std::printf("warm-up: %g us before each deadline\n",
+                    static_cast<double>(r.warmUpNs) / 1000.0);
+    } else if (r.warmUpAutomatic) {
+        std::printf("warm-up: off, as the servo threads share the cores (--warm-us to warm up "
+                    "anyway)\n");
+    }
     if (r.wakeLatencyUs >= 0) {
         std::printf("wake latency: idle CPUs held to %d us while the devices ran\n",
                     static_cast<int>(r.wakeLatencyUs));
@@ -157,7 +164,9 @@ int runSession(const RunArgs& a) {
     RuntimeOptions opt;
     opt.realtime = a.realtime;
     opt.spinNs = static_cast<std::uint64_t>(a.spinUs * 1000);
-    opt.warmUpNs = static_cast<std::uint64_t>(a.warmUs * 1000);
+    if (a.warmUs >= 0) {
+        opt.warmUpNs = static_cast<std::uint64_t>(a.warmUs * 1000);
+    }
     opt.missLimit = a.missLimit;
     opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
     opt.devicesPerThread = a.devicesPerThread;
@@ -262,9 +271,9 @@ void addRunCommands(CLI::App& app) {
     cmd->add_option("--warm-us", a->warmUs,
                     "Wake this long before each deadline, touch the tick's working set (snapshot, "
                     "index path, candidate objects, renderer) and spin to the deadline, so the "
-                    "tick starts warm; 0 = off (us; less than half the period; the default was "
-                    "chosen with `hapto bench tick`, docs/results/tick.md)")
-        ->capture_default_str()
+                    "tick starts warm; 0 = off (us; less than half the period; default: 5 when "
+                    "each servo thread has a core of its own (devices <= cores), else off, as "
+                    "measured with `hapto bench tick` and in docs/results/many-devices.md)")
         ->check(finiteRange(0, static_cast<double>(kMaxWarmUpNs) / 1000.0));
     cmd->add_option("--miss-limit", a->missLimit,
                     "K: after K missed deadlines in a row, command zero force until caught up")

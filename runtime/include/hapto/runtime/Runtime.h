@@ -22,6 +22,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <thread>
@@ -54,7 +55,11 @@ struct RuntimeOptions {
     /// ServoLoop.h) and spin to the deadline (ns); 0 = off. At most half the device's period
     /// is used (a longer one is cut to that). The step
     /// mode runs the same warm-up before each tick (it has no sleep to wake from).
-    std::uint64_t warmUpNs = kDefaultWarmUpNs;
+    /// Unset (the default): kDefaultWarmUpNs when every servo thread can have a core of its own
+    /// (no more per-device servo threads than cores), else off: a thread that spins on a
+    /// shared core takes that time from the others' ticks (docs/results/many-devices.md).
+    /// Servo groups (devicesPerThread > 1) never warm up.
+    std::optional<std::uint64_t> warmUpNs;
     int missLimit = 3;               ///< K: after K missed deadlines in a row, command zero force
                                      ///< until a tick meets its deadline again.
     double lateWakeupFraction = 0.1; ///< A wake-up later than this fraction of the period is late.
@@ -123,6 +128,10 @@ struct RunReport {
     std::string realtimeNote; ///< Why SCHED_FIFO or pinning was not granted, if not.
     /// The CPU latency request held during the run (us; RuntimeOptions::wakeLatencyUs), or -1.
     std::int32_t wakeLatencyUs = -1;
+    /// The warm-up before each deadline the per-device servo threads ran (ns; 0: none), and
+    /// whether the runtime chose it (RuntimeOptions::warmUpNs unset).
+    std::uint64_t warmUpNs = 0;
+    bool warmUpAutomatic = false;
 };
 
 /// Runs D servo threads (or D / K, RuntimeOptions::devicesPerThread) and a supervisor. Construct,
@@ -282,6 +291,7 @@ private:
     std::string mRealtimeNote;
     rt::WakeLatencyHold mWakeLatency;     // held from start() to stop() when asked for
     std::int32_t mHeldWakeLatencyUs = -1; // what it held (us), for the report
+    std::uint64_t mWarmUpNs = 0;          // RuntimeOptions::warmUpNs, resolved
     std::thread mSupervisor;
     std::atomic<bool> mStopping{false};
     std::mutex mWakeMutex; // with mWake: stop() interrupts supervision's waits

@@ -13,7 +13,7 @@
 /// nothing the tick reads (it does not move a cursor or the proxy; the snapshot claim it may take
 /// is the one the tick takes again), so forces and timing semantics are unchanged: the device is
 /// still sampled at the deadline. Cost: warmUpNs of CPU per tick (spinning), which is why it is an
-/// option.
+/// option, and why the runtime turns it off by itself when servo threads share cores.
 
 #include "hapto/core/Geometry.h"
 #include "hapto/runtime/GodObjectRenderer.h"
@@ -25,7 +25,8 @@
 
 namespace hapto {
 
-/// The default RuntimeOptions::warmUpNs (ns): chosen by measurement with `hapto bench tick`
+/// The warm-up the runtime runs when RuntimeOptions::warmUpNs is unset and every servo thread
+/// can have a core of its own (ns): chosen by measurement with `hapto bench tick`
 /// (docs/results/tick.md).
 inline constexpr std::uint64_t kDefaultWarmUpNs = 5'000;
 /// The largest warm-up the options accept (ns): 100 µs, a tenth of a 1 kHz period.
