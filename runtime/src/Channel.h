@@ -57,13 +57,14 @@ struct alignas(64) ServoState {
     bool first = true;                ///< The next tick is the first since the servo started.
     std::atomic<bool> stop{false};
     Vec3 lastPosition{0.0}; ///< The last device point (m, world).
+    Vec3 lastStep{0.0};     ///< The last tick's move of the device point (m, world).
     DeviceState sample;     ///< The last reading.
     HapticTick haptic;
 
     ServoState(const RendererConfig& renderer, const SafetyConfig& safety)
         : haptic(renderer, safety) {}
 };
-static_assert(sizeof(ServoState) == 12416, "update the size in the note above");
+static_assert(sizeof(ServoState) == 12480, "update the size in the note above");
 
 /// The cold record of a channel.
 struct ChannelRecord {

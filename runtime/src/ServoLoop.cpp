@@ -51,7 +51,7 @@ std::uint64_t touchObjects(const Scene& scene, std::span<const std::uint32_t> it
 
 std::uint64_t warmUpTick(const WorldSnapshot& snapshot, const GodObjectRenderer& renderer,
                          std::span<const std::byte> tickState, const Vec3& lastPointM,
-                         double dtS) noexcept {
+                         const Vec3& lastStepM, double dtS) noexcept {
     // The tick's own state first: the cursors, the renderer, the safety filter, the effects.
     for (std::size_t offset = 0; offset < tickState.size(); offset += 64) {
         __builtin_prefetch(tickState.data() + offset);
@@ -61,7 +61,10 @@ std::uint64_t warmUpTick(const WorldSnapshot& snapshot, const GodObjectRenderer&
     // The index's path to the device point's leaf and the proxy's (a locate from the root
     // reads every node on the way; no cursor moves), and the objects they list.
     CandidateSet candidates;
-    const LocateResult atDevice = index.locate(lastPointM);
+    // Where the hand will be if it keeps its last step: the tick's own situation (a corner it
+    // is about to reach), which the last point's would not show.
+    const Vec3 nextPointM = finite(lastStepM) ? lastPointM + lastStepM : lastPointM;
+    const LocateResult atDevice = index.locate(nextPointM);
     std::uint64_t sum = atDevice.leaf + touchObjects(scene, atDevice.candidates);
     candidates.add(atDevice.candidates);
     const LocateResult atProxy = index.locate(renderer.proxy());
@@ -73,7 +76,7 @@ std::uint64_t warmUpTick(const WorldSnapshot& snapshot, const GodObjectRenderer&
     candidates.add(snapshot.movingSlots());
     // A dry render on a copy: the solver's code and the near objects' data, warm.
     GodObjectRenderer dry = renderer; // a plain copy: no allocation
-    const RenderOutput out = dry.update(scene, candidates, lastPointM, Vec3(0.0), dtS);
+    const RenderOutput out = dry.update(scene, candidates, nextPointM, Vec3(0.0), dtS);
     return sum + out.objectsTested + out.contactCount;
 }
 
@@ -142,6 +145,7 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
         s.lastPosition = p;
         s.first = false;
     }
+    s.lastStep = p - s.lastPosition;
     const Vec3 tipTurn =
         s.sample.hasAngularVelocity ? glm::cross(s.sample.angularVelocity, tip) : Vec3(0.0);
     const Vec3 v = s.sample.hasVelocity ? s.transform.velocityToWorld(s.sample.velocity + tipTurn)
@@ -258,7 +262,7 @@ std::uint64_t Runtime::warm(Channel& ch) noexcept {
     ServoState& s = ch.servo;
     const WorldSnapshot& snap = mWorld.acquire(*s.reader); // the tick claims it again
     const std::uint64_t sum = warmUpTick(snap, s.haptic.renderer(), std::as_bytes(std::span(&s, 1)),
-                                         s.lastPosition, s.dtS);
+                                         s.lastPosition, s.lastStep, s.dtS);
     asm volatile("" : : "r"(sum) : "memory"); // what was read counts as used
     return sum;
 }

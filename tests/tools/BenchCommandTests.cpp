@@ -161,10 +161,24 @@ void checkTickEntry(const json& e, std::size_t ticks) {
     INFO(e.dump());
     for (const char* key :
          {"index", "mode", "objects", "ticks", "sleep_us", "warm_us", "wake_latency_us", "device",
-          "stages", "tick", "locate_steps_mean", "candidates_mean", "contact_fraction"}) {
+          "stages", "tick", "locate_steps_mean", "candidates_mean", "contact_fraction",
+          "warm_overruns", "start_late"}) {
         CHECK(e.contains(key));
     }
     CHECK(e["ticks"] == ticks);
+    // Only a warmed mode has a warm-up to overrun; at most every tick's.
+    if (e["warm_us"].get<double>() == 0.0) {
+        CHECK(e["warm_overruns"] == 0);
+    }
+    CHECK(e["warm_overruns"].get<std::uint64_t>() <= ticks);
+    // How late each tick after a sleep started: none for back-to-back ticks.
+    const json& late = e["start_late"];
+    CHECK(late["ns_p50"].get<double>() >= 0.0);
+    CHECK(late["ns_p50"].get<double>() <= late["ns_p99"].get<double>());
+    CHECK(late["ns_p99"].get<double>() <= late["ns_p999"].get<double>());
+    if (e["mode"] == "hot") {
+        CHECK(late["ns_p999"].get<double>() == 0.0);
+    }
     const json& tick = e["tick"];
     CHECK(tick["ns_p50"].get<double>() >= 0.0);
     CHECK(tick["ns_p50"].get<double>() <= tick["ns_p99"].get<double>());

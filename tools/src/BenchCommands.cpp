@@ -290,6 +290,7 @@ struct alignas(64) TickPieces {
     EffectSet effects;
     DeviceState sample;
     Vec3 lastPoint{0.0};
+    Vec3 lastStep{0.0};
     const SpatialIndex* boundIndex = nullptr;
     std::uint64_t boundVersion = 0;
     bool fresh = true;
@@ -309,6 +310,12 @@ struct TickRun {
     std::vector<double> tickNs;
     std::uint64_t ticks = 0, locateSteps = 0, candidates = 0, contactTicks = 0;
     std::uint64_t kept = 0; // what the warm-up read, kept
+    /// Warm-ups still running at their deadline: those ticks started late by the overrun,
+    /// which the tick's time (from the wake-up) does not show.
+    std::uint64_t warmOverruns = 0;
+    /// Per tick after a sleep: how long after its deadline it started (ns; 0 if on time): the
+    /// wake-up's lateness, plus a warm-up's overrun. A servo reads its device this late.
+    std::vector<double> startLateNs;
 };
 
 /// One `--index`: its world (scene copy, index, snapshots) and its three runs.
@@ -364,6 +371,7 @@ void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs,
         t.lastPoint = p;
     }
     const Vec3 v = t.sample.hasVelocity ? t.sample.velocity : (p - t.lastPoint) / dtS;
+    t.lastStep = p - t.lastPoint;
     t.lastPoint = p;
     stamp[2] = rt::nowNs();
     // locate
@@ -473,12 +481,16 @@ void driveTicks(TickRun& run, World& world, std::size_t at, std::size_t count,
                 const WorldSnapshot& snap = world.acquire(*run.reader);
                 run.kept += warmUpTick(snap, run.pieces->renderer,
                                        std::as_bytes(std::span(run.pieces.get(), 1)),
-                                       run.pieces->lastPoint, dtS);
+                                       run.pieces->lastPoint, run.pieces->lastStep, dtS);
+                run.warmOverruns += rt::nowNs() > deadline ? 1 : 0;
                 spinUntilNs(deadline);
             } else {
                 rt::sleepUntilNs(deadline, 0);
             }
             wake = rt::nowNs();
+            if (run.startLateNs.size() < run.startLateNs.capacity()) {
+                run.startLateNs.push_back(static_cast<double>(wake - deadline));
+            }
         }
         timedTick(run, world, k, wake, dtS);
     }
@@ -571,6 +583,7 @@ void runTick(const TickArgs& args) {
                 s.assign(args.ticks, 0.0);
             }
             run->tickNs.assign(args.ticks, 0.0);
+            run->startLateNs.reserve(args.ticks); // filled in the sleep modes only
             target.runs.push_back(std::move(run));
         }
         targets.push_back(std::move(target));
@@ -634,6 +647,19 @@ void runTick(const TickArgs& args) {
             }
             std::printf("\n");
         }
+        std::printf("%-12s", "start late");
+        for (const auto& run : target.runs) {
+            const Quantiles late = quantilesOf(run->startLateNs);
+            std::printf(" | %-10s %7.0f %7.0f %8.0f", "", late.p50, late.p99, late.p999);
+        }
+        std::printf("\n");
+        for (const auto& run : target.runs) {
+            if (run->mode == TickMode::Warm) {
+                std::printf("%-12s warm-ups still running at their deadline: %llu of %llu\n",
+                            modeName(*run), static_cast<unsigned long long>(run->warmOverruns),
+                            static_cast<unsigned long long>(run->ticks));
+            }
+        }
         for (std::size_t r = 0; r < target.runs.size(); ++r) {
             const TickRun& run = *target.runs[r];
             const double n = static_cast<double>(run.ticks);
@@ -655,7 +681,9 @@ void runTick(const TickArgs& args) {
                            {"tick", toJson(q[r][kStageCount])},
                            {"locate_steps_mean", static_cast<double>(run.locateSteps) / n},
                            {"candidates_mean", static_cast<double>(run.candidates) / n},
-                           {"contact_fraction", static_cast<double>(run.contactTicks) / n}});
+                           {"contact_fraction", static_cast<double>(run.contactTicks) / n},
+                           {"warm_overruns", run.warmOverruns},
+                           {"start_late", toJson(quantilesOf(run.startLateNs))}});
             keep(run.kept);
         }
     }

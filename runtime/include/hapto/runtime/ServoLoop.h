@@ -36,16 +36,17 @@ inline constexpr std::size_t kMaxWarmUpPrefetches = 256;
 
 /// Warms the next tick up without changing anything it reads: prefetches every cache line of
 /// `tickState` (the servo's hot state: the HapticTick with its cursors, renderer, safety filter
-/// and effects), locates `lastPointM` (m, world; the last device point) and the renderer's proxy
-/// from the index root (reading the nodes on the way; no cursor moves), prefetches the scene
-/// objects those leaves and the moving list name (up to kMaxWarmUpPrefetches each), and runs a
-/// dry render: a copy of `renderer` (on the stack) updated at `lastPointM` at rest against
-/// those candidates, so the solver's code and the objects' data are in cache; the copy is
-/// dropped. Returns a value derived from what it read (callers keep it, so the work is not
+/// and effects), locates the predicted device point `lastPointM + lastStepM` (m, world: the last
+/// device point and the last tick's move of it; the last point alone if the step is not finite)
+/// and the renderer's proxy from the index root (reading the nodes on the way; no cursor moves),
+/// prefetches the scene objects those leaves and the moving list name (up to
+/// kMaxWarmUpPrefetches each), and runs a dry render: a copy of `renderer` (on the stack)
+/// updated at the predicted point against those candidates, so the solver's code paths and the
+/// objects' data the tick is about to need are in cache; the copy is dropped. Returns a value derived from what it read (callers keep it, so the work is not
 /// optimised away). Never allocates, locks, logs or throws. [servo]
 std::uint64_t warmUpTick(const WorldSnapshot& snapshot, const GodObjectRenderer& renderer,
                          std::span<const std::byte> tickState, const Vec3& lastPointM,
-                         double dtS) noexcept;
+                         const Vec3& lastStepM, double dtS) noexcept;
 
 /// Spins (cpuPause) until CLOCK_MONOTONIC reaches `deadlineNs`. [servo]
 void spinUntilNs(std::uint64_t deadlineNs) noexcept;
