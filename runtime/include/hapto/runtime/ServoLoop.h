@@ -6,13 +6,14 @@
 /// other threads on its core evict what the tick reads: the snapshot, the cursor's leaf and its
 /// candidate objects, the renderer and the rest of the haptic tick. With a warm-up the thread
 /// wakes warmUpNs before its deadline, calls warmUpTick() (a read-only walk over that working
-/// set: a prefetch of the servo's hot state, a locate from the root at the last device point
+/// set: a prefetch of the servo's hot state, a locate from the root at the predicted device point
 /// and at the proxy, a prefetch of every candidate object, and a dry render on a copy of the
 /// renderer, which also brings the solver's code back into the instruction cache), spins to the
 /// deadline, and only then reads the device and ticks as before. Invariant: the warm-up writes
 /// nothing the tick reads (it does not move a cursor or the proxy; the snapshot claim it may take
 /// is the one the tick takes again), so forces and timing semantics are unchanged: the device is
-/// still sampled at the deadline. Cost: warmUpNs of CPU per tick (spinning), which is why it is an
+/// never sampled before the deadline (at it, or just after the warm-up when the wake-up came
+/// later than the window). Cost: warmUpNs of CPU per tick (spinning), which is why it is an
 /// option, and why the runtime turns it off by itself when servo threads share cores.
 
 #include "hapto/core/Geometry.h"
@@ -42,8 +43,9 @@ inline constexpr std::size_t kMaxWarmUpPrefetches = 256;
 /// prefetches the scene objects those leaves and the moving list name (up to
 /// kMaxWarmUpPrefetches each), and runs a dry render: a copy of `renderer` (on the stack)
 /// updated at the predicted point against those candidates, so the solver's code paths and the
-/// objects' data the tick is about to need are in cache; the copy is dropped. Returns a value derived from what it read (callers keep it, so the work is not
-/// optimised away). Never allocates, locks, logs or throws. [servo]
+/// objects' data the tick is about to need are in cache; the copy is dropped. Returns a value
+/// derived from what it read (callers keep it, so the work is not optimised away). Never allocates,
+/// locks, logs or throws. [servo]
 std::uint64_t warmUpTick(const WorldSnapshot& snapshot, const GodObjectRenderer& renderer,
                          std::span<const std::byte> tickState, const Vec3& lastPointM,
                          const Vec3& lastStepM, double dtS) noexcept;
