@@ -159,10 +159,9 @@ json runTickJson(const test::TempDir& dir, const std::string& args) {
 /// inside it), and the stage means adding up to the tick's mean (the stages tile the tick).
 void checkTickEntry(const json& e, std::size_t ticks) {
     INFO(e.dump());
-    for (const char* key :
-         {"index", "mode", "objects", "ticks", "sleep_us", "warm_us", "wake_latency_us", "device",
-          "stages", "tick", "locate_steps_mean", "candidates_mean", "contact_fraction",
-          "warm_overruns", "start_late"}) {
+    for (const char* key : {"index", "mode", "objects", "ticks", "sleep_us", "warm_us",
+                            "wake_latency_us", "device", "stages", "tick", "locate_steps_mean",
+                            "candidates_mean", "contact_fraction", "warm_overruns", "start_late"}) {
         CHECK(e.contains(key));
     }
     CHECK(e["ticks"] == ticks);
