@@ -73,8 +73,8 @@ void printSummary(const RunReport& r) {
         std::printf("warm-up: %g us before each deadline\n",
                     static_cast<double>(r.warmUpNs) / 1000.0);
     } else if (r.warmUpAutomatic) {
-        std::printf("warm-up: off, as the servo threads share the cores (--warm-us to warm up "
-                    "anyway)\n");
+        std::printf("warm-up: off, as the servo threads share the cores or run in groups "
+                    "(--warm-us warms per-device threads anyway)\n");
     }
     if (r.wakeLatencyUs >= 0) {
         std::printf("wake latency: idle CPUs held to %d us while the devices ran\n",
