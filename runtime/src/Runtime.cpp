@@ -82,9 +82,9 @@ Runtime::Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOption
         mChannels.push_back(std::move(ch));
     }
     makeGroups();
-    // The warm-up spins on its core until the deadline: free on a core of its own, taken from
-    // the other servo threads' ticks on a shared one (32 threads on 2 cores: a quarter of the
-    // devices unstable with it, none without; docs/results/many-devices.md).
+    // The warm-up spins on its core until the deadline: free on a core of its own; on a shared
+    // one it costs CPU the other servo threads could use, for little (their ticks keep the
+    // caches warm for each other; docs/results/many-devices.md).
     mWarmUpNs = mOptions.warmUpNs.value_or(
         mGroups.empty() && mChannels.size() <= cores ? kDefaultWarmUpNs : 0);
 }

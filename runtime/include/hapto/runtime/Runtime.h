@@ -56,8 +56,9 @@ struct RuntimeOptions {
     /// is used (a longer one is cut to that). The step
     /// mode runs the same warm-up before each tick (it has no sleep to wake from).
     /// Unset (the default): kDefaultWarmUpNs when every servo thread can have a core of its own
-    /// (no more per-device servo threads than cores), else off: a thread that spins on a
-    /// shared core takes that time from the others' ticks (docs/results/many-devices.md).
+    /// (no more per-device servo threads than cores), else off: threads sharing a core keep
+    /// its caches warm for each other, so there it costs CPU for little
+    /// (docs/results/many-devices.md).
     /// Servo groups (devicesPerThread > 1) never warm up.
     std::optional<std::uint64_t> warmUpNs;
     int missLimit = 3;               ///< K: after K missed deadlines in a row, command zero force
