@@ -170,18 +170,32 @@ def main():
     try:
         warms = [None if w == "default" else float(w) for w in a.warm_us.split(",")]
     except ValueError:
-        sys.exit(f"--warm-us: expected a comma-separated list of numbers or 'default', got "
-                 f"'{a.warm_us}'")
-    if a.duration < WARMUP_S + 3:
-        sys.exit(f"--duration: at least {WARMUP_S + 3} s ({WARMUP_S} s of start-up and 1 s at "
-                 "the end are left out)")
+        warms = []
+    if not warms or any(w is not None and not (0 <= w < float("inf")) for w in warms):
+        print(f"--warm-us: expected a comma-separated list of finite numbers >= 0 (us) or "
+              f"'default', got '{a.warm_us}'", file=sys.stderr)
+        sys.exit(2)
+    if not (WARMUP_S + 3 <= a.duration < float("inf")):
+        print(f"--duration: at least {WARMUP_S + 3} s ({WARMUP_S} s of start-up and 1 s at the "
+              f"end are left out), got {a.duration}", file=sys.stderr)
+        sys.exit(2)
+    if not (0 < a.rate < float("inf")):
+        print(f"--rate: expected a finite rate > 0 (Hz), got {a.rate}", file=sys.stderr)
+        sys.exit(2)
+    try:
+        counts = [int(c) for c in a.counts.split(",")]
+        per_threads = [int(k) for k in a.per_thread.split(",")]
+    except ValueError:
+        counts = per_threads = []
+    if not counts or not per_threads or min(counts + per_threads) < 1:
+        print(f"--counts / --per-thread: expected comma-separated integers >= 1, got "
+              f"'{a.counts}' / '{a.per_thread}'", file=sys.stderr)
+        sys.exit(2)
     rows = []
     with tempfile.TemporaryDirectory() as scratch:
         print(f"{'N':>4} {'K':>3} {'warm':>5} {'thr':>4} {'cpu/tick':>8} {'servo':>6} {'tick':>6} "
               f"{'share':>6} {'servo':>6} {'other':>6} {'vol/tk':>6} {'inv/tk':>6} "
               f"{'missed':>7} {'stable':>7}   (us per device-tick; shares of all cores)")
-        counts = [int(c) for c in a.counts.split(",")]
-        per_threads = [int(k) for k in a.per_thread.split(",")]
         for count, per_thread, warm in itertools.product(counts, per_threads, warms):
             w = run_one(a.hapto, count, per_thread, warm, a.duration, a.rate, scratch)
             rows.append(w)
