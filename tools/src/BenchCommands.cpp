@@ -489,7 +489,8 @@ void driveTicks(TickRun& run, World& world, std::size_t at, std::size_t count,
             }
             wake = rt::nowNs();
             if (run.startLateNs.size() < run.startLateNs.capacity()) {
-                run.startLateNs.push_back(static_cast<double>(wake - deadline));
+                run.startLateNs.push_back(
+                    static_cast<double>(wake > deadline ? wake - deadline : 0));
             }
         }
         timedTick(run, world, k, wake, dtS);
