@@ -19,6 +19,8 @@
 #include "hapto/scenes/InputError.h"
 #include "hapto/scenes/InputFile.h"
 
+#include <assimp/IOStream.hpp>
+#include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -59,6 +61,35 @@ const char* hintOf(detail::MeshFormat f) {
         return "ply";
     }
     return "";
+}
+
+/// The files assimp may open while it reads a model from memory: none. An OBJ may name material
+/// libraries (`mtllib`), which assimp's default IOSystem opens from disk by those names: a FIFO
+/// blocks the load forever, a device or any other file is read as a material and can get the
+/// model refused. hapto reads geometry only, so to assimp every other file is missing (it notes
+/// that and goes on without materials).
+class NoOtherFiles final : public Assimp::IOSystem {
+public:
+    bool Exists(const char*) const override { return false; }
+    char getOsSeparator() const override { return '/'; }
+    Assimp::IOStream* Open(const char*, const char*) override { return nullptr; }
+    void Close(Assimp::IOStream* stream) override { delete stream; }
+};
+
+void checkScale(const std::string& name, double scale) {
+    if (!(std::isfinite(scale) && scale > 0.0)) {
+        throw InputError(name + ": the scale must be a finite number > 0");
+    }
+}
+
+/// The format the path's extension names; throws InputError for any other.
+detail::MeshFormat knownFormat(const std::filesystem::path& path) {
+    const auto format = formatOf(path);
+    if (!format) {
+        throw InputError(path.string() + ": unknown model format '" + path.extension().string() +
+                         "' (hapto reads .obj, .stl and .ply)");
+    }
+    return *format;
 }
 
 struct Gathered {
@@ -126,22 +157,26 @@ bool isMeshFile(const std::filesystem::path& path) {
 std::shared_ptr<const TriangleMesh> loadMeshFile(const std::filesystem::path& path,
                                                  MeshSource source) {
     const std::string name = path.string();
-    if (!(std::isfinite(source.scale) && source.scale > 0.0)) {
-        throw InputError(name + ": the scale must be a finite number > 0");
-    }
+    checkScale(name, source.scale);
     // Opened first, so a folder or a FIFO is named as such whatever its name.
     InputFile file(path, "model file");
-    const auto format = formatOf(path);
-    if (!format) {
-        throw InputError(name + ": unknown model format '" + path.extension().string() +
-                         "' (hapto reads .obj, .stl and .ply)");
-    }
-    std::string bytes = file.readAll();
+    knownFormat(path);
+    return parseMeshFile(file.readAll(), path, std::move(source));
+}
+
+std::shared_ptr<const TriangleMesh>
+parseMeshFile(std::string bytes, const std::filesystem::path& path, MeshSource source) {
+    const std::string name = path.string();
+    checkScale(name, source.scale);
+    const detail::MeshFormat format = knownFormat(path);
     if (bytes.empty()) {
         throw InputError(name + ": the model file is empty");
     }
-    switch (*format) {
+    switch (format) {
     case detail::MeshFormat::Obj:
+        if (bytes.starts_with("\xEF\xBB\xBF")) {
+            bytes.erase(0, 3); // a UTF-8 byte order mark: assimp 5.2.5 would lose the first line
+        }
         detail::checkObj(bytes, name);
         break;
     case detail::MeshFormat::Stl:
@@ -153,11 +188,12 @@ std::shared_ptr<const TriangleMesh> loadMeshFile(const std::filesystem::path& pa
     }
 
     Assimp::Importer importer;
+    importer.SetIOHandler(new NoOtherFiles); // owned by the importer
     const aiScene* scene = importer.ReadFileFromMemory(
         bytes.data(), bytes.size(), aiProcess_Triangulate | aiProcess_ValidateDataStructure,
-        hintOf(*format));
+        hintOf(format));
     if (!scene || !scene->mRootNode) {
-        throw InputError(name + ": the " + hintOf(*format) +
+        throw InputError(name + ": the " + hintOf(format) +
                          " reader (assimp) refuses it: " + importer.GetErrorString());
     }
     std::string().swap(bytes); // assimp has its own copy now

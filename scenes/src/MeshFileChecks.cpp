@@ -12,12 +12,14 @@
 #include "hapto/scenes/InputError.h"
 #include "hapto/scenes/TriangleMesh.h"
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 #include <optional>
 #include <vector>
 
@@ -191,10 +193,51 @@ void checkObjIndex(std::string_view token, std::string_view part, const char* wh
     }
 }
 
+/// Refuses a line that assimp 5.2.5's OBJ reader would read otherwise than the specification:
+/// it takes a statement from the line's first character, with no space skipped, so it drops an
+/// indented `v` or `f` (shifting every index after it), reads any word that begins with `f`, `l`
+/// or `p` as a face, line or point and one that begins with `vt` or `vn` as those, and takes a
+/// vertex only when a space or a tab follows the `v`.
+template <class Place>
+void readAsAssimpDoes(std::string_view line, std::string_view key, const Place& place) {
+    const bool geometry =
+        key == "v" || key == "vt" || key == "vn" || key == "f" || key == "l" || key == "p";
+    if (key.data() != line.data()) {
+        if (geometry) {
+            fail(place() + "an indented '" + std::string(key) +
+                 "' statement (assimp skips a line that does not begin with its statement, "
+                 "which would lose it): remove the indentation");
+        }
+        return;
+    }
+    if (!geometry && key != "vp" &&
+        (key[0] == 'f' || key[0] == 'l' || key[0] == 'p' || key.starts_with("vt") ||
+         key.starts_with("vn"))) {
+        fail(place() + quoted(key) +
+             " is not an OBJ geometry statement, but assimp would read it as one (a word "
+             "beginning with f, l, p, vt or vn)");
+    }
+    if (key == "v" && line.size() > 1 && line[1] != ' ' && line[1] != '\t') {
+        fail(place() + "'v' must be followed by a space or a tab");
+    }
+}
+
 } // namespace
 
 void checkObj(std::string_view text, const std::string& name) {
     refuseNul(text, name, "an OBJ text file");
+    // assimp also ends an OBJ line at a carriage return or a form feed, so one inside a line
+    // would split its statement.
+    for (std::size_t i = text.find_first_of("\r\f"); i != std::string_view::npos;
+         i = text.find_first_of("\r\f", i + 1)) {
+        if (text[i] == '\f' || (i + 1 < text.size() && text[i + 1] != '\n')) {
+            const auto line = 1 + std::count(text.begin(), text.begin() + i, '\n');
+            fail(atLine(name, static_cast<std::size_t>(line)) +
+                 (text[i] == '\f' ? "a form feed" : "a carriage return") +
+                 " inside a line (assimp would end the line there; lines end with \\n or "
+                 "\\r\\n)");
+        }
+    }
     std::vector<std::string_view> tok;
     ObjCounts total;
     forEachObjLine(text, [&](std::size_t, std::string_view line) {
@@ -217,19 +260,28 @@ void checkObj(std::string_view text, const std::string& name) {
         if (tok.empty()) {
             return;
         }
+        const auto place = [&] { return atLine(name, lineNo); };
         const std::string_view key = tok[0];
-        if (key == "v") {
-            const auto place = [&] { return atLine(name, lineNo); };
-            if (tok.size() < 4) {
-                fail(place() + "a vertex needs x y z, got " + std::to_string(tok.size() - 1) +
-                     " numbers");
+        readAsAssimpDoes(line, key, place);
+        // x y z, x y z w or x y z r g b (assimp skips a vertex of any other count, which
+        // shifts every index after it); u [v [w]] with v (assimp throws on one); i j k.
+        const auto numbers = [&](std::initializer_list<std::size_t> counts, const char* forms) {
+            const std::size_t n = tok.size() - 1;
+            if (std::find(counts.begin(), counts.end(), n) == counts.end()) {
+                fail(place() + "'" + std::string(key) + "' takes " + forms + ", got " +
+                     std::to_string(n) + " numbers");
             }
+            for (std::size_t k = 1; k < tok.size(); ++k) {
+                if (!parseNumber(tok[k])) {
+                    fail(place() + quoted(tok[k]) + " is not a number");
+                }
+            }
+        };
+        if (key == "v") {
+            numbers({3, 4, 6}, "x y z, x y z w or x y z r g b");
             const std::size_t n = tok.size() == 5 ? 4 : 3; // x y z w; or x y z r g b
             for (std::size_t k = 1; k <= n; ++k) {
                 const auto v = parseNumber(tok[k]);
-                if (!v) {
-                    fail(place() + quoted(tok[k]) + " is not a number");
-                }
                 if (!std::isfinite(*v)) {
                     fail(place() + "vertex coordinate " + quoted(tok[k]) + " is not finite");
                 }
@@ -239,13 +291,20 @@ void checkObj(std::string_view text, const std::string& name) {
             }
             ++seen.v;
         } else if (key == "vt") {
+            numbers({2, 3}, "u v or u v w");
             ++seen.vt;
         } else if (key == "vn") {
+            numbers({3}, "i j k");
             ++seen.vn;
-        } else if (key == "f") {
-            const auto place = [&] { return atLine(name, lineNo); };
-            if (tok.size() < 4) {
-                fail(place() + "a face needs at least 3 vertices, got " +
+        } else if (key == "f" || key == "l" || key == "p") {
+            // Lines and points make no triangles, but assimp reads their indices too.
+            const std::size_t least = key == "f" ? 3 : key == "l" ? 2 : 1;
+            if (tok.size() < least + 1) {
+                fail(place() + "a " +
+                     (key == "f"   ? "face"
+                      : key == "l" ? "line"
+                                   : "point") +
+                     " needs at least " + std::to_string(least) + " vertices, got " +
                      std::to_string(tok.size() - 1));
             }
             for (std::size_t k = 1; k < tok.size(); ++k) {
@@ -267,8 +326,10 @@ void checkObj(std::string_view text, const std::string& name) {
                                   lineNo);
                 }
             }
-            triangles += tok.size() - 3;
-            checkTriangleLimit(triangles, name);
+            if (key == "f") {
+                triangles += tok.size() - 3;
+                checkTriangleLimit(triangles, name);
+            }
         }
     });
     if (triangles == 0) {
@@ -341,13 +402,59 @@ void checkAsciiStl(std::string_view text, const std::string& name) {
             return;
         }
         const auto place = [&] { return atLine(name, lineNo); };
-        if (tok[0] == "facet") {
-            if (facetLine != 0) {
+        // Every line is one of the grammar's (Burns 6.5; assimp's reader instead skips any
+        // byte it does not know and finds keywords anywhere, even inside other text).
+        const auto expect = [&](std::size_t count, const char* form) {
+            if (tok.size() != count) {
+                fail(place() + "expected '" + form + "', got " + std::to_string(tok.size()) +
+                     " words");
+            }
+        };
+        const auto numbers = [&](std::size_t first, const char* what, bool finite) {
+            for (int c = 0; c < 3; ++c) {
+                const std::string_view t = tok[first + c];
+                const auto v = parseNumber(t);
+                if (!v) {
+                    fail(place() + what + std::string(kAxis[c]) + " " + quoted(t) +
+                         " is not a number");
+                }
+                if (finite && !std::isfinite(*v)) {
+                    fail(place() + what + std::string(kAxis[c]) + " " + quoted(t) +
+                         " is not finite");
+                }
+            }
+        };
+        const bool inFacet = facetLine != 0;
+        if (tok[0] == "solid" || tok[0] == "endsolid") {
+            if (inFacet) {
+                fail(place() + quoted(tok[0]) + " inside the facet of line " +
+                     std::to_string(facetLine) + " (no endfacet)");
+            }
+        } else if (tok[0] == "facet") {
+            if (inFacet) {
                 fail(place() + "a facet begins inside the facet of line " +
                      std::to_string(facetLine) + " (no endfacet)");
             }
+            expect(5, "facet normal nx ny nz");
+            if (tok[1] != "normal") {
+                fail(place() + "expected 'facet normal nx ny nz', got " + quoted(tok[1]) +
+                     " after 'facet'");
+            }
+            numbers(2, "normal ", false); // not used (hapto takes the corners' order), but read
             facetLine = lineNo;
             vertices = 0;
+        } else if (tok[0] == "outer" || tok[0] == "endloop") {
+            if (!inFacet) {
+                fail(place() + quoted(tok[0]) + " outside a facet");
+            }
+            if (tok[0] == "outer") {
+                expect(2, "outer loop");
+                if (tok[1] != "loop") {
+                    fail(place() + "expected 'outer loop', got " + quoted(tok[1]));
+                }
+            } else {
+                expect(1, "endloop");
+            }
         } else if (tok[0] == "vertex") {
             if (facetLine == 0) {
                 fail(place() + "a vertex outside a facet");
@@ -356,28 +463,23 @@ void checkAsciiStl(std::string_view text, const std::string& name) {
                 fail(place() + "expected 'vertex x y z', got " + std::to_string(tok.size() - 1) +
                      " numbers");
             }
-            for (int c = 0; c < 3; ++c) {
-                const auto v = parseNumber(tok[1 + c]);
-                if (!v) {
-                    fail(place() + std::string(kAxis[c]) + " " + quoted(tok[1 + c]) +
-                         " is not a number");
-                }
-                if (!std::isfinite(*v)) {
-                    fail(place() + std::string(kAxis[c]) + " " + quoted(tok[1 + c]) +
-                         " is not finite");
-                }
-            }
+            numbers(1, "", true);
             ++vertices;
         } else if (tok[0] == "endfacet") {
             if (facetLine == 0) {
                 fail(place() + "endfacet without a facet");
             }
+            expect(1, "endfacet");
             if (vertices != 3) {
                 fail(atLine(name, facetLine) + "the facet has " + std::to_string(vertices) +
                      " vertices; an STL facet is a triangle (3)");
             }
             facetLine = 0;
             checkTriangleLimit(++facets, name);
+        } else {
+            fail(place() + quoted(tok[0]) +
+                 " is not an ASCII STL keyword (solid, facet normal, outer loop, vertex, "
+                 "endloop, endfacet, endsolid)");
         }
     });
     if (facetLine != 0) {
@@ -638,7 +740,7 @@ void checkPly(std::string_view bytes, const std::string& name) {
             end = bytes.size();
         }
         const std::string_view line = bytes.substr(at, end - at);
-        at = end + 1;
+        at = std::min(end + 1, bytes.size()); // the body starts after end_header's newline
         ++lineNo;
         const auto place = [&] { return atLine(name, lineNo); };
         tokens(line, tok);
@@ -689,6 +791,10 @@ void checkPly(std::string_view bytes, const std::string& name) {
             elements.back().properties.push_back(
                 {std::string(tok[list ? 4 : 2]), list, *count, *type});
         } else if (tok[0] == "end_header") {
+            if (tok.size() != 1) {
+                fail(place() + "expected 'end_header' alone on its line (the body starts after "
+                               "its newline)");
+            }
             ended = true;
         } else {
             fail(place() + "unknown PLY header line " + quoted(line));

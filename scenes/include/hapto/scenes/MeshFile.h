@@ -29,4 +29,10 @@ bool isMeshFile(const std::filesystem::path& path);
 std::shared_ptr<const TriangleMesh> loadMeshFile(const std::filesystem::path& path,
                                                  MeshSource source);
 
+/// What loadMeshFile does once the file is read: `bytes` are the file's contents, `path` names
+/// it in messages and its extension gives the format. The same checks, the same messages (those
+/// of opening a file aside). The fuzz target `mesh_file` drives it. [control]
+std::shared_ptr<const TriangleMesh>
+parseMeshFile(std::string bytes, const std::filesystem::path& path, MeshSource source);
+
 } // namespace hapto
