@@ -272,8 +272,17 @@ void checkObj(std::string_view text, const std::string& name) {
                      std::to_string(n) + " numbers");
             }
             for (std::size_t k = 1; k < tok.size(); ++k) {
-                if (!parseNumber(tok[k])) {
+                const auto v = parseNumber(tok[k]);
+                if (!v) {
                     fail(place() + quoted(tok[k]) + " is not a number");
+                }
+                // assimp counts a number only when it begins with a digit or a sign (or is
+                // NaN or infinite): ".5" would make the vertex one number short, and skipped.
+                const char c = tok[k][0];
+                if (std::isfinite(*v) && (c < '0' || c > '9') && c != '+' && c != '-') {
+                    fail(place() + quoted(tok[k]) +
+                         " does not begin with a digit or a sign (assimp would not count it; "
+                         "write 0.5 for .5)");
                 }
             }
         };

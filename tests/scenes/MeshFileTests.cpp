@@ -313,6 +313,8 @@ TEST_CASE("bad model files are refused with the file and the place") {
         {"return.obj", "v 0 0 0\r\nv 1 0 0\r\nv \r0 1 0\nf 1 2 3\n",
          ":3: a carriage return inside a line"},
         {"feed.obj", "v 0 0 0\nv 1 0 \f0\nv 0 1 0\nf 1 2 3\n", ":2: a form feed inside a line"},
+        {"dot.obj", "v 0 0 0\nv 1 0 0\nv 0 .5 0\nf 1 2 3\n",
+         ":3: '.5' does not begin with a digit or a sign"},
         {"point.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\np 1  11\nf 1 2 3\n",
          ":4: vertex index 11 is out of range (the file has 3 vertices)"},
         {"colour.obj", "v 0 0 0 1 red 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", ":1: 'red' is not a number"},
