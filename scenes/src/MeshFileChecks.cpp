@@ -276,10 +276,11 @@ void checkObj(std::string_view text, const std::string& name) {
                 if (!v) {
                     fail(place() + quoted(tok[k]) + " is not a number");
                 }
-                // assimp counts a number only when it begins with a digit or a sign (or is
-                // NaN or infinite): ".5" would make the vertex one number short, and skipped.
+                // assimp counts the numbers of a v or vt only when they begin with a digit or
+                // a sign (or are NaN or infinite): ".5" would make it one number short.
                 const char c = tok[k][0];
-                if (std::isfinite(*v) && (c < '0' || c > '9') && c != '+' && c != '-') {
+                if (key != "vn" && std::isfinite(*v) && (c < '0' || c > '9') && c != '+' &&
+                    c != '-') {
                     fail(place() + quoted(tok[k]) +
                          " does not begin with a digit or a sign (assimp would not count it; "
                          "write 0.5 for .5)");

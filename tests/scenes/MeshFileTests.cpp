@@ -236,9 +236,11 @@ TEST_CASE("an open surface is open, and degenerate triangles are dropped and cou
     CHECK(mesh->triangleCount() == 3);
     CHECK(mesh->droppedDegenerate() == 1);
     CHECK_FALSE(mesh->closed());
-    // A byte order mark, a tab after 'v', parameter-space vertices and vertex colours are read.
+    // A byte order mark, a tab after 'v', parameter-space vertices, vertex colours and a normal
+    // written with leading points (assimp reads a vn's three words whatever they begin with).
     test::writeFile(dir / "bom.obj",
-                    "\xEF\xBB\xBFv 0 0 0\nv\t1 0 0 0.5 0.5 0.5\nvp 0.5\nv 0 1 0\nf 1 2 3\n");
+                    "\xEF\xBB\xBFv 0 0 0\nv\t1 0 0 0.5 0.5 0.5\nvp 0.5\nv 0 1 0\nvn .6 0 .8\n"
+                    "f 1 2 3\n");
     const auto bom = loadMeshFile(dir / "bom.obj", MeshSource{"bom.obj", 1.0});
     CHECK(bom->triangleCount() == 1);
     CHECK(bom->localBounds().max.x == 1.0);
