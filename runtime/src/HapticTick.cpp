@@ -1,6 +1,7 @@
 #include "hapto/runtime/HapticTick.h"
 
 #include "hapto/core/Finite.h"
+#include "hapto/runtime/Realtime.h"
 
 #include <algorithm>
 #include <array>
@@ -101,6 +102,12 @@ Unlisted firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& ren
 HapticTick::HapticTick(const RendererConfig& renderer, const SafetyConfig& safety)
     : mRenderer(renderer), mSafety(safety) {}
 
+void HapticTick::stamp(std::size_t i) noexcept {
+    if (mStamps != nullptr) {
+        (*mStamps)[i] = rt::nowNs();
+    }
+}
+
 void HapticTick::reset() noexcept {
     mFresh = true;
     mSafety.reset();
@@ -135,6 +142,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     // another leaf (or one is outside the bounds), and every moving object.
     const LocateResult atDevice = mDeviceCursor.locate(p);
     const LocateResult atProxy = mProxyCursor.locate(mRenderer.proxy());
+    stamp(0);
     mCandidates.clear();
     mCandidates.add(atDevice.candidates);
     if (atProxy.leaf != atDevice.leaf || atProxy.outside != atDevice.outside) {
@@ -169,6 +177,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
         listed[listedCount++] = missed.at.leaf;
         ++out.extraLeaves;
     }
+    stamp(1);
     const GodObjectRenderer::State start = mRenderer.state(); // a plain copy: no allocation
     out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
     out.solves = 1;
@@ -210,6 +219,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     if (out.render.contactCount > 0) {
         mSlideNormal = out.render.contacts[0].normal;
     }
+    stamp(2);
 
     // 4. Force effects at the device point, then the hook, and the external force. A hook
     // that returns NaN or infinity adds nothing (counted), like a renderer's non-finite output.
@@ -229,9 +239,11 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
             out.hookNonFinite = true;
         }
     }
+    stamp(3);
     // 5. Safety.
     const Vec3 requested = out.render.force + externalForceN + out.effectsN + out.hookN;
     out.forceN = mSafety.filter(requested);
+    stamp(4);
     return out;
 }
 

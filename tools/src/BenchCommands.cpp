@@ -16,6 +16,7 @@
 #include "hapto/runtime/Effects.h"
 #include "hapto/runtime/ForceSafety.h"
 #include "hapto/runtime/GodObjectRenderer.h"
+#include "hapto/runtime/HapticTick.h"
 #include "hapto/runtime/Realtime.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/runtime/ServoLoop.h"
@@ -279,21 +280,20 @@ private:
     Vec3 mForceN{0.0};
 };
 
-/// What one tick reads and writes, laid out like the servo's hot state: the pieces HapticTick
-/// holds (two cursors, the renderer, the safety filter, the candidates, the effects), driven
-/// stage by stage from outside so each stage can be timed. One per (index, mode).
+/// What one tick reads and writes, laid out like the servo's hot state: the servo's own
+/// HapticTick (timing its stages), the device sample, and the walk's last point and step (the
+/// velocity, and the warm-up's predicted point). One per (index, mode).
 struct alignas(64) TickPieces {
-    Cursor deviceCursor, proxyCursor;
-    GodObjectRenderer renderer;
-    ForceSafety safety;
-    CandidateSet candidates;
-    EffectSet effects;
+    HapticTick haptic;
+    HapticTick::StageStamps stamps{};
     DeviceState sample;
     Vec3 lastPoint{0.0};
     Vec3 lastStep{0.0};
-    const SpatialIndex* boundIndex = nullptr;
-    std::uint64_t boundVersion = 0;
     bool fresh = true;
+
+    TickPieces() { haptic.timeStages(&stamps); }
+    TickPieces(const TickPieces&) = delete;
+    TickPieces& operator=(const TickPieces&) = delete;
 };
 
 /// One (index, mode) being driven: its device, its tick state, its per-stage samples (ns).
@@ -350,9 +350,10 @@ Aabb walkBox(const Aabb& bounds, double edgeM) {
             glm::min(bounds.max, bounds.center() + half)};
 }
 
-/// One tick, stage by stage, as Runtime::servoTick and HapticTick::tick run it; the stage
-/// boundaries are steady clock readings (`wake` is the first). What HapticTick does that is
-/// not reachable from outside (the re-solve with a leaf the proxy slid into) is not run.
+/// One tick, stage by stage, as Runtime::servoTick runs it: read, snapshot, HapticTick::tick
+/// (its own five stages: locate, candidates, render with the walk and re-solves, effects,
+/// safety), write, metrics. The stage boundaries are steady clock readings (`wake` is the
+/// first).
 void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs, double dtS) {
     TickPieces& t = *run.pieces;
     std::array<std::uint64_t, kStageCount + 1> stamp{};
@@ -369,43 +370,17 @@ void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs,
     const Vec3 p = t.sample.position;
     if (t.fresh) {
         t.lastPoint = p;
+        t.fresh = false;
     }
     const Vec3 v = t.sample.hasVelocity ? t.sample.velocity : (p - t.lastPoint) / dtS;
     t.lastStep = p - t.lastPoint;
     t.lastPoint = p;
     stamp[2] = rt::nowNs();
-    // locate
-    const SpatialIndex* index = snap.index.get();
-    if (t.fresh || snap.version != t.boundVersion || index != t.boundIndex) {
-        t.deviceCursor.reset(*index);
-        t.proxyCursor.reset(*index);
-        t.boundIndex = index;
-        t.boundVersion = snap.version;
-    }
-    if (t.fresh) {
-        t.renderer.reset(p);
-        t.fresh = false;
-    }
-    const LocateResult atDevice = t.deviceCursor.locate(p);
-    const LocateResult atProxy = t.proxyCursor.locate(t.renderer.proxy());
-    stamp[3] = rt::nowNs();
-    // candidates
-    t.candidates.clear();
-    t.candidates.add(atDevice.candidates);
-    if (atProxy.leaf != atDevice.leaf || atProxy.outside != atDevice.outside) {
-        t.candidates.add(atProxy.candidates);
-    }
-    t.candidates.add(snap.movingSlots());
-    stamp[4] = rt::nowNs();
-    // render
-    const RenderOutput out = t.renderer.update(*snap.scene, t.candidates, p, v, dtS);
-    stamp[5] = rt::nowNs();
-    // effects
-    const Vec3 effectsN = t.effects.forceN(p, v);
-    stamp[6] = rt::nowNs();
-    // safety
-    const Vec3 force = t.safety.filter(out.force + effectsN);
-    stamp[7] = rt::nowNs();
+    // locate, candidates, render, effects, safety
+    const TickOutput tick = t.haptic.tick(snap, p, v, dtS, Vec3(0.0), t.sample);
+    std::copy(t.stamps.begin(), t.stamps.end(), stamp.begin() + 3);
+    const RenderOutput& out = tick.render;
+    const Vec3 force = tick.forceN;
     // write
     (void)run.device->write(force);
     stamp[8] = rt::nowNs();
@@ -414,7 +389,7 @@ void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs,
     m.tickNs.record(stamp[8] - wakeNs);
     m.latenessNs.record(0);
     m.ioNs.record((stamp[1] - wakeNs) + (stamp[8] - stamp[7]));
-    DeviceMetrics::bump(m.locateStepsSum, atDevice.steps + atProxy.steps);
+    DeviceMetrics::bump(m.locateStepsSum, tick.locateSteps);
     DeviceMetrics::bump(m.candidatesSum, out.objectsTested);
     if (out.contactCount > 0) {
         DeviceMetrics::bump(m.contactTicks);
@@ -423,7 +398,7 @@ void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs,
         m.forceN[i].store(force[i], std::memory_order_relaxed);
         m.positionM[i].store(p[i], std::memory_order_relaxed);
     }
-    m.leafAtVersion.store((snap.version & 0xFFFFFFFFu) << 32 | atDevice.leaf,
+    m.leafAtVersion.store((snap.version & 0xFFFFFFFFu) << 32 | tick.deviceLeaf,
                           std::memory_order_relaxed);
     ContactReport report;
     report.tick = run.ticks;
@@ -445,7 +420,7 @@ void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs,
     }
     run.tickNs[at] = static_cast<double>(stamp[kStageCount] - stamp[0]);
     ++run.ticks;
-    run.locateSteps += atDevice.steps + atProxy.steps;
+    run.locateSteps += tick.locateSteps;
     run.candidates += out.objectsTested;
     run.contactTicks += out.contactCount > 0 ? 1 : 0;
 }
@@ -479,7 +454,7 @@ void driveTicks(TickRun& run, World& world, std::size_t at, std::size_t count,
                 // As the servo loop does with a warm-up: wake early, touch, spin to the deadline.
                 rt::sleepUntilNs(deadline - warmNs, 0);
                 const WorldSnapshot& snap = world.acquire(*run.reader);
-                run.kept += warmUpTick(snap, run.pieces->renderer,
+                run.kept += warmUpTick(snap, run.pieces->haptic.renderer(),
                                        std::as_bytes(std::span(run.pieces.get(), 1)),
                                        run.pieces->lastPoint, run.pieces->lastStep, dtS);
                 run.warmOverruns += rt::nowNs() > deadline ? 1 : 0;
@@ -744,9 +719,10 @@ void addBenchCommands(CLI::App& app) {
         "run: back to back (hot), after a --sleep-us sleep (a real 1 kHz servo), and after the "
         "same sleep with the servo loop's warm-up --warm-us before the deadline (hapto run "
         "--warm-us); with --wake-latency-us, both sleep modes again while a CPU wake-latency "
-        "request is held. The stages are the public pieces Runtime::servoTick and HapticTick::tick "
-        "call, in their order, with a steady clock reading at each boundary; the re-solve "
-        "HapticTick runs when the proxy slides into an unlisted leaf is not run. Reports each "
+        "request is held. The stages are Runtime::servoTick's, in their order, with a steady clock "
+        "reading at each "
+        "boundary; locate to safety are timed inside the servo's own HapticTick::tick (render "
+        "includes its walk over the proxy's path and any re-solve). Reports each "
         "stage's and the whole tick's median, p99 and p99.9 (ns).");
     tick->add_option("--scene", targs->scene, "Scene file (default: the embedded default scene)");
     tick->add_option("--index", targs->indices,

@@ -11,6 +11,7 @@
 #include "hapto/runtime/TickHook.h"
 #include "hapto/runtime/World.h"
 
+#include <array>
 #include <cstdint>
 
 namespace hapto {
@@ -102,6 +103,15 @@ public:
     /// ticks: it is a plain field, not synchronised.
     void setHook(const TickHook& hook) noexcept { mHook = hook; }
 
+    /// The steady clock (ns, rt::nowNs) at the end of each of tick()'s stages, in order:
+    /// locate, candidates (the slide's leaves listed before solving included), render (the
+    /// walk over the proxy's path, its re-solves and pull-backs included), effects (the hook
+    /// included), safety. `hapto bench tick` times the tick with them.
+    using StageStamps = std::array<std::uint64_t, 5>;
+    /// From the next tick on, tick() writes the clock at each stage's end into `*stamps`;
+    /// null (the default) reads no clock. [control] before the ticks it is for
+    void timeStages(StageStamps* stamps) noexcept { mStamps = stamps; }
+
     /// The force of the last tick is not sent (a fault rule commanded zero): the next force
     /// grows from zero at the safety filter's rate. [servo]
     void zeroForce() noexcept { mSafety.reset(); }
@@ -114,6 +124,9 @@ public:
     const ForceSafety& safety() const noexcept { return mSafety; }
 
 private:
+    /// Writes the clock as stage `i`'s end when stages are timed. [servo]
+    void stamp(std::size_t i) noexcept;
+
     Cursor mDeviceCursor; ///< The device point's leaf.
     Cursor mProxyCursor;  ///< The proxy's leaf.
     GodObjectRenderer mRenderer;
@@ -124,6 +137,7 @@ private:
     const SpatialIndex* mBoundIndex = nullptr; ///< The index the cursors are bound to.
     Vec3 mSlideNormal{0.0}; ///< The last contact's first normal: the plane a proxy slides on.
     std::uint64_t mBoundVersion = 0; ///< The snapshot version they were bound for.
+    StageStamps* mStamps = nullptr;  ///< Where tick() writes its stage ends, or none.
     bool mFresh = true;              ///< The next tick starts afresh (reset()).
 };
 
