@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
+#include <iostream>
 #include <random>
 #include <stdexcept>
 #include <streambuf>
@@ -187,6 +188,30 @@ void AtomicOutputFile::commit() {
                                  "); the file was left as it was");
     }
     m.committed = true;
+}
+
+TextOutput::TextOutput(const fs::path& path)
+    : mFile(path.empty() ? nullptr : std::make_unique<AtomicOutputFile>(path)),
+      mOut(mFile ? &mFile->stream() : &std::cout) {}
+
+void TextOutput::afterRow() {
+    if (mText.size() > (std::size_t{1} << 20)) {
+        mOut->write(mText.data(), static_cast<std::streamsize>(mText.size()));
+        mText.clear();
+    }
+}
+
+void TextOutput::finish() {
+    mOut->write(mText.data(), static_cast<std::streamsize>(mText.size()));
+    mText.clear();
+    if (mFile) {
+        mFile->commit(); // checks the stream, names the file
+        return;
+    }
+    mOut->flush();
+    if (!*mOut) {
+        throw std::runtime_error("writing to standard output failed");
+    }
 }
 
 void writeFileAtomically(const fs::path& path, std::string_view content) {

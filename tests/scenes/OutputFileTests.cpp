@@ -46,6 +46,33 @@ TEST_CASE("an output replaces its file only when committed, and leaves no tempor
     CHECK(namesIn(dir.path()) == std::vector<std::string>{"out.csv"});
 }
 
+TEST_CASE("rows of text pass 1 MiB in pieces and land whole, and only at finish") {
+    TempDir dir;
+    writeFile(dir / "rows.csv", "old\n");
+    std::string want = "n\n";
+    {
+        TextOutput out(dir / "rows.csv");
+        out.text() = "n\n";
+        for (int i = 0; i < 200000; ++i) { // about 1.3 MB: written out at least once before finish
+            const std::string row = std::to_string(i) + ",abc\n";
+            out.text() += row;
+            want += row;
+            out.afterRow();
+            CHECK(out.text().size() <= (std::size_t{1} << 20) + row.size());
+        }
+        CHECK(readFile(dir / "rows.csv") == "old\n");
+        out.finish();
+    }
+    CHECK(readFile(dir / "rows.csv") == want);
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"rows.csv"});
+    // A write that fails is an error naming the file, not a silent short file.
+    if (fs::exists("/dev/full")) {
+        TextOutput full("/dev/full");
+        full.text() = "x\n";
+        CHECK_THROWS_WITH(full.finish(), Catch::Contains("/dev/full"));
+    }
+}
+
 TEST_CASE("an output abandoned before commit leaves the old file and no temporary") {
     TempDir dir;
     writeFile(dir / "out.csv", "old\n");

@@ -97,12 +97,9 @@ void runQuery(const std::string& scenePath, const std::string& specText,
     const Scene scene = loadSceneOrDefault(scenePath);
     const std::unique_ptr<SpatialIndex> index = buildIndex(scene, spec);
 
-    std::unique_ptr<AtomicOutputFile> file;
-    if (!outPath.empty()) {
-        file = std::make_unique<AtomicOutputFile>(outPath);
-    }
-    std::ostream& out = file ? file->stream() : std::cout;
-    std::string text = "point,candidates\n";
+    TextOutput out(outPath);
+    std::string& text = out.text();
+    text = "point,candidates\n";
     Cursor cursor(*index);
     // A candidate is an object id, or for a mesh triangle "id:triangle" (its mesh's id and its
     // number in that mesh); sorted by id, then triangle (the object itself first).
@@ -133,19 +130,9 @@ void runQuery(const std::string& scenePath, const std::string& specText,
             }
         }
         text += '\n';
-        if (text.size() > (1u << 20)) {
-            out << text;
-            text.clear();
-        }
+        out.afterRow();
     }
-    out << text;
-    out.flush();
-    if (!out) {
-        throw std::runtime_error("writing the query results failed");
-    }
-    if (file) {
-        file->commit();
-    }
+    out.finish();
 }
 
 nlohmann::json statsJson(const IndexStats& s) {

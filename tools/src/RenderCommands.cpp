@@ -67,12 +67,9 @@ void runRender(const RenderArgs& a) {
     const World world(loadSceneOrDefault(a.scene), spec);
     const WorldSnapshot& snapshot = world.current();
 
-    std::unique_ptr<AtomicOutputFile> file;
-    if (!a.output.empty()) {
-        file = std::make_unique<AtomicOutputFile>(a.output);
-    }
-    std::ostream& out = file ? file->stream() : std::cout;
-    std::string text = "tick,x,y,z,proxy_x,proxy_y,proxy_z,fx,fy,fz,contacts\n";
+    TextOutput out(a.output);
+    std::string& text = out.text();
+    text = "tick,x,y,z,proxy_x,proxy_y,proxy_z,fx,fy,fz,contacts\n";
     HapticTick tick;
     const double dtS = 1.0 / a.rateHz;
     Vec3 last = path.front();
@@ -88,19 +85,9 @@ void runRender(const RenderArgs& a) {
         text += ',';
         text += std::to_string(t.render.contactCount);
         text += '\n';
-        if (text.size() > (1u << 20)) {
-            out << text;
-            text.clear();
-        }
+        out.afterRow();
     }
-    out << text;
-    out.flush();
-    if (!out) {
-        throw std::runtime_error("writing the rendered path failed");
-    }
-    if (file) {
-        file->commit();
-    }
+    out.finish();
 }
 
 } // namespace

@@ -31,13 +31,9 @@ void exportCsv(const std::string& tracePath, const std::string& outPath) {
         checkOutputFile(outPath, "-o");
     }
     TraceReader reader(tracePath);
-    std::unique_ptr<AtomicOutputFile> file;
-    std::ostream* os = &std::cout;
-    if (toFile) {
-        file = std::make_unique<AtomicOutputFile>(outPath);
-        os = &file->stream();
-    }
-    std::string out = "tick,time_ns,x_m,y_m,z_m,fx_n,fy_n,fz_n,compute_ns,io_ns,status,buttons\n";
+    TextOutput csv(toFile ? outPath : std::string());
+    std::string& out = csv.text();
+    out = "tick,time_ns,x_m,y_m,z_m,fx_n,fy_n,fz_n,compute_ns,io_ns,status,buttons\n";
     TraceSample s;
     std::uint64_t rows = 0;
     while (reader.next(s)) {
@@ -62,19 +58,10 @@ void exportCsv(const std::string& tracePath, const std::string& outPath) {
         out += std::to_string(s.buttons);
         out += '\n';
         ++rows;
-        if (out.size() > (1u << 20)) {
-            os->write(out.data(), static_cast<std::streamsize>(out.size()));
-            out.clear();
-        }
+        csv.afterRow();
     }
-    os->write(out.data(), static_cast<std::streamsize>(out.size()));
-    os->flush();
-    if (!*os) {
-        throw std::runtime_error((outPath.empty() ? std::string("stdout") : outPath) +
-                                 ": write failed (disk full?)");
-    }
-    if (file) {
-        file->commit();
+    csv.finish();
+    if (toFile) {
         std::cerr << "wrote " << rows << " samples to " << outPath << "\n";
     }
 }

@@ -44,6 +44,27 @@ private:
     std::unique_ptr<Impl> mImpl;
 };
 
+/// Rows of text (CSV) written whole to a file through an AtomicOutputFile, or to standard
+/// output when the path is empty. The caller appends rows to text(); the text is written out
+/// each time it passes 1 MiB (afterRow()) and at finish(). [control]
+class TextOutput {
+public:
+    /// Opens the output (see AtomicOutputFile); `path` empty: standard output.
+    explicit TextOutput(const std::filesystem::path& path);
+    /// The text not yet written: append rows here.
+    std::string& text() noexcept { return mText; }
+    /// Writes the text out once it holds more than 1 MiB; call after each row.
+    void afterRow();
+    /// Writes the rest and renames the file into place. Throws std::runtime_error naming the
+    /// file, or standard output, when a write failed (the file is then left as it was).
+    void finish();
+
+private:
+    std::unique_ptr<AtomicOutputFile> mFile;
+    std::ostream* mOut;
+    std::string mText;
+};
+
 /// Writes `content` to `path` through an AtomicOutputFile. Throws InputError when the folder
 /// cannot take it, std::runtime_error when the write fails. [control]
 void writeFileAtomically(const std::filesystem::path& path, std::string_view content);
