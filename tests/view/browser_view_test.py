@@ -136,7 +136,9 @@ def png_pixels(path):
 def live(hapto, browser, workdir):
     report_path = os.path.join(workdir, "report.json")
     record = os.path.join(workdir, "recording")
-    duration = 10.0
+    # Long enough for both viewers to be following before it ends: on a busy two-core machine
+    # Chromium took 3 s to start and 5 s more to load the page (two of them at once).
+    duration = 30.0
     proc, url = start([hapto, "run", "--view", "0", "--duration", str(duration), "--no-realtime",
                        "--quiet", "--report", report_path, "--record", record],
                       os.path.join(workdir, "run.log"))

@@ -52,15 +52,23 @@ function setupScene(scene) {
     note.style.display = 'block';
   }
 
+  // Drawn on demand: when a frame arrives, the camera moves or the window changes size, at
+  // most once per display frame. A page that redrew every display frame kept a core busy in
+  // software WebGL (SwiftShader, no GPU) and starved its own stream on a two-core machine.
+  let pending = false;
+  view.redraw = () => {
+    if (pending) return;
+    pending = true;
+    requestAnimationFrame(() => { pending = false; renderer.render(world, camera); });
+  };
+  controls.addEventListener('change', view.redraw);
   window.addEventListener('resize', () => {
     camera.aspect = host.clientWidth / host.clientHeight;
     camera.updateProjectionMatrix();
     renderer.setSize(host.clientWidth, host.clientHeight);
+    view.redraw();
   });
-  (function draw() {
-    requestAnimationFrame(draw);
-    renderer.render(world, camera);
-  })();
+  view.redraw();
 }
 
 function makeObject(o) {
@@ -222,6 +230,7 @@ function showFrame(frame, devices) {
                                : view.listed.has(id) ? LISTED_COLOR : OBJECT_COLOR);
   }
   view.frames++;
+  if (view.redraw) view.redraw();
   const status = document.getElementById('status');
   status.dataset.frames = String(view.frames);
   if (status.dataset.firstT === undefined) status.dataset.firstT = String(frame.t);
