@@ -4,6 +4,7 @@
 
 #include "hapto/scenes/InputError.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hapto {
@@ -91,10 +92,7 @@ DeviceStatus SimDevice::read(DeviceState& state) noexcept {
     if (!mOpen) {
         return DeviceStatus::NotOpen;
     }
-    ++mTick;
-    mTargetWorld = mScript->targetAt(timeS(), mCursor, mPhase);
-    mPublishedPhase.store(mPhase, std::memory_order_relaxed);
-    mHand.step(mConfig.transform.positionToDevice(mTargetWorld), mForceN, mDtS);
+    advance();
     const Vec3& p = mHand.position();
     for (int i = 0; i < 3; ++i) {
         const double noise = mSim.noiseM > 0.0 ? mNoise.uniform(-mSim.noiseM, mSim.noiseM) : 0.0;
@@ -116,6 +114,24 @@ DeviceStatus SimDevice::read(DeviceState& state) noexcept {
     state.buttons = holding ? 1u : 0u;
     state.sequence = mTick;
     return DeviceStatus::Ok;
+}
+
+void SimDevice::periodsSkipped(std::uint64_t periods) noexcept {
+    if (!mOpen) {
+        return;
+    }
+    const std::uint64_t stepped = std::min(periods, kMaxSkippedSteps);
+    mTick += periods - stepped;
+    for (std::uint64_t i = 0; i < stepped; ++i) {
+        advance();
+    }
+}
+
+void SimDevice::advance() noexcept {
+    ++mTick;
+    mTargetWorld = mScript->targetAt(timeS(), mCursor, mPhase);
+    mPublishedPhase.store(mPhase, std::memory_order_relaxed);
+    mHand.step(mConfig.transform.positionToDevice(mTargetWorld), mForceN, mDtS);
 }
 
 DeviceStatus SimDevice::write(const Vec3& forceN) noexcept {

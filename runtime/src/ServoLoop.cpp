@@ -246,12 +246,14 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
     m.heartbeatNs.store(done, std::memory_order_relaxed);
 
     // The next deadline. A tick whose force came after the next deadline missed it; skip the
-    // slots it overran instead of bursting to catch up.
+    // slots it overran instead of bursting to catch up, and tell the device they went by.
     s.deadlineNs += s.periodNs;
     if (done > s.deadlineNs) {
         DeviceMetrics::bump(m.missedDeadlines);
         s.consecutiveMisses = std::min(s.consecutiveMisses + 1, s.missLimit); // saturates
-        s.deadlineNs += ((done - s.deadlineNs) / s.periodNs + 1) * s.periodNs;
+        const std::uint64_t skipped = (done - s.deadlineNs) / s.periodNs + 1;
+        s.deadlineNs += skipped * s.periodNs;
+        s.device->periodsSkipped(skipped);
     } else {
         s.consecutiveMisses = 0;
     }

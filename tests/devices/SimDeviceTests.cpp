@@ -97,6 +97,53 @@ TEST_CASE("sim: same seed gives the same trajectory bit for bit, another seed di
     }
 }
 
+TEST_CASE("sim: periods the servo skipped move the hand on as reading through them would, under "
+          "the force last written") {
+    const Scene scene = makeDefaultScene();
+    const Vec3 f(0.5, -0.3, 0.2);
+    for (const std::uint64_t skipped :
+         {std::uint64_t{1}, std::uint64_t{5}, SimDevice::kMaxSkippedSteps, std::uint64_t{1000}}) {
+        INFO(skipped << " periods skipped");
+        SimDevice read(simConfig("slide", 3), scene), skip(simConfig("slide", 3), scene);
+        REQUIRE(read.open() == DeviceStatus::Ok);
+        REQUIRE(skip.open() == DeviceStatus::Ok);
+        DeviceState s;
+        for (int i = 0; i < 300; ++i) {
+            REQUIRE(read.write(f) == DeviceStatus::Ok);
+            REQUIRE(skip.write(f) == DeviceStatus::Ok);
+            REQUIRE(read.read(s) == DeviceStatus::Ok);
+            REQUIRE(skip.read(s) == DeviceStatus::Ok);
+        }
+        for (std::uint64_t i = 0; i < skipped; ++i) {
+            REQUIRE(read.read(s) == DeviceStatus::Ok);
+        }
+        const Vec3 before = skip.handPosition();
+        skip.periodsSkipped(skipped);
+        // The clock and the script agree whatever the gap.
+        CHECK(skip.tick() == read.tick());
+        CHECK(skip.timeS() == read.timeS());
+        CHECK(skip.targetWorld() == read.targetWorld());
+        CHECK(skip.phase() == read.phase());
+        DeviceState r;
+        REQUIRE(skip.read(s) == DeviceStatus::Ok);
+        REQUIRE(read.read(r) == DeviceStatus::Ok);
+        CHECK(s.sequence == r.sequence);
+        CHECK(skip.handPosition() != before);
+        if (skipped <= SimDevice::kMaxSkippedSteps) {
+            // Every skipped period stepped the hand: the same hand, bit for bit.
+            CHECK(skip.handPosition() == read.handPosition());
+        } else {
+            // Only the last kMaxSkippedSteps were stepped (bounded work): the hand started
+            // them from where it was, so it trails, but it stays finite.
+            CHECK(std::isfinite(glm::length(skip.handPosition())));
+        }
+    }
+    // A closed device ignores it.
+    SimDevice closed(simConfig("slide", 3), scene);
+    closed.periodsSkipped(10);
+    CHECK(closed.tick() == 0);
+}
+
 TEST_CASE("sim: the device feels the force written to it") {
     const Scene empty; // nothing to touch: the hand holds still at its start
     DeviceConfig c = simConfig("touch", 1);

@@ -116,11 +116,16 @@ public:
         recordForce(f);
         return DeviceStatus::Ok;
     }
+    void periodsSkipped(std::uint64_t periods) noexcept override {
+        mSkipped.fetch_add(periods, std::memory_order_relaxed);
+    }
     std::string errorMessage() const override {
         return mInject == Inject::OpenFails ? "injected open failure" : "";
     }
 
     std::uint64_t reads() const { return mReads.load(); }
+    /// Periods the servo told this device it skipped (periodsSkipped), in total.
+    std::uint64_t skippedPeriods() const { return mSkipped.load(); }
     std::uint64_t opens() const { return mOpens; }
     /// Step mode: every force written, with the read count when it was written. [control]
     struct Written {
@@ -180,7 +185,7 @@ private:
     std::uint64_t mAwayFrom = ~0ull, mBackAtNs = 0, mOpenNs = 0, mOpens = 0;
     mutable std::mutex mHistoryMutex;
     std::vector<Written> mHistory;
-    std::atomic<std::uint64_t> mReads{0}, mWrites{0};
+    std::atomic<std::uint64_t> mReads{0}, mWrites{0}, mSkipped{0};
     std::atomic<double> mLast[3]{};
     std::atomic<double> mMaxForce{0};
     std::atomic<double> mForceAfterGap{-1.0};

@@ -364,6 +364,9 @@ TEST_CASE("step mode: after K missed deadlines in a row the device gets zero for
     // Ticks 100 and 101 miss (K = 2 in a row); 102..199 are zeroed, and so is 200, the first
     // on time, which still follows two misses; 201 sends force again.
     CHECK(m.missedDeadlines.load() == 100);
+    // Each 3-period read ended on the third deadline after its own: those 3 slots had no tick,
+    // and the device was told (a simulated hand's clock runs on through them).
+    CHECK(rig.devices[0]->skippedPeriods() == 300);
     CHECK(m.zeroedForMisses.load() == 99);
     CHECK(m.lateWakeups.load() == 0); // every wake-up was on its (skipped-ahead) deadline
     const std::vector<ScriptedDevice::Written> f = rig.devices[0]->forces();
@@ -399,6 +402,9 @@ TEST_CASE("step mode: a wake-up K periods late commands zero for that tick, a la
         CHECK(m.zeroedForMisses.load() == 0);
         CHECK(rig.force(0).y == Approx(before.y).epsilon(1e-12));
         CHECK(rig.runtime->nextDeadlineNs(0) == rig.t0 + 104 * kMs);
+        // The 101 ms tick ran at 103: the slots of 102 and 103 ms had none, and the device
+        // hears of both.
+        CHECK(rig.devices[0]->skippedPeriods() == 2);
     }
     SECTION("K = 3 periods late: zero force that tick, then force grows back from zero") {
         REQUIRE(rig.runtime->step(0, rig.t0 + 104 * kMs));

@@ -81,6 +81,12 @@ public:
     virtual DeviceStatus read(DeviceState& state) noexcept = 0;
     /// Commands a force (N), device frame. [servo]
     virtual DeviceStatus write(const Vec3& forceN) noexcept = 0;
+    /// The servo let `periods` of its deadlines pass without a tick (a late wake-up or a tick
+    /// that overran; the next tick's deadline is that many periods further on than the one
+    /// after the tick just done). A device that keeps its own time (a simulated hand) lets it run
+    /// on through them, under the force last written, as a real hand moves on while nobody reads
+    /// it; a real device needs nothing. Bounded work. [servo]
+    virtual void periodsSkipped(std::uint64_t periods) noexcept { (void)periods; }
 
     /// What went wrong last, for people. [control]
     virtual std::string errorMessage() const = 0;

@@ -50,6 +50,9 @@ public:
     void close() override { mInner->close(); }
     DeviceStatus read(DeviceState& state) noexcept override;
     DeviceStatus write(const Vec3& forceN) noexcept override;
+    void periodsSkipped(std::uint64_t periods) noexcept override {
+        mInner->periodsSkipped(periods);
+    }
     std::string errorMessage() const override;
 
 private:

@@ -15,12 +15,13 @@
 namespace hapto {
 
 /// A device held by a simulated hand. At open() the script (SimConfig::script) is planned
-/// against the scene in the world frame. Every read() advances time by exactly 1 / rate: the
-/// script's target, converted into the device frame, pulls the HandModel, and the force last
-/// written acts on it, so a hand pressing on a surface feels the surface push back. Readings
-/// are quantised to SimConfig::resolutionM after uniform noise of at most SimConfig::noiseM per
-/// axis. Same configuration, scene and written forces, same readings, bit for bit; devices share
-/// nothing, so any number can run at once. Button 0 is held while a grasp squeezes and carries.
+/// against the scene in the world frame. Every read() advances time by exactly 1 / rate (and
+/// periodsSkipped() by the periods the servo could not run): the script's target, converted into
+/// the device frame, pulls the HandModel, and the force last written acts on it, so a hand pressing
+/// on a surface feels the surface push back. Readings are quantised to SimConfig::resolutionM after
+/// uniform noise of at most SimConfig::noiseM per axis. Same configuration, scene, written
+/// forces and skipped periods, same readings, bit for bit; devices share nothing, so any number can
+/// run at once. Button 0 is held while a grasp squeezes and carries.
 class SimDevice final : public Device {
 public:
     /// Keeps a reference to `scene`, which must outlive open(). Throws InputError when the
@@ -38,6 +39,14 @@ public:
     void close() override;
     /// Advances one tick of 1 / rate and reports position and velocity (device frame). [servo]
     DeviceStatus read(DeviceState& state) noexcept override;
+    /// Time runs on by `periods` ticks that nobody read (the servo missed its deadlines), the
+    /// hand moving under the force last written: two hands stay in step with each other and
+    /// with the clock however often either thread is late. The hand is stepped through the
+    /// last kMaxSkippedSteps of them (bounded work); earlier ones move only the script's
+    /// clock. The step mode, which misses no deadline, never calls it. [servo]
+    void periodsSkipped(std::uint64_t periods) noexcept override;
+    /// Most hand steps one periodsSkipped() call takes (64 ms of hand at 1 kHz).
+    static constexpr std::uint64_t kMaxSkippedSteps = 64;
     /// The force (N, device frame) acting on the hand from the next read() on, clamped to the
     /// max force; a non-finite force is refused with BadData and zero force is applied. [servo]
     DeviceStatus write(const Vec3& forceN) noexcept override;
@@ -58,9 +67,9 @@ public:
     const Vec3& handPosition() const { return mHand.position(); }
     /// The hand's exact position in the world (m). [servo]
     Vec3 handPositionWorld() const { return mConfig.transform.positionToWorld(mHand.position()); }
-    /// Ticks since open. [servo]
+    /// Ticks since open, skipped periods included. [servo]
     std::uint64_t tick() const { return mTick; }
-    /// Simulated time since open (s): tick / rate. [servo]
+    /// Simulated time since open (s): tick / rate, skipped periods included. [servo]
     double timeS() const { return static_cast<double>(mTick) * mDtS; }
     /// The plan, once open. [control]
     const std::optional<SimScript>& script() const { return mScript; }
@@ -70,6 +79,9 @@ public:
     const SimConfig& simConfig() const { return mSim; }
 
 private:
+    /// One tick of simulated time: the script's target pulls the hand, the force acts. [servo]
+    void advance() noexcept;
+
     DeviceConfig mConfig;
     SimConfig mSim;
     const Scene* mScene;

@@ -107,6 +107,8 @@ public:
     DeviceStatus read(DeviceState& state) noexcept override;
     /// Forwards the force. [servo]
     DeviceStatus write(const Vec3& forceN) noexcept override { return mSim.write(forceN); }
+    /// Forwards the skipped periods (the hand's time runs on). [servo]
+    void periodsSkipped(std::uint64_t periods) noexcept override { mSim.periodsSkipped(periods); }
     std::string errorMessage() const override { return mSim.errorMessage(); }
 
 private:
