@@ -43,7 +43,7 @@ public:
     /// hand moving under the force last written: two hands stay in step with each other and
     /// with the clock however often either thread is late. The hand is stepped through the
     /// last kMaxSkippedSteps of them (bounded work); earlier ones move only the script's
-    /// clock. The step mode, which misses no deadline, never calls it. [servo]
+    /// clock. The step mode calls it only when the times a test gives make a tick miss. [servo]
     void periodsSkipped(std::uint64_t periods) noexcept override;
     /// Most hand steps one periodsSkipped() call takes (64 ms of hand at 1 kHz).
     static constexpr std::uint64_t kMaxSkippedSteps = 64;
