@@ -5,7 +5,7 @@ and `hapto view` playing that session's recording.
     browser_view_test.py HAPTO CHROMIUM WORKDIR
 
 Live: the page's 3-D canvas is drawn (a screenshot, not blank, with the scene's objects in its
-colours); the values it shows change as the session runs (its first and its last frame differ)
+colours and each hand's marker in its device colour); the values it shows change as the session runs (its first and its last frame differ)
 and match the runtime's own report within tolerance (ticks, misses, time, load p50). Offline:
 the player moves through the recorded trace (two page loads, the later one further on).
 
@@ -192,6 +192,12 @@ def live(hapto, browser, workdir):
               "the screenshot is not blank: %.1f%% of the canvas drawn" % (100 * drawn / len(canvas)))
         check(objects > 0.02 * len(canvas),
               "the scene's objects are in view: %.1f%% of the canvas" % (100 * objects / len(canvas)))
+        # Each hand's marker in its device colour (view.js COLORS: left 0x4fc3f7, right
+        # 0xffb74d, unlit), although both hands work inside the default scene's block of cubes:
+        # the markers are drawn over the objects. A point's sphere is about 20 px across here.
+        for name, colour in (("left", (0x4F, 0xC3, 0xF7)), ("right", (0xFF, 0xB7, 0x4D))):
+            marker = sum(1 for p in canvas if max(abs(p[k] - colour[k]) for k in range(3)) <= 24)
+            check(marker >= 30, "%s's hand is in sight: %d pixels of its colour" % (name, marker))
     return record, report
 
 

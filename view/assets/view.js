@@ -121,7 +121,17 @@ function makeDevice(world, d, i) {
   // The device point's cursor leaf: the paper's idea made visible (the box the cursor caches
   // and the objects it hands to the renderer); shown when "leaves" is ticked.
   const leaf = new THREE.Box3Helper(new THREE.Box3(), color);
-  for (const o of [point, proxy, arrow, leaf]) { o.visible = false; world.add(o); }
+  // Drawn over the objects, never hidden by them: a hand works among the objects (the default
+  // scene's hands are inside a block of 200 cubes), where a depth-tested marker is out of sight
+  // from every side.
+  for (const o of [point, proxy, arrow, leaf]) {
+    o.visible = false;
+    o.traverse((part) => {
+      part.renderOrder = 1;
+      if (part.material) part.material.depthTest = false;
+    });
+    world.add(o);
+  }
   const row = document.createElement('div');
   row.className = 'device';
   row.dataset.device = d.name;
