@@ -431,6 +431,53 @@ TEST_CASE("step mode: a wake-up K periods late commands zero for that tick, a la
     rig.runtime->stop();
 }
 
+TEST_CASE("step mode: a device unstable by late wake-ups alone is told so, with how many of "
+          "its misses started late, and one unstable by slow ticks is not") {
+    SECTION("short ticks, five wake-ups two periods late") {
+        Rig rig(1, 1000.0);
+        rig.start();
+        rig.runTo(100.0);
+        for (int k = 0; k < 5; ++k) {
+            const std::uint64_t deadline = rig.runtime->nextDeadlineNs(0);
+            REQUIRE(rig.runtime->step(0, deadline + 2 * kMs));
+            rig.runtime->runUntil(deadline + 200 * kMs);
+        }
+        rig.runtime->stop();
+        const DeviceReport d = rig.report(0);
+        REQUIRE(d.missedDeadlines == 5);
+        REQUIRE(d.ticks > 1000);
+        REQUIRE(d.ticks < 2000); // so at most 1 tick may have taken its whole period
+        CHECK_FALSE(d.stable);
+        CHECK(d.loadFraction.p999 < 0.01); // the step mode's clock stands still in a tick
+        const std::string note = lateWakeupNote(d);
+        INFO(note);
+        CHECK(note.find("5 missed deadlines") == 0);
+        CHECK(note.find("at least 4 of them ticks shorter than their period that started "
+                        "late") != std::string::npos);
+        CHECK(note.find("the latest wake-up 2.00 ms after its deadline") != std::string::npos);
+    }
+    SECTION("ticks that take three periods") {
+        Rig rig(1, 1000.0,
+                [](int, ScriptedDevice& d) { d.inject(Inject::SlowTicks, 100, 3 * kMs, 200); });
+        rig.start();
+        rig.runTo(1000.0);
+        rig.runtime->stop();
+        const DeviceReport d = rig.report(0);
+        REQUIRE_FALSE(d.stable);
+        REQUIRE(d.missedDeadlines == 100);
+        CHECK(d.loadFraction.p999 >= 1.0);
+        CHECK(lateWakeupNote(d).empty());
+    }
+    SECTION("a stable device") {
+        Rig rig(1, 1000.0);
+        rig.start();
+        rig.runTo(500.0);
+        rig.runtime->stop();
+        REQUIRE(rig.report(0).stable);
+        CHECK(lateWakeupNote(rig.report(0)).empty());
+    }
+}
+
 TEST_CASE("step mode: a device whose thread cannot run is caught by the watchdog, gets zero "
           "when it runs again, is reopened, and the other device never notices") {
     RuntimeOptions opt;

@@ -217,6 +217,9 @@ int runDemo(const DemoArgs& a) {
                     d.name.c_str(), felt[i].squeezeSumN / n, felt[i].verticalSumN / n,
                     felt[i].maxForceN, 100 * d.loadFraction.p50, 100 * d.loadFraction.p999,
                     d.fault.empty() ? (d.stable ? "stable" : "UNSTABLE") : d.fault.c_str());
+        if (const std::string note = lateWakeupNote(d); !note.empty()) {
+            std::printf("         %s\n", note.c_str());
+        }
         devicesJson.push_back({{"name", d.name},
                                {"ticks", d.ticks},
                                {"squeeze_mean_n", felt[i].squeezeSumN / n},

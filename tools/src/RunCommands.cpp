@@ -64,6 +64,9 @@ void printSummary(const RunReport& r) {
         for (const std::string& e : d.events) {
             std::printf("  %s: %s\n", d.name.c_str(), e.c_str());
         }
+        if (const std::string note = lateWakeupNote(d); !note.empty()) {
+            std::printf("  %s: %s\n", d.name.c_str(), note.c_str());
+        }
     }
     std::printf(
         "total: load %.2f%% of one core summed over %zu devices, %.2f%% per core (%d cores); %s\n",

@@ -302,4 +302,12 @@ private:
 /// Renders a report as JSON text (the `hapto run --report` format). [control]
 std::string reportToJson(const RunReport& report);
 
+/// Why a device is unstable when its ticks were short and it missed too many deadlines: how
+/// many of the misses, at least, were ticks shorter than their period that started late, and
+/// the latest wake-up. At most 0.1 % of the ticks can have taken their whole period when the
+/// p99.9 load is below it, so the other misses woke too late: the operating system or the
+/// virtual machine did not run the servo thread on time. Empty when that does not apply
+/// (stable, faulted, or a p99.9 load of 90 % or more). [any thread]
+std::string lateWakeupNote(const DeviceReport& device);
+
 } // namespace hapto
