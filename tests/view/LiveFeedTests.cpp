@@ -103,6 +103,42 @@ TEST_CASE("a live frame carries each device's ticks, misses, load, point, force 
     runtime.stop();
 }
 
+TEST_CASE("a live frame gives the run report's late wake-up note for a device unstable by late "
+          "wake-ups alone, and none while it is stable") {
+    Session session("octree:2:0.005");
+    ManualClock& clock = session.clock;
+    Runtime& runtime = session.runtime;
+    const std::uint64_t t0 = clock.nowNs();
+    REQUIRE(runtime.startStepped(clock) == 2);
+    runtime.runUntil(t0 + 100'000'000);
+    const auto before = nlohmann::json::parse(session.feed.frame(100'000'000));
+    for (std::size_t i = 0; i < 2; ++i) {
+        REQUIRE(runtime.report().devices[i].stable);
+        CHECK_FALSE(before["devices"][i].contains("note"));
+    }
+    // Device 0 wakes two periods late five times in about 1.1 s (the step mode's one clock
+    // jumps, so device 1's next tick is late as well): 5 misses in ~1100 ticks.
+    for (int k = 0; k < 5; ++k) {
+        const std::uint64_t deadline = runtime.nextDeadlineNs(0);
+        REQUIRE(runtime.step(0, deadline + 2'000'000));
+        runtime.runUntil(deadline + 200'000'000);
+    }
+    const auto frame = nlohmann::json::parse(session.feed.frame(clock.nowNs() - t0));
+    const RunReport report = runtime.report();
+    REQUIRE(report.devices[0].missedDeadlines == 5);
+    REQUIRE_FALSE(lateWakeupNote(report.devices[0]).empty());
+    for (std::size_t i = 0; i < 2; ++i) {
+        INFO(report.devices[i].name);
+        const std::string note = lateWakeupNote(report.devices[i]);
+        CHECK(frame["devices"][i]["verdict"] == (report.devices[i].stable ? "stable" : "UNSTABLE"));
+        CHECK(frame["devices"][i].contains("note") == !note.empty());
+        if (!note.empty()) {
+            CHECK(frame["devices"][i]["note"] == note);
+        }
+    }
+    runtime.stop();
+}
+
 TEST_CASE("a live frame shows each device's cursor leaf: the box holding its point and the "
           "objects the leaf lists, as a fresh locate in the same snapshot gives them") {
     Session session("octree:4:0.005");

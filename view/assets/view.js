@@ -136,7 +136,8 @@ function makeDevice(world, d, i) {
   row.className = 'device';
   row.dataset.device = d.name;
   row.innerHTML =
-    '<span class="name"></span> <span data-field="verdict"></span><br>' +
+    '<span class="name"></span> <span data-field="verdict"></span>' +
+    ' <span data-field="why" class="why"></span><br>' +
     '|F| <span data-field="forceN">-</span> N &middot; ticks <span data-field="ticks">0</span>' +
     ' &middot; misses <span data-field="misses">0</span><br>' +
     'load p50 <span data-field="loadP50">-</span> % &middot; p99.9 ' +
@@ -189,6 +190,11 @@ function showDevice(dev, f, touched) {
     const v = dev.row.querySelector('[data-field="verdict"]');
     v.textContent = f.verdict;
     v.className = f.verdict === 'stable' ? 'stable' : f.verdict.startsWith('FAULT') ? 'fault' : 'unstable';
+    // Unstable by late wake-ups while the ticks stayed short (the run report's note, whole
+    // on hover): the machine's scheduling, not the tick.
+    const why = dev.row.querySelector('[data-field="why"]');
+    why.textContent = f.note ? 'late wake-ups' : '';
+    why.title = f.note || '';
   }
 }
 

@@ -134,8 +134,8 @@ std::string LiveFeed::frame(std::uint64_t sessionNs) {
                 : 0.0;
         const FaultKind fault = m.fault.load(std::memory_order_relaxed);
         const double periodNs = 1e9 / mDevices[i].rateHz;
-        const bool stable = fault == FaultKind::None && m.tickNs.summary().p999 / periodNs < 1.0 &&
-                            misses * 1000 <= ticks;
+        const double p999 = m.tickNs.summary().p999 / periodNs;
+        const bool stable = fault == FaultKind::None && p999 < 1.0 && misses * 1000 <= ticks;
         nlohmann::json d{{"name", mDevices[i].name},
                          {"ticks", ticks},
                          {"misses", misses},
@@ -147,6 +147,18 @@ std::string LiveFeed::frame(std::uint64_t sessionNs) {
                                          ? std::string("FAULT ") + faultName(fault)
                                      : stable ? "stable"
                                               : "UNSTABLE"}};
+        // Why it is unstable when its ticks stayed short: the run report's note, over the run
+        // so far (the fields lateWakeupNote reads).
+        DeviceReport sofar;
+        sofar.ticks = ticks;
+        sofar.missedDeadlines = misses;
+        sofar.loadFraction.p999 = p999;
+        sofar.latenessNs = m.latenessNs.summary();
+        sofar.fault = fault != FaultKind::None ? faultName(fault) : "";
+        sofar.stable = stable;
+        if (std::string note = lateWakeupNote(sofar); !note.empty()) {
+            d["note"] = std::move(note);
+        }
         ContactReport c;
         if (mRuntime.contact(i, c)) {
             nlohmann::json contacts = nlohmann::json::array();
