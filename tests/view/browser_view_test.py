@@ -5,7 +5,9 @@ and `hapto view` playing that session's recording.
     browser_view_test.py HAPTO CHROMIUM WORKDIR
 
 Live: the page's 3-D canvas is drawn (a screenshot, not blank, with the scene's objects in its
-colours and each hand's marker in its device colour); the values it shows change as the session runs (its first and its last frame differ)
+colours, each hand's marker in its device colour, and what the hands touch or their leaves list
+in the highlight colours); the values it shows change as the session runs (its first and its
+last frame differ)
 and match the runtime's own report within tolerance (ticks, misses, time, load p50). Offline:
 the player moves through the recorded trace (two page loads, the later one further on).
 
@@ -198,6 +200,26 @@ def live(hapto, browser, workdir):
         for name, colour in (("left", (0x4F, 0xC3, 0xF7)), ("right", (0xFF, 0xB7, 0x4D))):
             marker = sum(1 for p in canvas if max(abs(p[k] - colour[k]) for k in range(3)) <= 24)
             check(marker >= 30, "%s's hand is in sight: %d pixels of its colour" % (name, marker))
+        # What the hands touch and what their leaves list (the "leaves" box is ticked by
+        # default), in the highlight colours, although it is inside the block: those objects
+        # are drawn over the others. Lit, the colours keep their channel ratios until a channel
+        # clips (white lights): view.js CONTACT_COLOR 0xff7043 (g/r 0.44, b/r 0.26) and
+        # LISTED_COLOR 0xd4c15a (0.91, 0.42); the grey objects, the background and the hands'
+        # colours are far from both.
+        named = [f for d in dom.devices.values()
+                 for f in (d.get("contacts", ""), d.get("leaf", ""))]
+        check(any("#" in f for f in named),
+              "at the end a hand touches an object or its leaf lists one (%s)" % "; ".join(named))
+
+        def highlight(p):
+            r, g, b = p[0], p[1], p[2]
+            if r < 80:
+                return False
+            return ((0.85 <= g / r <= 1.0 and 0.35 <= b / r <= 0.5) or
+                    (0.38 <= g / r <= 0.62 and 0.2 <= b / r <= 0.4))
+        shown = sum(1 for p in canvas if highlight(p))
+        check(shown >= 200,
+              "the touched and listed objects are in sight: %d pixels of their colours" % shown)
     return record, report
 
 

@@ -7,7 +7,7 @@ const OBJECT_COLOR = 0x8a96a8, CONTACT_COLOR = 0xff7043, MOVING_COLOR = 0x66bb6a
 const LISTED_COLOR = 0xd4c15a; // in a shown cursor leaf
 const HISTORY = 300; // chart samples (10 s at 30 Hz)
 
-const view = { objects: new Map(), devices: [], frames: 0, listed: new Set() };
+const view = { objects: new Map(), devices: [], frames: 0, listed: new Set(), depthCleared: false };
 
 function v3(a) { return new THREE.Vector3(a[0], a[1], a[2]); }
 
@@ -61,7 +61,11 @@ function setupScene(scene) {
   view.redraw = () => {
     if (pending) return;
     pending = true;
-    requestAnimationFrame(() => { pending = false; renderer.render(world, camera); });
+    requestAnimationFrame(() => {
+      pending = false;
+      view.depthCleared = false;
+      renderer.render(world, camera);
+    });
   };
   controls.addEventListener('change', view.redraw);
   window.addEventListener('resize', () => {
@@ -103,6 +107,17 @@ function makeObject(o) {
   const mesh = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({ color: OBJECT_COLOR }));
   placeObject(mesh, o.center, o.rotation);
   return mesh;
+}
+
+function noop() {}
+
+// Called before each highlighted object is drawn (renderOrder 0.5: after every other object,
+// before the hands' markers); the first of them in a frame clears the depth buffer.
+function clearDepthOnce(renderer) {
+  if (view.depthCleared) return;
+  view.depthCleared = true;
+  renderer.state.buffers.depth.setMask(true); // a clear honours the depth write mask
+  renderer.clearDepth();
 }
 
 function placeObject(mesh, centre, q) {
@@ -246,6 +261,12 @@ function showFrame(frame, devices) {
   for (const [id, mesh] of view.objects) {
     mesh.material.color.setHex(touched.has(id) ? CONTACT_COLOR : moving.has(id) ? MOVING_COLOR
                                : view.listed.has(id) ? LISTED_COLOR : OBJECT_COLOR);
+    // An object in a highlight colour is drawn over the rest (after them, on a cleared depth
+    // buffer, so the highlighted ones still hide each other correctly): what a hand touches
+    // or its leaf lists is among the objects around it, inside the default scene's block.
+    const over = touched.has(id) || moving.has(id) || view.listed.has(id);
+    mesh.renderOrder = over ? 0.5 : 0;
+    mesh.onBeforeRender = over ? clearDepthOnce : noop;
   }
   view.frames++;
   if (view.redraw) view.redraw();
