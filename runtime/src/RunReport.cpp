@@ -181,6 +181,9 @@ std::string reportToJson(const RunReport& r) {
             {"realtime", d.realtime},
             {"stable", d.stable},
         });
+        if (std::string note = lateWakeupNote(d); !note.empty()) {
+            devices.back()["note"] = std::move(note); // what hapto run prints under the row
+        }
     }
     json total{{"load_sum", r.loadSum},
                {"load_per_core", r.loadPerCore},

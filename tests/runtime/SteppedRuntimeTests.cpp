@@ -455,6 +455,9 @@ TEST_CASE("step mode: a device unstable by late wake-ups alone is told so, with 
         CHECK(note.find("at least 4 of them ticks shorter than their period that started "
                         "late") != std::string::npos);
         CHECK(note.find("the latest wake-up 2.00 ms after its deadline") != std::string::npos);
+        // The --report JSON carries the same note.
+        const auto j = nlohmann::json::parse(reportToJson(rig.runtime->report()));
+        CHECK(j["devices"][0]["note"] == note);
     }
     SECTION("ticks that take three periods") {
         Rig rig(1, 1000.0,
@@ -467,6 +470,8 @@ TEST_CASE("step mode: a device unstable by late wake-ups alone is told so, with 
         REQUIRE(d.missedDeadlines == 100);
         CHECK(d.loadFraction.p999 >= 1.0);
         CHECK(lateWakeupNote(d).empty());
+        CHECK_FALSE(nlohmann::json::parse(reportToJson(rig.runtime->report()))["devices"][0]
+                        .contains("note"));
     }
     SECTION("a stable device") {
         Rig rig(1, 1000.0);
