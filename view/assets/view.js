@@ -7,7 +7,7 @@ const OBJECT_COLOR = 0x8a96a8, CONTACT_COLOR = 0xff7043, MOVING_COLOR = 0x66bb6a
 const LISTED_COLOR = 0xd4c15a; // in a shown cursor leaf
 const HISTORY = 300; // chart samples (10 s at 30 Hz)
 
-const view = { objects: new Map(), devices: [], frames: 0, listed: new Set(), depthCleared: false };
+const view = { objects: new Map(), devices: [], frames: 0, listed: new Set() };
 
 function v3(a) { return new THREE.Vector3(a[0], a[1], a[2]); }
 
@@ -40,7 +40,7 @@ function setupScene(scene) {
   world.add(bounds);
   for (const o of scene.objects) {
     const mesh = makeObject(o);
-    if (mesh) { world.add(mesh); view.objects.set(o.id, mesh); }
+    if (mesh) { addGhost(mesh); world.add(mesh); view.objects.set(o.id, mesh); }
   }
   scene.devices.forEach((d, i) => view.devices.push(makeDevice(world, d, i)));
   const boxed = (scene.meshes && scene.meshes.boxed) || [];
@@ -61,11 +61,7 @@ function setupScene(scene) {
   view.redraw = () => {
     if (pending) return;
     pending = true;
-    requestAnimationFrame(() => {
-      pending = false;
-      view.depthCleared = false;
-      renderer.render(world, camera);
-    });
+    requestAnimationFrame(() => { pending = false; renderer.render(world, camera); });
   };
   controls.addEventListener('change', view.redraw);
   window.addEventListener('resize', () => {
@@ -109,15 +105,19 @@ function makeObject(o) {
   return mesh;
 }
 
-function noop() {}
-
-// Called before each highlighted object is drawn (renderOrder 0.5: after every other object,
-// before the hands' markers); the first of them in a frame clears the depth buffer.
-function clearDepthOnce(renderer) {
-  if (view.depthCleared) return;
-  view.depthCleared = true;
-  renderer.state.buffers.depth.setMask(true); // a clear honours the depth write mask
-  renderer.clearDepth();
+// An object's ghost: the same geometry, unlit and half transparent, drawn without the depth
+// test after every solid object (three.js draws transparent objects after opaque ones; the
+// hands' markers, transparent at full opacity with renderOrder 1, come after the ghosts). A
+// child of the object, so it follows its pose; shown while the object is highlighted.
+function addGhost(object) {
+  const options = { transparent: true, opacity: 0.5, depthTest: false, depthWrite: false };
+  const ghost = object.isMesh
+    ? new THREE.Mesh(object.geometry, new THREE.MeshBasicMaterial(options))
+    : new THREE.LineSegments(object.geometry, new THREE.LineBasicMaterial(options));
+  ghost.visible = false;
+  ghost.renderOrder = 0.5;
+  object.add(ghost);
+  object.userData.ghost = ghost;
 }
 
 function placeObject(mesh, centre, q) {
@@ -136,14 +136,18 @@ function makeDevice(world, d, i) {
   // The device point's cursor leaf: the paper's idea made visible (the box the cursor caches
   // and the objects it hands to the renderer); shown when "leaves" is ticked.
   const leaf = new THREE.Box3Helper(new THREE.Box3(), color);
-  // Drawn over the objects, never hidden by them: a hand works among the objects (the default
-  // scene's hands are inside a block of 200 cubes), where a depth-tested marker is out of sight
-  // from every side.
+  // Drawn over the objects and their ghosts, never hidden by them: a hand works among the
+  // objects (the default scene's hands are inside a block of 200 cubes), where a depth-tested
+  // marker is out of sight from every side. Transparent at full opacity only to be drawn in
+  // three.js's second (transparent) list, after the ghosts.
   for (const o of [point, proxy, arrow, leaf]) {
     o.visible = false;
     o.traverse((part) => {
       part.renderOrder = 1;
-      if (part.material) part.material.depthTest = false;
+      if (part.material) {
+        part.material.depthTest = false;
+        part.material.transparent = true;
+      }
     });
     world.add(o);
   }
@@ -261,12 +265,12 @@ function showFrame(frame, devices) {
   for (const [id, mesh] of view.objects) {
     mesh.material.color.setHex(touched.has(id) ? CONTACT_COLOR : moving.has(id) ? MOVING_COLOR
                                : view.listed.has(id) ? LISTED_COLOR : OBJECT_COLOR);
-    // An object in a highlight colour is drawn over the rest (after them, on a cleared depth
-    // buffer, so the highlighted ones still hide each other correctly): what a hand touches
-    // or its leaf lists is among the objects around it, inside the default scene's block.
-    const over = touched.has(id) || moving.has(id) || view.listed.has(id);
-    mesh.renderOrder = over ? 0.5 : 0;
-    mesh.onBeforeRender = over ? clearDepthOnce : noop;
+    // An object in a highlight colour also shows through whatever hides it, as its ghost:
+    // what a hand touches or its leaf lists is among the objects around it (inside the
+    // default scene's block), and a touched floor must not hide what stands on it.
+    const ghost = mesh.userData.ghost;
+    ghost.visible = touched.has(id) || moving.has(id) || view.listed.has(id);
+    ghost.material.color.copy(mesh.material.color);
   }
   view.frames++;
   if (view.redraw) view.redraw();
