@@ -470,8 +470,9 @@ TEST_CASE("step mode: a device unstable by late wake-ups alone is told so, with 
         REQUIRE(d.missedDeadlines == 100);
         CHECK(d.loadFraction.p999 >= 1.0);
         CHECK(lateWakeupNote(d).empty());
-        CHECK_FALSE(nlohmann::json::parse(reportToJson(rig.runtime->report()))["devices"][0]
-                        .contains("note"));
+        CHECK_FALSE(
+            nlohmann::json::parse(reportToJson(rig.runtime->report()))["devices"][0].contains(
+                "note"));
     }
     SECTION("a stable device") {
         Rig rig(1, 1000.0);
