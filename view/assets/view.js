@@ -263,14 +263,15 @@ function showFrame(frame, devices) {
     if (p.moving) moving.add(p.id);
   }
   for (const [id, mesh] of view.objects) {
-    mesh.material.color.setHex(touched.has(id) ? CONTACT_COLOR : moving.has(id) ? MOVING_COLOR
-                               : view.listed.has(id) ? LISTED_COLOR : OBJECT_COLOR);
+    const highlight = touched.has(id) ? CONTACT_COLOR : moving.has(id) ? MOVING_COLOR
+                    : view.listed.has(id) ? LISTED_COLOR : null;
+    mesh.material.color.setHex(highlight === null ? OBJECT_COLOR : highlight);
     // An object in a highlight colour also shows through whatever hides it, as its ghost:
     // what a hand touches or its leaf lists is among the objects around it (inside the
     // default scene's block), and a touched floor must not hide what stands on it.
     const ghost = mesh.userData.ghost;
-    ghost.visible = touched.has(id) || moving.has(id) || view.listed.has(id);
-    ghost.material.color.copy(mesh.material.color);
+    ghost.visible = highlight !== null;
+    if (ghost.visible) ghost.material.color.setHex(highlight);
   }
   view.frames++;
   if (view.redraw) view.redraw();
