@@ -5,11 +5,11 @@ and `hapto view` playing that session's recording.
     browser_view_test.py HAPTO CHROMIUM WORKDIR
 
 Live: the page's 3-D canvas is drawn (a screenshot, not blank, with the scene's objects in its
-colours, each hand's marker in its device colour, and what the hands touch in sight through the
-objects that hide it); the values it shows change as the session runs (its first and its
-last frame differ) and match the runtime's own report within tolerance (ticks, misses, time,
-load p50). Offline: the player moves through the recorded trace (two page loads, the later one
-further on).
+colours, each hand's marker in its device colour, and what the hands touch or their leaves list
+in sight through the objects that hide it); the values it shows change as the session runs
+(its first and its last frame differ) and match the runtime's own report within tolerance
+(ticks, misses, time, load p50). Offline: the player moves through the recorded trace (two page
+loads, the later one further on).
 
 Chromium runs with a virtual-time budget: it loads the page, runs its scripts and waits for the
 network to go quiet; for the live page that is the end of the session, when the stream closes.
@@ -200,18 +200,29 @@ def live(hapto, browser, workdir):
         for name, colour in (("left", (0x4F, 0xC3, 0xF7)), ("right", (0xFF, 0xB7, 0x4D))):
             marker = sum(1 for p in canvas if max(abs(p[k] - colour[k]) for k in range(3)) <= 24)
             check(marker >= 30, "%s's hand is in sight: %d pixels of its colour" % (name, marker))
-        # What the hands touch, in sight although it is inside the block: a highlighted object
-        # also shows through what hides it, as a half-transparent ghost of its colour. Over
-        # the lit grey objects (view.js OBJECT_COLOR 0x8a96a8 x 0.45..1.25) the touched
-        # object's ghost (CONTACT_COLOR 0xff7043 at half opacity) has g/r 0.57..0.70 and b/r
-        # 0.45..0.65; the grey, the background and the hands' colours and their blends have
-        # g/r above 0.71 or b above r, and the lit solid orange g/r under 0.56.
-        touching = [d.get("contacts", "") for d in dom.devices.values()]
-        check(any("#" in t for t in touching),
-              "at the end a hand touches an object (%s)" % "; ".join(touching))
-        ghost = sum(1 for p in canvas
-                    if p[0] >= 120 and 0.56 <= p[1] / p[0] <= 0.705 and 0.4 <= p[2] / p[0] <= 0.68)
-        check(ghost >= 1000, "the touched objects are in sight: %d pixels of their ghosts" % ghost)
+        # What the hands touch and what their leaves list (the "leaves" box is ticked by
+        # default), in sight although it is inside the block: a highlighted object also shows
+        # through what hides it, as a half-transparent ghost of its colour. Over the lit grey
+        # objects (view.js OBJECT_COLOR 0x8a96a8 x 0.45..1.25) a touched object's ghost
+        # (CONTACT_COLOR 0xff7043 at half opacity) has g/r 0.57..0.70 and b/r 0.45..0.65, a
+        # listed one's (LISTED_COLOR 0xd4c15a) g/r 0.94..0.98 and b/r 0.60..0.74; the grey
+        # and the background have g/r above 1.08, the lit solid colours b/r under 0.45, and
+        # the hands' colours blend into these ranges only along their edges. Which objects are
+        # touched or listed at the end depends on where the hands are when the session stops
+        # (under AddressSanitizer one session ran 27 000 of its 30 000 ticks and ended touching
+        # nothing), so the check takes either.
+        named = [f for d in dom.devices.values()
+                 for f in (d.get("contacts", ""), d.get("leaf", ""))]
+        check(any("#" in f for f in named),
+              "at the end a hand touches an object or its leaf lists one (%s)" % "; ".join(named))
+
+        def ghost(p):
+            r, g, b = p[0], p[1], p[2]
+            return r >= 120 and ((0.56 <= g / r <= 0.705 and 0.4 <= b / r <= 0.68) or
+                                 (0.88 <= g / r <= 1.0 and 0.5 <= b / r <= 0.78))
+        shown = sum(1 for p in canvas if ghost(p))
+        check(shown >= 1000,
+              "the touched and listed objects are in sight: %d pixels of their ghosts" % shown)
     return record, report
 
 
