@@ -24,6 +24,14 @@
 //              device's and the proxy's).
 //   mesh-tick-slow  the same at 0.1 mm steps (0.1 m/s): a hand feeling the surface, which
 //              crosses a fifth as many facets per tick.
+//   mesh-tick-patch  like for like: the same tick along a short loop (the slide only +-2 mm
+//              about the pole), over the 10^6-triangle sphere's N triangles nearest the pole
+//              (N = 10^3 .. 10^5; the patch keeps the sphere's bounds, so the octree cuts its
+//              cells where it cuts the sphere's) and over the whole sphere ("whole"). The
+//              hand meets the same facets in every scene, so what changes with N is the index
+//              and the memory it spans, not the geometry; mesh-tick compares a coarse sphere
+//              with a fine one, whose facets are 32 times smaller. Counter patch_mm: how far
+//              the patch reaches from the axis through the pole (the loop: 2 mm).
 //
 //   hapto_bench --benchmark_filter='^mesh-' --benchmark_min_time=0.5
 
@@ -51,6 +59,7 @@
 #include <memory>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hapto::bench {
@@ -62,6 +71,9 @@ constexpr double kNearM = 0.002;      // r: "near" for the baselines
 constexpr double kStepM = 0.0005;     // path spacing: 0.5 m/s at 1 kHz
 constexpr double kSlowStepM = 0.0001; // mesh-tick-slow's: 0.1 m/s, a hand feeling a surface
 constexpr std::size_t kPathPoints = 4096;
+constexpr double kSlideRad = 0.3;            // the slide's reach about the pole: +-3 cm
+constexpr double kPatchSlideRad = 0.02;      // mesh-tick-patch's: +-2 mm
+constexpr std::size_t kFineSphere = 1000000; // mesh-tick-patch's sphere (about 10^6 triangles)
 
 /// The sphere scene of about n triangles, made once per n.
 const Scene& meshScene(std::size_t n) {
@@ -78,15 +90,15 @@ const Scene& meshScene(std::size_t n) {
 }
 
 /// A touch and slide on the sphere's top, as a loop: down the +z axis from 1 cm above the pole
-/// to kPressM inside, a slide along a wavy great circle through the pole (+-0.3 rad, back and
-/// forth) kPressM inside, and back out along the radius; `step` apart (kStepM unless given).
-const std::vector<Vec3>& slidePath(double step = kStepM) {
-    static std::map<double, std::vector<Vec3>> paths;
-    auto found = paths.find(step);
+/// to kPressM inside, a slide along a wavy great circle through the pole (+-`reach` rad, back
+/// and forth) kPressM inside, and back out along the radius; `step` apart.
+const std::vector<Vec3>& slidePath(double step = kStepM, double reach = kSlideRad) {
+    static std::map<std::pair<double, double>, std::vector<Vec3>> paths;
+    auto found = paths.find({step, reach});
     if (found != paths.end()) {
         return found->second;
     }
-    const std::vector<Vec3> path = [step] {
+    const std::vector<Vec3> path = [step, reach] {
         std::vector<Vec3> p;
         const double outside = 0.5 * kSphereSizeM + 0.01, inside = 0.5 * kSphereSizeM - kPressM;
         // A wavy line over the sphere, every point at distance r from its centre (kPressM
@@ -102,7 +114,7 @@ const std::vector<Vec3>& slidePath(double step = kStepM) {
         while (p.size() < kPathPoints) {
             p.push_back(onRadius(a, inside));
             a += dir * dA;
-            if (std::abs(a) > 0.3) {
+            if (std::abs(a) > reach) {
                 dir = -dir;
             }
         }
@@ -111,7 +123,7 @@ const std::vector<Vec3>& slidePath(double step = kStepM) {
         }
         return p;
     }();
-    return paths.emplace(step, path).first->second;
+    return paths.emplace(std::make_pair(step, reach), path).first->second;
 }
 
 IndexSpec meshSpec(bool grid) {
@@ -336,10 +348,62 @@ void buildMesh(benchmark::State& state, std::size_t n, int which) {
     state.counters["triangles"] = scene.triangleCount();
 }
 
-void tickMesh(benchmark::State& state, std::size_t n, bool grid, double step) {
-    World world(meshScene(n), meshSpec(grid));
+/// The fine sphere's n triangles nearest its pole, as a scene with the sphere's bounds (n = 0:
+/// the whole sphere); made once per n.
+const Scene& patchScene(std::size_t n) {
+    static std::map<std::size_t, Scene> scenes;
+    auto it = scenes.find(n);
+    if (it != scenes.end()) {
+        return it->second;
+    }
+    const Scene& sphere = meshScene(kFineSphere);
+    if (n == 0 || n >= sphere.triangleCount()) {
+        return scenes.emplace(n, sphere).first->second;
+    }
+    const TriangleMesh& mesh = *sphere.object(0).mesh;
+    const Vec3 pole(0.0, 0.0, 0.5 * kSphereSizeM);
+    // A triangle's distance from the pole: its farthest corner's.
+    const auto far = [&](std::uint32_t t) {
+        const auto c = mesh.corners(t);
+        return std::max(
+            {glm::distance(c[0], pole), glm::distance(c[1], pole), glm::distance(c[2], pole)});
+    };
+    std::vector<std::uint32_t> order(mesh.triangleCount());
+    for (std::uint32_t t = 0; t < order.size(); ++t) {
+        order[t] = t;
+    }
+    std::nth_element(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n), order.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return far(a) < far(b); });
+    order.resize(n);
+    std::sort(order.begin(), order.end()); // the sphere's order, so its memory layout
+    std::vector<Vec3> vertices;
+    std::vector<TriangleIndices> triangles;
+    std::map<std::uint32_t, std::uint32_t> renumber;
+    for (const std::uint32_t t : order) {
+        TriangleIndices out{};
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = mesh.triangles()[t][static_cast<std::size_t>(k)];
+            const auto [at, added] =
+                renumber.emplace(v, static_cast<std::uint32_t>(vertices.size()));
+            if (added) {
+                vertices.push_back(mesh.vertices()[v]);
+            }
+            out[static_cast<std::size_t>(k)] = at->second;
+        }
+        triangles.push_back(out);
+    }
+    std::vector<SceneObject> objects;
+    objects.push_back(makeMesh(
+        0, Vec3(0.0),
+        TriangleMesh::make(std::move(vertices), std::move(triangles), {}, "mesh-tick-patch"),
+        Quat(1, 0, 0, 0), sphere.object(0).material));
+    return scenes.emplace(n, Scene(sphere.bounds(), std::move(objects))).first->second;
+}
+
+void tickMesh(benchmark::State& state, const Scene& scene, bool grid,
+              const std::vector<Vec3>& path) {
+    World world(scene, meshSpec(grid));
     HapticTick tick;
-    const std::vector<Vec3>& path = slidePath(step);
     std::vector<double> ns;
     ns.reserve(1 << 20);
     std::size_t i = 0;
@@ -377,7 +441,7 @@ void tickMesh(benchmark::State& state, std::size_t n, bool grid, double step) {
     state.counters["passes"] = benchmark::Counter(passes, benchmark::Counter::kAvgIterations);
     state.counters["extra_leaves"] = benchmark::Counter(extra, benchmark::Counter::kAvgIterations);
     state.counters["solves"] = benchmark::Counter(solves, benchmark::Counter::kAvgIterations);
-    state.counters["triangles"] = meshScene(n).triangleCount();
+    state.counters["triangles"] = scene.triangleCount();
 }
 
 } // namespace
@@ -410,10 +474,29 @@ void registerMeshBenchmarks() {
         RegisterBenchmark(("mesh-near/" + sn + "hapto-grid").c_str(), nearHapto, n, true);
         RegisterBenchmark(("mesh-near/" + sn + "bullet-bvh").c_str(), nearBullet, n);
         RegisterBenchmark(("mesh-near/" + sn + "fcl-obbrss").c_str(), nearFcl, n);
-        RegisterBenchmark(("mesh-tick/" + sn + "hapto-octree").c_str(), tickMesh, n, false, kStepM)
+        RegisterBenchmark(
+            ("mesh-tick/" + sn + "hapto-octree").c_str(),
+            [n](benchmark::State& state) { tickMesh(state, meshScene(n), false, slidePath()); })
             ->UseManualTime();
-        RegisterBenchmark(("mesh-tick-slow/" + sn + "hapto-octree").c_str(), tickMesh, n, false,
-                          kSlowStepM)
+        RegisterBenchmark(("mesh-tick-slow/" + sn + "hapto-octree").c_str(),
+                          [n](benchmark::State& state) {
+                              tickMesh(state, meshScene(n), false, slidePath(kSlowStepM));
+                          })
+            ->UseManualTime();
+    }
+    for (const std::size_t n : {1000, 10000, 100000, 0}) {
+        const std::string name = n == 0 ? "whole" : std::to_string(n);
+        RegisterBenchmark(("mesh-tick-patch/sphere-1000000/" + name + "/hapto-octree").c_str(),
+                          [n](benchmark::State& state) {
+                              const Scene& scene = patchScene(n);
+                              tickMesh(state, scene, false, slidePath(kStepM, kPatchSlideRad));
+                              // How far the patch reaches from the pole's axis (mm).
+                              double reach = 0.0;
+                              for (const Vec3& v : scene.object(0).mesh->vertices()) {
+                                  reach = std::max(reach, std::hypot(v.x, v.y));
+                              }
+                              state.counters["patch_mm"] = 1e3 * reach;
+                          })
             ->UseManualTime();
     }
 }
