@@ -20,7 +20,7 @@ packages=(
   libtbb-dev libglm-dev libeigen3-dev catch2 libusb-1.0-0-dev libcli11-dev nlohmann-json3-dev
   gnuplot-nox libbenchmark-dev libbullet-dev libfcl-dev libboost-dev
   umockdev libumockdev-dev libglib2.0-dev libassimp-dev libsimdjson-dev
-  libcpp-httplib-dev libjs-three chromium python3
+  libcpp-httplib-dev libmeshoptimizer-dev libjs-three chromium python3
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -43,11 +43,18 @@ function setupScene(scene) {
     if (mesh) { addGhost(mesh); world.add(mesh); view.objects.set(o.id, mesh); }
   }
   scene.devices.forEach((d, i) => view.devices.push(makeDevice(world, d, i)));
+  // Past the page's triangle cap a mesh comes simplified (or, with no room left, as its box).
+  const simplified = (scene.meshes && scene.meshes.simplified) || [];
   const boxed = (scene.meshes && scene.meshes.boxed) || [];
-  if (boxed.length) {
+  if (simplified.length || boxed.length) {
+    const byId = new Map(scene.objects.map((o) => [o.id, o]));
+    const lines = simplified.map((id) => 'mesh #' + id + ' drawn simplified, ' +
+      byId.get(id).trianglesShown + ' of its ' + byId.get(id).triangleCount + ' triangles');
+    if (boxed.length) lines.push('mesh #' + boxed.join(', #') + ' drawn as its bounding box');
     const note = document.getElementById('meshnote');
-    note.textContent = 'mesh #' + boxed.join(', #') + ' drawn as its bounding box: over ' +
-      scene.meshes.maxTriangles + ' triangles per scene';
+    note.textContent = lines.join('; ') + ' (the page takes ' + scene.meshes.maxTriangles +
+      ' triangles per scene)';
+    note.dataset.simplified = simplified.join(',');
     note.dataset.boxed = boxed.join(',');
     note.style.display = 'block';
   }
@@ -88,7 +95,8 @@ function makeObject(o) {
     geometry.setIndex(o.triangles.flat());
     geometry.computeVertexNormals();
   } else if (o.shape === 'mesh' && o.localBounds) {
-    // Over the page's triangle cap: its bounding box in its own frame, as a wireframe.
+    // No room left under the page's triangle cap: its bounding box in its own frame, as a
+    // wireframe.
     const lo = v3(o.localBounds.min), hi = v3(o.localBounds.max);
     const size = hi.clone().sub(lo), mid = lo.clone().add(hi).multiplyScalar(0.5);
     const box = new THREE.BoxBufferGeometry(size.x, size.y, size.z);

@@ -5,9 +5,14 @@
 #include "hapto/scenes/TriangleMesh.h"
 #include "hapto/view/LoadWindow.h"
 
+#include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <vector>
 
 namespace hapto {
@@ -34,14 +39,135 @@ nlohmann::json containing(const Scene& scene, const Vec3& p) {
     return ids;
 }
 
+// A mesh as the page takes it: flat vertices (m, its own frame) and flat triangles.
+struct PageMesh {
+    std::vector<double> vertices;
+    std::vector<std::uint32_t> triangles;
+};
+
+// The whole mesh, exactly as held.
+PageMesh wholeMesh(const TriangleMesh& mesh) {
+    PageMesh out;
+    out.vertices.reserve(3 * mesh.vertices().size());
+    for (const Vec3& v : mesh.vertices()) {
+        out.vertices.insert(out.vertices.end(), {v.x, v.y, v.z});
+    }
+    out.triangles.reserve(3 * mesh.triangles().size());
+    for (const TriangleIndices& t : mesh.triangles()) {
+        out.triangles.insert(out.triangles.end(), t.begin(), t.end());
+    }
+    return out;
+}
+
+// The mesh simplified by meshoptimizer to at most `budget` triangles, over the vertices it
+// keeps (their original positions, renumbered); empty when it cannot be brought that low.
+// meshopt_simplify collapses edges while keeping the surface's look; where the mesh's borders
+// or seams stop it above the budget, meshopt_simplifySloppy (a vertex grid) takes over.
+// meshoptimizer 0.18 checks each collapse against the triangle just before it, not the original
+// surface (simplifier.cpp, hasTriangleFlip: "does triangle ABC flip when C is replaced with
+// D?", a sign test), so after many collapses some triangles face inwards (5 % of them, 2 %
+// of the area, for a 10^6-triangle sphere brought to 2 x 10^5), drawn as dark specks; each
+// kept triangle is therefore turned, if need be, to face the way the original surface faces
+// at its corners (the vertex normals: the sum of the area-weighted normals of the faces there).
+PageMesh simplifiedMesh(const TriangleMesh& mesh, std::uint64_t budget) {
+    if (budget == 0) {
+        return {};
+    }
+    std::vector<unsigned int> indices;
+    indices.reserve(3 * mesh.triangles().size());
+    for (const TriangleIndices& t : mesh.triangles()) {
+        indices.insert(indices.end(), t.begin(), t.end());
+    }
+    std::vector<float> positions;
+    positions.reserve(3 * mesh.vertices().size());
+    for (const Vec3& v : mesh.vertices()) {
+        positions.insert(positions.end(), {static_cast<float>(v.x), static_cast<float>(v.y),
+                                           static_cast<float>(v.z)});
+    }
+    const std::size_t target = 3 * static_cast<std::size_t>(budget);
+    // Any error is allowed (1 = the mesh's whole extent): the count is what limits.
+    constexpr float kAnyError = 1.0f;
+    std::vector<unsigned int> kept(indices.size());
+    std::size_t count =
+        meshopt_simplify(kept.data(), indices.data(), indices.size(), positions.data(),
+                         mesh.vertices().size(), 3 * sizeof(float), target, kAnyError, 0, nullptr);
+    if (count > target) {
+        count = meshopt_simplifySloppy(kept.data(), indices.data(), indices.size(),
+                                       positions.data(), mesh.vertices().size(), 3 * sizeof(float),
+                                       target, kAnyError, nullptr);
+    }
+    PageMesh out;
+    if (count == 0 || count > target) {
+        return out;
+    }
+    std::vector<Vec3> normals(mesh.vertices().size(), Vec3(0.0));
+    for (const TriangleIndices& t : mesh.triangles()) {
+        const auto c =
+            std::array{mesh.vertices()[t[0]], mesh.vertices()[t[1]], mesh.vertices()[t[2]]};
+        const Vec3 n = glm::cross(c[1] - c[0], c[2] - c[0]);
+        for (const std::uint32_t v : t) {
+            normals[v] += n;
+        }
+    }
+    for (std::size_t i = 0; i < count; i += 3) {
+        const Vec3& a = mesh.vertices()[kept[i]];
+        const Vec3 n =
+            glm::cross(mesh.vertices()[kept[i + 1]] - a, mesh.vertices()[kept[i + 2]] - a);
+        if (glm::dot(n, normals[kept[i]] + normals[kept[i + 1]] + normals[kept[i + 2]]) < 0.0) {
+            std::swap(kept[i + 1], kept[i + 2]);
+        }
+    }
+    constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> renumber(mesh.vertices().size(), kUnused);
+    out.triangles.reserve(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        std::uint32_t& to = renumber[kept[i]];
+        if (to == kUnused) {
+            to = static_cast<std::uint32_t>(out.vertices.size() / 3);
+            const Vec3& v = mesh.vertices()[kept[i]];
+            out.vertices.insert(out.vertices.end(), {v.x, v.y, v.z});
+        }
+        out.triangles.push_back(to);
+    }
+    return out;
+}
+
 } // namespace
 
 std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& devices, ViewMode mode,
                           std::uint64_t maxMeshTriangles) {
+    // Meshes that fit the cap in slot order go whole; those that do not share what is left,
+    // in ascending size, each at most an even share of the rest, simplified to it.
+    const std::span<const SceneObject> all = scene.objects();
+    std::vector<PageMesh> pageMeshes(all.size());
+    std::vector<std::size_t> over; // slots of the meshes that did not fit whole
+    std::uint64_t sent = 0;        // mesh triangles sent
+    for (std::size_t i = 0; i < all.size(); ++i) {
+        if (all[i].shape != Shape::Mesh || !all[i].mesh) {
+            continue;
+        }
+        if (sent + all[i].mesh->triangleCount() <= maxMeshTriangles) {
+            sent += all[i].mesh->triangleCount();
+            pageMeshes[i] = wholeMesh(*all[i].mesh);
+        } else {
+            over.push_back(i);
+        }
+    }
+    std::stable_sort(over.begin(), over.end(), [&](std::size_t a, std::size_t b) {
+        return all[a].mesh->triangleCount() < all[b].mesh->triangleCount();
+    });
+    nlohmann::json simplified = nlohmann::json::array();
+    for (std::size_t k = 0; k < over.size(); ++k) {
+        const std::uint64_t share = (maxMeshTriangles - sent) / (over.size() - k);
+        PageMesh m = simplifiedMesh(*all[over[k]].mesh, share);
+        sent += m.triangles.size() / 3;
+        pageMeshes[over[k]] = std::move(m);
+    }
+
     nlohmann::json objects = nlohmann::json::array();
     nlohmann::json boxed = nlohmann::json::array();
-    std::uint64_t sent = 0; // mesh triangles sent so far, in slot order
-    for (const SceneObject& o : scene.objects()) {
+    for (std::size_t i = 0; i < all.size(); ++i) {
+        const SceneObject& o = all[i];
         nlohmann::json object{{"id", o.id},
                               {"shape", std::string(shapeName(o.shape))},
                               {"center", vec(o.center)},
@@ -50,23 +176,17 @@ std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& dev
         if (o.shape == Shape::Mesh && o.mesh) {
             const TriangleMesh& mesh = *o.mesh;
             object["triangleCount"] = mesh.triangleCount();
-            if (sent + mesh.triangleCount() <= maxMeshTriangles) {
-                sent += mesh.triangleCount();
+            PageMesh& m = pageMeshes[i];
+            if (!m.triangles.empty()) {
+                object["trianglesShown"] = m.triangles.size() / 3;
+                if (m.triangles.size() / 3 < mesh.triangleCount()) {
+                    simplified.push_back(o.id);
+                }
                 // Flat, in the object's own frame: x y z x y z ... and a b c a b c ...
-                std::vector<double> vertices;
-                vertices.reserve(3 * mesh.vertices().size());
-                for (const Vec3& v : mesh.vertices()) {
-                    vertices.insert(vertices.end(), {v.x, v.y, v.z});
-                }
-                std::vector<std::uint32_t> triangles;
-                triangles.reserve(3 * mesh.triangles().size());
-                for (const TriangleIndices& t : mesh.triangles()) {
-                    triangles.insert(triangles.end(), t.begin(), t.end());
-                }
-                object["vertices"] = std::move(vertices);
-                object["triangles"] = std::move(triangles);
+                object["vertices"] = std::move(m.vertices);
+                object["triangles"] = std::move(m.triangles);
             } else {
-                // Over the cap: its local bounding box, drawn as a wireframe.
+                // Not even simplified within the cap: its local bounding box, as a wireframe.
                 object["localBounds"] = {{"min", vec(mesh.localBounds().min)},
                                          {"max", vec(mesh.localBounds().max)}};
                 boxed.push_back(o.id);
@@ -82,7 +202,11 @@ std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& dev
         {"mode", mode == ViewMode::Live ? "live" : "trace"},
         {"bounds", {{"min", vec(scene.bounds().min)}, {"max", vec(scene.bounds().max)}}},
         {"objects", objects},
-        {"meshes", {{"maxTriangles", maxMeshTriangles}, {"trianglesSent", sent}, {"boxed", boxed}}},
+        {"meshes",
+         {{"maxTriangles", maxMeshTriangles},
+          {"trianglesSent", sent},
+          {"simplified", simplified},
+          {"boxed", boxed}}},
         {"devices", devs}};
     return doc.dump();
 }

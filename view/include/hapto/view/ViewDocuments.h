@@ -21,15 +21,18 @@ struct ViewDevice {
 };
 
 /// At most this many mesh triangles per scene go to the page (about 10 MB of JSON); a mesh
-/// beyond it is drawn as its bounding box.
+/// beyond it is simplified to its share.
 inline constexpr std::uint64_t kViewMaxMeshTriangles = 200'000;
 
 /// The scene for the page: bounds, every object (centre, half extents, rotation (w, x, y, z))
-/// and the devices and the mode. A mesh object also carries `triangleCount` and, while the
-/// scene's running total (in slot order) stays within `maxMeshTriangles`, its `vertices` (flat
-/// x y z ..., m, in its own frame) and `triangles` (flat a b c ..., CCW from outside); a mesh
-/// beyond the cap carries its `localBounds` (min, max) instead and is listed in
-/// `meshes.boxed`. [control]
+/// and the devices and the mode. A mesh object also carries `triangleCount` and, as
+/// `vertices` (flat x y z ..., m, in its own frame) and `triangles` (flat a b c ..., CCW from
+/// outside, `trianglesShown` of them), either the whole mesh, while the scene's running total
+/// in slot order stays within `maxMeshTriangles`, or, for the meshes past that, the mesh
+/// simplified by meshoptimizer to an even share of what the cap leaves (the smaller meshes
+/// first; listed in `meshes.simplified`). A mesh that cannot be simplified within its share
+/// carries its `localBounds` (min, max) instead and is listed in `meshes.boxed`. Simplifying a
+/// 10^6-triangle mesh takes about a second. [control]
 std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& devices, ViewMode mode,
                           std::uint64_t maxMeshTriangles = kViewMaxMeshTriangles);
 
