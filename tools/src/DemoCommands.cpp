@@ -33,7 +33,7 @@ struct DemoArgs {
     std::string scene;
     std::string devices;
     std::string report;
-    std::string index = "octree:2:0.005";
+    std::string index; ///< Empty: defaultIndexSpec(scene).
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
     ObjectId object = 0;
     bool realtime = false;
@@ -87,7 +87,8 @@ int runDemo(const DemoArgs& a) {
     }
     useTraceSettings(configs);
     checkSessionFiles({a.scene, a.devices, a.report, ""}, configs);
-    World world(shared, IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb));
+    World world(shared, IndexSpec::parse(a.index.empty() ? defaultIndexSpec(scene) : a.index)
+                            .withMaxMegabytes(a.maxIndexMb));
     std::vector<RuntimeDevice> devices;
     std::vector<SimDevice*> sims;
     for (const DeviceConfig& c : configs) {
@@ -276,7 +277,7 @@ void addDemoCommands(CLI::App& app) {
     cmd->add_option("--object", a->object, "Id of the object to grasp")
         ->capture_default_str()
         ->check(finiteRange(0, kMaxObjectId));
-    cmd->add_option("--index", a->index, "Spatial index SPEC")->capture_default_str();
+    addIndexOption(cmd, a->index);
     addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--report", a->report, "Write a JSON report here");
     addRealtimeFlag(cmd, a->realtime, "default: do not, the demo shares the machine");

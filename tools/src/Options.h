@@ -1,6 +1,8 @@
 #pragma once
 /// The one check every numeric command-line option goes through: a finite number in a range.
 
+#include "hapto/scenes/Scene.h"
+
 #include <CLI/CLI.hpp>
 
 #include <cstddef>
@@ -42,8 +44,14 @@ CLI::Option* addNumberListOption(CLI::App* cmd, const std::string& name,
 /// `--realtime` and declined with `--no-realtime`. Old spellings stay as deprecated aliases.
 /// Adds `--realtime` and `--no-realtime` as one flag setting `realtime`. [control]
 CLI::Option* addRealtimeFlag(CLI::App* cmd, bool& realtime, const std::string& what);
-/// Adds `--index SPEC` (brute, grid:N, octree:M:MIN, optional :aabb), default shown. [control]
+/// Adds `--index SPEC` (brute, grid:N, octree:M:MIN, optional :aabb); left empty when not
+/// given, for defaultIndexSpec to choose. [control]
 CLI::Option* addIndexOption(CLI::App* cmd, std::string& spec);
+/// The index a session builds when `--index` is not given: the paper's octree:2:0.005 over
+/// boxes and spheres; over mesh triangles an octree of at most 8 items per leaf whose smallest
+/// leaf is the scene's median triangle's longest edge (two significant digits, within 0.1 to
+/// 5 mm), so that a leaf of a fine scan holds a few triangles rather than hundreds. [control]
+std::string defaultIndexSpec(const Scene& scene);
 /// Adds `--max-index-mb MB`, the most memory an index build may take. [control]
 CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes);
 /// Adds `--wake-latency-us US` (0 or more; unset leaves `us` at -1): a CPU wake-latency

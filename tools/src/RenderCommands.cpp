@@ -21,8 +21,10 @@
 #include <charconv>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hapto::cli {
@@ -31,7 +33,7 @@ namespace {
 struct RenderArgs {
     std::string scene;
     std::string path;
-    std::string index = "octree:2:0.005";
+    std::string index; ///< Empty: defaultIndexSpec(scene).
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
     double rateHz = 1000.0;
     std::string output;
@@ -58,13 +60,20 @@ void runRender(const RenderArgs& a) {
         refuseSameFile(a.output, "-o", a.path, "--path");
         checkOutputFile(a.output, "-o");
     }
-    const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
+    // A given spec is checked before any file is read; the default needs the scene.
+    std::optional<IndexSpec> given;
+    if (!a.index.empty()) {
+        given = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
+    }
     const std::vector<Vec3> path = readPoints(a.path, "path file");
     if (path.empty()) {
         throw InputError(a.path + ": no points; a path file holds one point x,y,z (m, world "
                                   "frame) per tick, e.g. 0,0.03,0");
     }
-    const World world(loadSceneOrDefault(a.scene), spec);
+    Scene scene = loadSceneOrDefault(a.scene);
+    const IndexSpec spec =
+        given ? *given : IndexSpec::parse(defaultIndexSpec(scene)).withMaxMegabytes(a.maxIndexMb);
+    const World world(std::move(scene), spec);
     const WorldSnapshot& snapshot = world.current();
 
     TextOutput out(a.output);

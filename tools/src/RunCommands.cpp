@@ -33,7 +33,7 @@ namespace {
 struct RunArgs {
     std::string scene;
     std::string devices;
-    std::string index = "octree:2:0.005";
+    std::string index; ///< Empty: defaultIndexSpec(scene).
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
     double rateHz = 0;
     double durationS = 5;
@@ -128,7 +128,8 @@ int runSession(const RunArgs& a) {
     // One copy of the scene: the world's first snapshot shares it with the devices and the view.
     const auto shared = std::make_shared<const Scene>(loadSceneOrDefault(a.scene));
     const Scene& scene = *shared;
-    const IndexSpec spec = IndexSpec::parse(a.index).withMaxMegabytes(a.maxIndexMb);
+    const IndexSpec spec = IndexSpec::parse(a.index.empty() ? defaultIndexSpec(scene) : a.index)
+                               .withMaxMegabytes(a.maxIndexMb);
     std::vector<DeviceConfig> configs =
         a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
     if (a.rateHz > 0) {

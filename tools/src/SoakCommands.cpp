@@ -26,12 +26,16 @@ int runSoakCommand(const SoakArgs& a) {
     experiments::checkSoakOptions(a);
     checkSessionFiles({a.scene, "", a.report, ""}, {});
     auto scene = std::make_shared<const Scene>(loadSceneOrDefault(a.scene));
+    SoakArgs options = a;
+    if (options.index.empty()) {
+        options.index = defaultIndexSpec(*scene);
+    }
     experiments::SoakControl control;
     control.stopRequested = [&signals] { return signals.requested(); };
     control.onRuntime = [&signals](Runtime& runtime) {
         signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
     };
-    return experiments::runSoak(std::move(scene), a, control);
+    return experiments::runSoak(std::move(scene), options, control);
 }
 
 } // namespace
@@ -60,6 +64,7 @@ void addSoakCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(100, 100000));
     cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
+    a->index.clear(); // not given: defaultIndexSpec over the scene
     addIndexOption(cmd, a->index);
     addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--fault-every", a->faultEveryS,
