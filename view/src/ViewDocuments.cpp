@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -101,11 +100,10 @@ PageMesh simplifiedMesh(const TriangleMesh& mesh, std::uint64_t budget) {
         return out;
     }
     std::vector<Vec3> normals(mesh.vertices().size(), Vec3(0.0));
-    for (const TriangleIndices& t : mesh.triangles()) {
-        const auto c =
-            std::array{mesh.vertices()[t[0]], mesh.vertices()[t[1]], mesh.vertices()[t[2]]};
-        const Vec3 n = glm::cross(c[1] - c[0], c[2] - c[0]);
-        for (const std::uint32_t v : t) {
+    for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) {
+        const auto [p, q, r] = mesh.corners(t);
+        const Vec3 n = glm::cross(q - p, r - p);
+        for (const std::uint32_t v : mesh.triangles()[t]) {
             normals[v] += n;
         }
     }
