@@ -41,3 +41,35 @@ TEST_CASE("makeHandWalk gives the same positions as stepping a walk of the same 
     }
     CHECK(stepped == once);
 }
+
+TEST_CASE("a held-back hand stays where it was held, slides along the wall and keeps hand speed") {
+    // A wall at x = 0.06 that the hand feels: every step past it is held back onto it.
+    const Aabb box{Vec3(0.0), Vec3(0.1)};
+    experiments::HandWalk walk(box, 5);
+    Vec3 previous = walk.position();
+    int held = 0;
+    double slidAlongWall = 0.0;
+    bool wasHeld = false;
+    for (int i = 0; i < 20000; ++i) {
+        Vec3 p = walk.next();
+        REQUIRE(glm::length(p - previous) <= 0.5 * 1e-3 * (1.0 + 1e-12));
+        if (p.x > 0.06) {
+            walk.holdBack(Vec3(0.06, p.y, p.z));
+            REQUIRE(walk.position() == Vec3(0.06, p.y, p.z));
+            if (wasHeld) {
+                slidAlongWall += glm::length(Vec3(0.0, p.y - previous.y, p.z - previous.z));
+            }
+            p = walk.position();
+            ++held;
+            wasHeld = true;
+        } else {
+            wasHeld = false;
+        }
+        previous = p;
+    }
+    CHECK(held >= 20);            // 50 with this seed
+    CHECK(slidAlongWall > 0.001); // pressed against the wall it still moves along it (4 mm)
+    // Held back outside the box: the position stays in the box.
+    walk.holdBack(Vec3(0.2, -0.1, 0.05));
+    CHECK(walk.position() == Vec3(0.1, 0.0, 0.05));
+}

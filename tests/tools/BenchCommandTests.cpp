@@ -302,6 +302,34 @@ TEST_CASE("hapto bench tick --walk-edge keeps the walk in a cube about the scene
     checkTickEntry(inner[0], 50);
 }
 
+TEST_CASE("hapto bench tick --push-mm holds the walking hand back near the proxy") {
+    // 10^3 cubes of 2 mm filling half of a 2.5 cm cube: the hand walks into them all the time.
+    test::TempDir dir;
+    const std::string scene = (dir / "dense.json").string();
+    REQUIRE(test::runHapto("scene random --count 1000 --seed 1 --size 0.002 --workspace 0.025 -o " +
+                           scene)
+                .exitCode == 0);
+    const std::string args = "--scene " + scene + " --ticks 300 --sleep-us 50";
+    const json held = runTickJson(dir, args); // the default: 2 mm
+    const json through = runTickJson(dir, args + " --push-mm 0");
+    for (const json* j : {&held, &through}) {
+        REQUIRE(j->size() == 3);
+        for (const json& e : *j) {
+            checkTickEntry(e, 300);
+            CHECK(e["solves_mean"].get<double>() >= 1.0);
+            CHECK(e["extra_leaves_mean"].get<double>() >= 0.0);
+            CHECK(e["pull_backs_mean"].get<double>() >= 0.0);
+            CHECK(e["gap_m"]["p50"].get<double>() <= e["gap_m"]["p99"].get<double>());
+            CHECK(e["gap_m"]["p99"].get<double>() <= e["gap_m"]["p999"].get<double>());
+        }
+    }
+    // Held back to 2 mm from the proxy after each tick, the hand is at most one walk step
+    // (0.5 mm) further at the next; walking through, it leaves the proxy far behind.
+    CHECK(held[0]["contact_fraction"].get<double>() > 0.1);
+    CHECK(held[0]["gap_m"]["p999"].get<double>() <= 0.0025 + 1e-9);
+    CHECK(through[0]["gap_m"]["p99"].get<double>() > 0.005);
+}
+
 TEST_CASE("hapto bench tick refuses bad options with exit code 2 and writes nothing") {
     test::TempDir dir;
     const std::string out = (dir / "tick.json").string();
@@ -332,6 +360,14 @@ TEST_CASE("hapto bench tick refuses bad options with exit code 2 and writes noth
                                           " --json " + out);
             CHECK(r.exitCode == 2);
             CHECK_THAT(r.output, Catch::Contains("--walk-edge"));
+        }
+    }
+    SECTION("a negative or non-finite push") {
+        for (const char* push : {"-1", "nan", "inf"}) {
+            const auto r = test::runHapto(std::string("bench tick --ticks 10 --push-mm ") + push +
+                                          " --json " + out);
+            CHECK(r.exitCode == 2);
+            CHECK_THAT(r.output, Catch::Contains("--push-mm"));
         }
     }
     SECTION("an unknown index") {

@@ -274,6 +274,7 @@ public:
         return DeviceStatus::Ok;
     }
     std::string errorMessage() const override { return {}; }
+    experiments::HandWalk& walk() { return mWalk; }
 
 private:
     experiments::HandWalk mWalk;
@@ -302,6 +303,7 @@ struct TickRun {
     bool holdLatency = false; // hold --wake-latency-us while it ticks
     std::unique_ptr<Device> device;
     std::unique_ptr<experiments::HandWalk> walk; // the point, when the device is a sim hand
+    experiments::HandWalk* hand = nullptr;       // the walk either way (held back near the proxy)
     std::unique_ptr<TickPieces> pieces;
     std::unique_ptr<DeviceMetrics> metrics;
     std::unique_ptr<Mailbox<ContactReport>> contacts;
@@ -309,7 +311,9 @@ struct TickRun {
     std::array<std::vector<double>, kStageCount> stageNs;
     std::vector<double> tickNs;
     std::uint64_t ticks = 0, locateSteps = 0, candidates = 0, contactTicks = 0;
-    std::uint64_t kept = 0; // what the warm-up read, kept
+    std::uint64_t solves = 0, extraLeaves = 0, pullBacks = 0; // HapticTick's, summed
+    std::vector<double> gapM; ///< Per tick: the device point's distance from the proxy (m).
+    std::uint64_t kept = 0;   // what the warm-up read, kept
     /// Warm-ups still running at their deadline: those ticks started late by the overrun,
     /// which the tick's time (from the wake-up) does not show.
     std::uint64_t warmOverruns = 0;
@@ -333,7 +337,10 @@ struct TickArgs {
     double sleepUs = 1000;
     double warmUs = static_cast<double>(kDefaultWarmUpNs) / 1000.0;
     std::uint64_t seed = 1;
-    double walkEdgeM = 0.0;          ///< 0: the walk roams the scene's bounds
+    double walkEdgeM = 0.0; ///< 0: the walk roams the scene's bounds
+    /// After each tick the hand is held back to at most this far from the proxy (mm); 0: it
+    /// ignores the force and walks through everything, leaving the proxy behind.
+    double pushMm = 2.0;
     std::int32_t wakeLatencyUs = -1; ///< >= 0: also the sleep modes with this request held
     std::string json;
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
@@ -354,7 +361,8 @@ Aabb walkBox(const Aabb& bounds, double edgeM) {
 /// (its own five stages: locate, candidates, render with the walk and re-solves, effects,
 /// safety), write, metrics. The stage boundaries are steady clock readings (`wake` is the
 /// first).
-void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs, double dtS) {
+void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs, double dtS,
+               double pushM) {
     TickPieces& t = *run.pieces;
     std::array<std::uint64_t, kStageCount + 1> stamp{};
     stamp[0] = wakeNs;
@@ -423,6 +431,16 @@ void timedTick(TickRun& run, World& world, std::size_t at, std::uint64_t wakeNs,
     run.locateSteps += tick.locateSteps;
     run.candidates += out.objectsTested;
     run.contactTicks += out.contactCount > 0 ? 1 : 0;
+    run.solves += tick.solves;
+    run.extraLeaves += tick.extraLeaves;
+    run.pullBacks += tick.pullBacks;
+    const double gap = glm::length(p - out.proxy);
+    run.gapM[at] = gap;
+    // A hand that feels the force: it is never more than --push-mm from the proxy (beyond the
+    // proxy only where a surface holds it back).
+    if (pushM > 0.0 && gap > pushM) {
+        run.hand->holdBack(out.proxy + (pushM / gap) * (p - out.proxy));
+    }
 }
 
 /// "hot", "sleep", "sleep+warm", "sleep+lat", "sleep+warm+lat".
@@ -468,7 +486,7 @@ void driveTicks(TickRun& run, World& world, std::size_t at, std::size_t count,
                     static_cast<double>(wake > deadline ? wake - deadline : 0));
             }
         }
-        timedTick(run, world, k, wake, dtS);
+        timedTick(run, world, k, wake, dtS, args.pushMm * 1e-3);
     }
 }
 
@@ -495,6 +513,12 @@ Quantiles quantilesOf(std::vector<double> ns) {
 
 nlohmann::ordered_json toJson(const Quantiles& q) {
     return {{"ns_p50", q.p50}, {"ns_p99", q.p99}, {"ns_p999", q.p999}, {"ns_mean", q.mean}};
+}
+
+/// The device point's distance from the proxy over a run's ticks (m).
+nlohmann::ordered_json gapJson(const std::vector<double>& gapM) {
+    const Quantiles q = quantilesOf(gapM);
+    return {{"p50", q.p50}, {"p99", q.p99}, {"p999", q.p999}, {"mean", q.mean}};
 }
 
 void runTick(const TickArgs& args) {
@@ -544,8 +568,11 @@ void runTick(const TickArgs& args) {
                 c.name = "bench";
                 run->device = makeDevice(c, scene);
                 run->walk = std::make_unique<experiments::HandWalk>(walkIn, args.seed);
+                run->hand = run->walk.get();
             } else {
-                run->device = std::make_unique<WalkDevice>(walkIn, args.seed);
+                auto device = std::make_unique<WalkDevice>(walkIn, args.seed);
+                run->hand = &device->walk();
+                run->device = std::move(device);
             }
             if (run->device->open() != DeviceStatus::Ok) {
                 throw std::runtime_error("bench tick: the " + args.device +
@@ -559,6 +586,7 @@ void runTick(const TickArgs& args) {
                 s.assign(args.ticks, 0.0);
             }
             run->tickNs.assign(args.ticks, 0.0);
+            run->gapM.assign(args.ticks, 0.0);
             run->startLateNs.reserve(args.ticks); // filled in the sleep modes only
             target.runs.push_back(std::move(run));
         }
@@ -630,6 +658,16 @@ void runTick(const TickArgs& args) {
         }
         std::printf("\n");
         for (const auto& run : target.runs) {
+            const double n = static_cast<double>(run->ticks);
+            const Quantiles gap = quantilesOf(run->gapM);
+            std::printf("%-14s per tick: %.2f solves, %.2f extra leaves, %.3f pull-backs, %.1f "
+                        "candidates; device to proxy p50 %.2f mm, p99 %.2f mm\n",
+                        modeName(*run), static_cast<double>(run->solves) / n,
+                        static_cast<double>(run->extraLeaves) / n,
+                        static_cast<double>(run->pullBacks) / n,
+                        static_cast<double>(run->candidates) / n, gap.p50 * 1e3, gap.p99 * 1e3);
+        }
+        for (const auto& run : target.runs) {
             if (run->mode == TickMode::Warm) {
                 std::printf("%-12s warm-ups still running at their deadline: %llu of %llu\n",
                             modeName(*run), static_cast<unsigned long long>(run->warmOverruns),
@@ -658,6 +696,10 @@ void runTick(const TickArgs& args) {
                            {"locate_steps_mean", static_cast<double>(run.locateSteps) / n},
                            {"candidates_mean", static_cast<double>(run.candidates) / n},
                            {"contact_fraction", static_cast<double>(run.contactTicks) / n},
+                           {"solves_mean", static_cast<double>(run.solves) / n},
+                           {"extra_leaves_mean", static_cast<double>(run.extraLeaves) / n},
+                           {"pull_backs_mean", static_cast<double>(run.pullBacks) / n},
+                           {"gap_m", gapJson(run.gapM)},
                            {"warm_overruns", run.warmOverruns},
                            {"start_late", toJson(quantilesOf(run.startLateNs))}});
             keep(run.kept);
@@ -755,6 +797,13 @@ void addBenchCommands(CLI::App& app) {
                      "(within the bounds), e.g. to walk the same neighbourhood of a small and a "
                      "large scene of equal density; default: the whole bounds")
         ->check(finiteRange(1e-6, 1e4));
+    tick->add_option("--push-mm", targs->pushMm,
+                     "After each tick the walking hand is held back to at most this far from "
+                     "the proxy (mm; 2 mm is 1.6 N at 800 N/m), as a hand that feels the force; "
+                     "0: it walks through everything, leaving the proxy behind (trapped in a "
+                     "dense scene, many cm away)")
+        ->capture_default_str()
+        ->check(finiteRange(0.0, 1e3));
     addWakeLatencyOption(tick, targs->wakeLatencyUs,
                          "the two sleep modes run again, as sleep+lat and sleep+warm+lat, "
                          "interleaved with the others (hapto run --wake-latency-us)");

@@ -68,6 +68,25 @@ public:
         return mPosition;
     }
 
+    /// A hand that feels the surface it pushes into: the position goes back to `to` (m, a
+    /// point on the segment from the current position toward where the surface holds the
+    /// hand, e.g. within a given distance of the god-object's proxy), clamped to the box, and
+    /// the velocity loses its component along the push (position - to), if it points that way:
+    /// the hand stops pushing in and keeps what it had along the surface. Consecutive
+    /// positions stay at most maxSpeedMPerS x tickS apart after the next step. [any thread]
+    void holdBack(const Vec3& to) {
+        const Vec3 push = mPosition - to;
+        const double length = glm::length(push);
+        mPosition = glm::clamp(to, mBox.min, mBox.max);
+        if (length > 0.0) {
+            const Vec3 n = push / length;
+            const double in = glm::dot(mVelocity, n);
+            if (in > 0.0) {
+                mVelocity -= in * n;
+            }
+        }
+    }
+
 private:
     Aabb mBox;
     HandWalkOptions mOptions;
