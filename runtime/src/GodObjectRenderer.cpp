@@ -874,6 +874,12 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
 RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& candidates,
                                        const Vec3& devicePosition, const Vec3& deviceVelocity,
                                        double dtSeconds) noexcept {
+    return update(scene, candidates, devicePosition, devicePosition, deviceVelocity, dtSeconds);
+}
+
+RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& candidates,
+                                       const Vec3& devicePosition, const Vec3& goal,
+                                       const Vec3& deviceVelocity, double dtSeconds) noexcept {
     RenderOutput out;
     ++mState.counters.ticks;
     mNearRadius = -1.0;
@@ -883,7 +889,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     mNearTriangles = false;
     mVisitedCount = 0;
     mVisitedSecond = 0;
-    if (!finite(devicePosition)) {
+    if (!finite(devicePosition) || !finite(goal)) {
         out.status = RenderStatus::NonFiniteInput;
         out.proxy = mState.proxy;
         ++mState.counters.nonFiniteInput;
@@ -906,7 +912,6 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     mState.hasLastDevice = true;
     visit(mState.proxy);
 
-    const Vec3 goal = devicePosition;
     Vec3 start = mState.proxy;
     std::uint32_t tested = 0;
     // Every point the proxy visits while solving toward g lies within |start - g| of g.
@@ -1009,11 +1014,12 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
         }
     }
 
-    // Contacts: planes the final proxy is on and the device point is behind.
+    // Contacts: planes the final proxy is on and the device point is behind (a goal short of
+    // the device point is behind every plane it is behind: it lies on the way to it).
     double stiffness = kInf;
     for (std::uint32_t i = 0; i < fin.planeCount && out.contactCount < kMaxContacts; ++i) {
         const Plane& pl = fin.planes[i];
-        const double depth = pl.offset - glm::dot(pl.normal, goal);
+        const double depth = pl.offset - glm::dot(pl.normal, devicePosition);
         const bool onPlane = stuck || glm::dot(pl.normal, fin.proxy) - pl.offset <= kOnM;
         if (depth <= 0.0 || !onPlane) {
             continue;
@@ -1025,7 +1031,7 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
 
     Vec3 force(0.0);
     if (out.contactCount > 0) {
-        force = stiffness * (fin.proxy - goal);
+        force = stiffness * (fin.proxy - devicePosition);
         const double magnitude = glm::length(force);
         if (mConfig.damping > 0.0 && magnitude > 0.0) {
             const Vec3 n = force / magnitude;

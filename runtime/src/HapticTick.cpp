@@ -199,17 +199,21 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
         ++out.solves;
     }
     // Out of room while the path still crosses a leaf no span lists (a very fast hand over
-    // very small leaves), or a walk that could not finish: the proxy must not move through space
-    // whose items the renderer has not seen. Solve again toward a goal pulled back from the device
-    // point toward the start, halving, until the path stays in listed leaves; the last try is the
-    // start itself (the proxy stays, no force this tick). The force is then the pulled-back goal's:
-    // weaker, never a fall through the surface.
+    // very small leaves, or a proxy trapped far behind a hand that pushed through), or a walk
+    // that could not finish: the proxy must not move through space whose items the renderer
+    // has not seen. Solve again with the proxy's motion held to a goal pulled back from the
+    // device point toward the start, halving, then a nudge of kNudgeM, until the path stays in
+    // listed leaves; the last try is the start itself (the proxy stays, no contact, no force).
+    // The contacts and the force are the device point's: the hand pushing in feels the surface
+    // as hard as ever, and the proxy never falls through it.
+    const double away = glm::length(p - from);
+    const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (p - from) : p;
     Vec3 goal = p;
     const std::span<const std::uint32_t> known(listed.data(), listedCount);
     for (int k = 0; !covered && k < kPullBacks; ++k) {
-        goal = k + 1 < kPullBacks ? from + 0.5 * (goal - from) : from;
+        goal = k + 2 < kPullBacks ? from + 0.5 * (goal - from) : k + 1 < kPullBacks ? nudge : from;
         mRenderer.restore(start);
-        out.render = mRenderer.update(*snapshot.scene, mCandidates, goal, v, dtS);
+        out.render = mRenderer.update(*snapshot.scene, mCandidates, p, goal, v, dtS);
         tested += out.render.objectsTested;
         ++out.pullBacks;
         ++out.solves;

@@ -117,6 +117,16 @@ public:
     RenderOutput update(const Scene& scene, const CandidateSet& candidates,
                         const Vec3& devicePosition, const Vec3& deviceVelocity,
                         double dtSeconds) noexcept;
+    /// The same tick with the proxy's motion held short: the proxy moves toward `goal` (m,
+    /// world; a point on the way from the proxy to the device point) instead of the device
+    /// point, and the contacts and the force are still taken at `devicePosition`: the planes
+    /// the proxy ends on that the device point is behind, force = k (proxy - device) - damping.
+    /// HapticTick pulls the goal back this way when the proxy's path to the device point
+    /// crosses more leaves than one tick can list, so a pulled-back tick moves the proxy less
+    /// but pushes as hard. With `goal` == `devicePosition` it is update() above. [servo]
+    RenderOutput update(const Scene& scene, const CandidateSet& candidates,
+                        const Vec3& devicePosition, const Vec3& goal, const Vec3& deviceVelocity,
+                        double dtSeconds) noexcept;
 
     /// The proxy position (m, world). [servo]
     const Vec3& proxy() const noexcept { return mState.proxy; }

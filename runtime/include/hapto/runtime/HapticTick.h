@@ -36,7 +36,8 @@ struct TickOutput {
                                   ///< (HapticTick::kExtraLeaves at most).
     /// Times the goal was pulled back toward the proxy's start because the proxy's path still
     /// crossed a leaf no span listed after kExtraLeaves (HapticTick::kPullBacks at most; the
-    /// last keeps the proxy where it was, with no force this tick).
+    /// contacts and force stay the device point's; only the last, which keeps the proxy where
+    /// it was, has no contact and no force).
     std::uint8_t pullBacks = 0;
     /// Times the renderer solved this tick: 1, plus one per leaf the solved proxy reached,
     /// plus one per pull-back.
@@ -68,9 +69,16 @@ public:
     /// Leaves the proxy may slide into in one tick, each solved again with its items
     /// (CandidateSet has a span for each: device, proxy, moving, and these).
     static constexpr std::size_t kExtraLeaves = CandidateSet::kMaxSpans - 3;
-    /// Goals pulled back (halving toward the proxy's start, then the start itself) when the
-    /// proxy's path crosses more unlisted leaves than kExtraLeaves.
-    static constexpr int kPullBacks = 4;
+    /// Goals pulled back when the proxy's path crosses more unlisted leaves than kExtraLeaves:
+    /// halving toward the proxy's start three times, then kNudgeM from the start toward the
+    /// device point, then the start itself. The proxy moves only toward the pulled-back goal;
+    /// the contacts and the force are taken at the device point (GodObjectRenderer::update
+    /// with a goal), so a pulled-back tick pushes as hard as a full one.
+    static constexpr int kPullBacks = 5;
+    /// The last pull-back but one moves the proxy at most this far (m): enough to meet the
+    /// surfaces it rests on that the device point is behind, so the tick keeps their contact
+    /// and force; 1 µm is inside the proxy's leaf unless it sits on the leaf's face.
+    static constexpr double kNudgeM = 1e-6;
 
     /// Checks both configurations; throws std::invalid_argument when one is invalid. [control]
     explicit HapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
