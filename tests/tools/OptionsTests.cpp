@@ -2,6 +2,7 @@
 // (tools/src/Options.h), in process.
 
 #include "Options.h"
+#include "hapto/scenes/InputError.h"
 
 #include <catch2/catch.hpp>
 
@@ -162,4 +163,9 @@ TEST_CASE("the default index is the paper's octree over boxes and spheres, and o
     // Clamped: within 0.1 mm and 5 mm.
     CHECK(defaultIndexSpec(Scene(bounds, {strip(1, 5, 1e-6)})) == "octree:8:0.0001");
     CHECK(defaultIndexSpec(Scene(bounds, {strip(1, 5, 0.1)})) == "octree:8:0.005");
+    // A session's index: the given spec, or the default when none is given; with its limit.
+    CHECK(sessionIndexSpec("", fine, 64).toString() == "octree:8:0.00042");
+    CHECK(sessionIndexSpec("grid:4", fine, 64).toString() == "grid:4");
+    CHECK(sessionIndexSpec("", fine, 64).maxBytes == 64u << 20);
+    CHECK_THROWS_AS(sessionIndexSpec("kdtree:3", fine, 64), hapto::InputError);
 }

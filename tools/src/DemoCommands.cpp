@@ -87,8 +87,7 @@ int runDemo(const DemoArgs& a) {
     }
     useTraceSettings(configs);
     checkSessionFiles({a.scene, a.devices, a.report, ""}, configs);
-    World world(shared, IndexSpec::parse(a.index.empty() ? defaultIndexSpec(scene) : a.index)
-                            .withMaxMegabytes(a.maxIndexMb));
+    World world(shared, sessionIndexSpec(a.index, scene, a.maxIndexMb));
     std::vector<RuntimeDevice> devices;
     std::vector<SimDevice*> sims;
     for (const DeviceConfig& c : configs) {

@@ -105,6 +105,12 @@ std::string defaultIndexSpec(const Scene& scene) {
     return spec;
 }
 
+IndexSpec sessionIndexSpec(const std::string& given, const Scene& scene,
+                           std::uint64_t maxMegabytes) {
+    return IndexSpec::parse(given.empty() ? defaultIndexSpec(scene) : given)
+        .withMaxMegabytes(maxMegabytes);
+}
+
 CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes) {
     return cmd
         ->add_option("--max-index-mb", megabytes,

@@ -1,6 +1,7 @@
 #pragma once
 /// The one check every numeric command-line option goes through: a finite number in a range.
 
+#include "hapto/index/IndexSpec.h"
 #include "hapto/scenes/Scene.h"
 
 #include <CLI/CLI.hpp>
@@ -52,6 +53,11 @@ CLI::Option* addIndexOption(CLI::App* cmd, std::string& spec);
 /// leaf is the scene's median triangle's longest edge (two significant digits, within 0.1 to
 /// 5 mm), so that a leaf of a fine scan holds a few triangles rather than hundreds. [control]
 std::string defaultIndexSpec(const Scene& scene);
+/// The index a session over `scene` builds: `given` (an `--index` text) or, when it is empty,
+/// defaultIndexSpec(scene); at most `maxMegabytes` (`--max-index-mb`). Throws InputError for a
+/// bad `given`. [control]
+IndexSpec sessionIndexSpec(const std::string& given, const Scene& scene,
+                           std::uint64_t maxMegabytes);
 /// Adds `--max-index-mb MB`, the most memory an index build may take. [control]
 CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes);
 /// Adds `--wake-latency-us US` (0 or more; unset leaves `us` at -1): a CPU wake-latency

@@ -71,8 +71,7 @@ void runRender(const RenderArgs& a) {
                                   "frame) per tick, e.g. 0,0.03,0");
     }
     Scene scene = loadSceneOrDefault(a.scene);
-    const IndexSpec spec =
-        given ? *given : IndexSpec::parse(defaultIndexSpec(scene)).withMaxMegabytes(a.maxIndexMb);
+    const IndexSpec spec = given ? *given : sessionIndexSpec({}, scene, a.maxIndexMb);
     const World world(std::move(scene), spec);
     const WorldSnapshot& snapshot = world.current();
 

@@ -128,8 +128,7 @@ int runSession(const RunArgs& a) {
     // One copy of the scene: the world's first snapshot shares it with the devices and the view.
     const auto shared = std::make_shared<const Scene>(loadSceneOrDefault(a.scene));
     const Scene& scene = *shared;
-    const IndexSpec spec = IndexSpec::parse(a.index.empty() ? defaultIndexSpec(scene) : a.index)
-                               .withMaxMegabytes(a.maxIndexMb);
+    const IndexSpec spec = sessionIndexSpec(a.index, scene, a.maxIndexMb);
     std::vector<DeviceConfig> configs =
         a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
     if (a.rateHz > 0) {
