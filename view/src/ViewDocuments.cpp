@@ -10,7 +10,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -44,6 +46,16 @@ struct PageMesh {
     std::vector<std::uint32_t> triangles;
 };
 
+// The mesh's triangles as one flat list of vertex indices, three per triangle.
+std::vector<std::uint32_t> flatTriangles(const TriangleMesh& mesh) {
+    std::vector<std::uint32_t> flat;
+    flat.reserve(3 * mesh.triangles().size());
+    for (const TriangleIndices& t : mesh.triangles()) {
+        flat.insert(flat.end(), t.begin(), t.end());
+    }
+    return flat;
+}
+
 // The whole mesh, exactly as held.
 PageMesh wholeMesh(const TriangleMesh& mesh) {
     PageMesh out;
@@ -51,10 +63,7 @@ PageMesh wholeMesh(const TriangleMesh& mesh) {
     for (const Vec3& v : mesh.vertices()) {
         out.vertices.insert(out.vertices.end(), {v.x, v.y, v.z});
     }
-    out.triangles.reserve(3 * mesh.triangles().size());
-    for (const TriangleIndices& t : mesh.triangles()) {
-        out.triangles.insert(out.triangles.end(), t.begin(), t.end());
-    }
+    out.triangles = flatTriangles(mesh);
     return out;
 }
 
@@ -72,11 +81,8 @@ PageMesh simplifiedMesh(const TriangleMesh& mesh, std::uint64_t budget) {
     if (budget == 0) {
         return {};
     }
-    std::vector<unsigned int> indices;
-    indices.reserve(3 * mesh.triangles().size());
-    for (const TriangleIndices& t : mesh.triangles()) {
-        indices.insert(indices.end(), t.begin(), t.end());
-    }
+    static_assert(std::is_same_v<std::uint32_t, unsigned int>, "meshoptimizer's index type");
+    const std::vector<std::uint32_t> indices = flatTriangles(mesh);
     std::vector<float> positions;
     positions.reserve(3 * mesh.vertices().size());
     for (const Vec3& v : mesh.vertices()) {

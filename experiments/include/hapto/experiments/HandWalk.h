@@ -7,8 +7,9 @@
 /// velocity is an Ornstein-Uhlenbeck process per axis (it turns smoothly, over about
 /// `turnTimeS`), its magnitude capped at `maxSpeedMPerS`; the position moves by velocity x tick
 /// and is mirrored at the faces of the box (the velocity component flips).
-/// Invariant: every position lies in the closed box, and consecutive positions are at most
-/// maxSpeedMPerS x tickS apart (0.5 mm at 0.5 m/s and 1 kHz).
+/// Invariant: every position lies in the closed box, and each step moves at most
+/// maxSpeedMPerS x tickS (0.5 mm at 0.5 m/s and 1 kHz) from the last position, which holdBack()
+/// may have moved (a hand stopped by a surface).
 /// Cost: a few flops and two normal draws per axis per step; no allocation in next().
 
 #include "hapto/core/Geometry.h"
