@@ -16,6 +16,8 @@ namespace {
 /// What a walk along a path found: the first leaf no span lists, if any.
 struct Unlisted {
     LocateResult at; ///< That leaf (at.leaf == kNoLeaf: every leaf on the way is listed).
+    /// Where on the segment that leaf begins (0 at its start, 1 at its end); 1 when none does.
+    double t = 1.0;
     /// The walk stopped before the end without knowing (more than kMaxWalk leaves on one
     /// segment, which only rounding that keeps finding the same face could make): the path
     /// counts as not covered.
@@ -45,7 +47,7 @@ Unlisted firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
             return {};
         }
         if (std::find(listed.begin(), listed.end(), at.leaf) == listed.end()) {
-            return {at};
+            return {at, t};
         }
         if (!(length > 0.0)) {
             return {};
@@ -71,7 +73,7 @@ Unlisted firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
             return {};
         }
     }
-    return {{}, true};
+    return {{}, 1.0, true};
 }
 
 /// The first leaf not in `listed` along any segment of the renderer's visited paths (where the
@@ -205,13 +207,23 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     // device point toward the start, halving, then a nudge of kNudgeM, until the path stays in
     // listed leaves; the last try is the start itself (the proxy stays, no contact, no force).
     // The contacts and the force are the device point's: the hand pushing in feels the surface
-    // as hard as ever, and the proxy never falls through it.
+    // as hard as ever, and the proxy never falls through it. The first goal is halfway to where
+    // the straight way from the start to the device point leaves the listed leaves (halfway to
+    // the device point when it does not): a proxy trapped centimetres behind then moves up to
+    // half a leaf in one more solve, where halving from the device point would try goals
+    // centimetres away, each crossing unlisted leaves again, and end on the nudge.
     const double away = glm::length(p - from);
     const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (p - from) : p;
     Vec3 goal = p;
     const std::span<const std::uint32_t> known(listed.data(), listedCount);
+    double firstHalf = 0.5;
+    if (!covered) {
+        const Unlisted straight = firstUnlistedLeaf(mProxyCursor, from, p, known);
+        firstHalf = straight.at.leaf != kNoLeaf ? 0.5 * straight.t : 0.5;
+    }
     for (int k = 0; !covered && k < kPullBacks; ++k) {
-        goal = k + 2 < kPullBacks ? from + 0.5 * (goal - from) : k + 1 < kPullBacks ? nudge : from;
+        const double keep = k == 0 ? firstHalf : 0.5;
+        goal = k + 2 < kPullBacks ? from + keep * (goal - from) : k + 1 < kPullBacks ? nudge : from;
         mRenderer.restore(start);
         out.render = mRenderer.update(*snapshot.scene, mCandidates, p, goal, v, dtS);
         tested += out.render.objectsTested;
