@@ -216,11 +216,8 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (p - from) : p;
     Vec3 goal = p;
     const std::span<const std::uint32_t> known(listed.data(), listedCount);
-    double firstHalf = 0.5;
-    if (!covered) {
-        const Unlisted straight = firstUnlistedLeaf(mProxyCursor, from, p, known);
-        firstHalf = straight.at.leaf != kNoLeaf ? 0.5 * straight.t : 0.5;
-    }
+    const double firstHalf =
+        covered ? 0.5 : 0.5 * firstUnlistedLeaf(mProxyCursor, from, p, known).t;
     for (int k = 0; !covered && k < kPullBacks; ++k) {
         const double keep = k == 0 ? firstHalf : 0.5;
         goal = k + 2 < kPullBacks ? from + keep * (goal - from) : k + 1 < kPullBacks ? nudge : from;

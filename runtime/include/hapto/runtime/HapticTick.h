@@ -70,10 +70,10 @@ public:
     /// (CandidateSet has a span for each: device, proxy, moving, and these).
     static constexpr std::size_t kExtraLeaves = CandidateSet::kMaxSpans - 3;
     /// Goals pulled back when the proxy's path crosses more unlisted leaves than kExtraLeaves:
-    /// halving toward the proxy's start three times (the first from where the straight way to the
-    /// device point leaves the listed leaves, when it does), then kNudgeM from the start toward the
-    /// device point, then the start itself. The proxy moves only toward the pulled-back goal;
-    /// the contacts and the force are taken at the device point (GodObjectRenderer::update
+    /// halving toward the proxy's start three times (the first halves the way to where the straight
+    /// line to the device point leaves the listed leaves, if it does), then kNudgeM from the start
+    /// toward the device point, then the start itself. The proxy moves only toward the pulled-back
+    /// goal; the contacts and the force are taken at the device point (GodObjectRenderer::update
     /// with a goal), so a pulled-back tick pushes as hard as a full one.
     static constexpr int kPullBacks = 5;
     /// The last pull-back but one moves the proxy at most this far (m): enough to meet the
