@@ -110,8 +110,8 @@ void GraspController::step(double dtS) {
     // A read that races a servo thread's write (the writer preempted mid-publish) keeps the
     // last report: "no fresh news" is not "no contact".
     ContactReport l = mLastLeft, r = mLastRight;
-    const bool haveL = mRuntime.contact(mLeft, l) || mHaveLeft;
-    const bool haveR = mRuntime.contact(mRight, r) || mHaveRight;
+    const bool haveL = mRuntime.lastTick(mLeft, l) || mHaveLeft;
+    const bool haveR = mRuntime.lastTick(mRight, r) || mHaveRight;
     mLastLeft = l;
     mLastRight = r;
     mHaveLeft = haveL;

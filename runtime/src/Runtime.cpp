@@ -279,7 +279,7 @@ Device& Runtime::device(std::size_t i) {
     return *mChannels.at(i)->record.rd.device;
 }
 
-bool Runtime::contact(std::size_t i, ContactReport& report) const {
+bool Runtime::lastTick(std::size_t i, ContactReport& report) const {
     return mChannels.at(i)->contacts.read(report);
 }
 
@@ -308,6 +308,10 @@ void Runtime::setEffects(std::size_t i, std::span<const ForceEffect> effects) {
                                     "': " + e.what());
     }
     publishEffects(ch.effects, ch.effectsPublished, ch.record.effects);
+}
+
+void Runtime::setEffects(std::size_t i, std::initializer_list<ForceEffect> effects) {
+    setEffects(i, std::span<const ForceEffect>(effects.begin(), effects.size()));
 }
 
 void Runtime::setEffectEnabled(std::size_t i, std::size_t k, bool enabled) {

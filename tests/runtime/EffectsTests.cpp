@@ -284,6 +284,34 @@ TEST_CASE("runtime: effects set from the control thread are picked up at the nex
     CHECK(rig.runtime->effects(0).size() == 2);
 }
 
+TEST_CASE("runtime: effects are set from a list, and lastTick gives the force sent, zero after "
+          "the stop") {
+    Rig rig(still(Vec3(0.08, 0.06, -0.04)));
+    rig.runtime->setEffects(0, {ForceEffect::damper(2.0), ForceEffect::constant(Vec3(0, 0, 0.4))});
+    CHECK(rig.runtime->effects(0).size() == 2);
+    rig.runTo(3);
+    ContactReport last;
+    REQUIRE(rig.runtime->lastTick(0, last));
+    CHECK(last.tick == rig.ticks() - 1);
+    CHECK(last.force == rig.force());
+    CHECK(near(last.force, Vec3(0, 0, 0.4))); // held still in free space: the damper adds nothing
+    CHECK(last.contactCount == 0);
+    rig.runtime->setEffects(0, {});
+    rig.runTo(4);
+    REQUIRE(rig.runtime->lastTick(0, last));
+    CHECK(last.force == Vec3(0.0));
+
+    rig.runtime->setEffects(0, {ForceEffect::constant(Vec3(0.2, 0, 0))});
+    rig.runTo(5);
+    REQUIRE(rig.runtime->lastTick(0, last));
+    CHECK(near(last.force, Vec3(0.2, 0, 0)));
+    rig.runtime->stop(); // the force the device feels at the end of the session: none
+    REQUIRE(rig.runtime->lastTick(0, last));
+    CHECK(last.force == Vec3(0.0));
+    CHECK(last.contactCount == 0);
+    CHECK(rig.device->forces().back().force == Vec3(0.0));
+}
+
 TEST_CASE("runtime: a device's renderer damping comes from its configuration") {
     // Two runs pressing into the cube's top at 0.1 m/s: the damped one pushes back harder by
     // b v along the normal while the tool moves in (b = 20 N·s/m: 2 N more).
@@ -356,6 +384,23 @@ TEST_CASE("runtime: the hook is called every tick with the sample, proxy, contac
     // The force sent: the renderer's plus the hook's.
     CHECK(near(rig.force(), probe.renderForce + probe.returns, 1e-12));
     CHECK(rig.runtime->report().devices[0].hookNonFinite == 0);
+}
+
+TEST_CASE("runtime: a hook may be a lambda that captures nothing, declared noexcept, with its "
+          "data through the context pointer") {
+    HookProbe probe;
+    probe.returns = Vec3(0.0, 0.0, 0.25);
+    const TickHook hook{[](void* context, const TickHookArgs&) noexcept {
+                            auto& p = *static_cast<HookProbe*>(context);
+                            ++p.calls;
+                            return p.returns;
+                        },
+                        &probe};
+    Rig rig(still(Vec3(0.08, 0.06, 0)), {}, hook);
+    rig.runTo(10);
+    CHECK(probe.calls == 10);
+    CHECK(near(rig.force(), probe.returns));
+    CHECK(TickHook{}.fn == nullptr);
 }
 
 TEST_CASE("runtime: a hook registers only before the start") {

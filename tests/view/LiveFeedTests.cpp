@@ -78,7 +78,7 @@ TEST_CASE("a live frame carries each device's ticks, misses, load, point, force 
         // The first frame's second reaches back to the start: the report's mean.
         CHECK(d["candidates"].get<double>() == Approx(r.candidatesMean));
         ContactReport c;
-        REQUIRE(runtime.contact(i, c));
+        REQUIRE(runtime.lastTick(i, c));
         CHECK(d["point"] ==
               nlohmann::json::array({c.devicePoint.x, c.devicePoint.y, c.devicePoint.z}));
         CHECK(d["proxy"][0] == c.proxy.x);
@@ -156,7 +156,7 @@ TEST_CASE("a live frame shows each device's cursor leaf: the box holding its poi
         const auto frame = nlohmann::json::parse(feed.frame(step * 150'000'000ull));
         for (std::size_t i = 0; i < 2; ++i) {
             ContactReport c;
-            REQUIRE(runtime.contact(i, c));
+            REQUIRE(runtime.lastTick(i, c));
             const LocateResult fresh = snap.index->locate(c.devicePoint);
             const auto& d = frame["devices"][i];
             if (fresh.outside) {

@@ -139,7 +139,7 @@ int runDemo(const DemoArgs& a) {
         }
         if (grasp.state() == GraspState::Grasped) {
             ContactReport c[2];
-            if (runtime.contact(0, c[0]) && runtime.contact(1, c[1])) {
+            if (runtime.lastTick(0, c[0]) && runtime.lastTick(1, c[1])) {
                 const Vec3 axis = glm::normalize(c[1].devicePoint - c[0].devicePoint);
                 for (int i = 0; i < 2; ++i) {
                     const double sign = i == 0 ? -1.0 : 1.0; // left is pushed to -axis

@@ -160,7 +160,7 @@ std::string LiveFeed::frame(std::uint64_t sessionNs) {
             d["note"] = std::move(note);
         }
         ContactReport c;
-        if (mRuntime.contact(i, c)) {
+        if (mRuntime.lastTick(i, c)) {
             nlohmann::json contacts = nlohmann::json::array();
             for (std::uint32_t k = 0; k < c.contactCount && k < c.objects.size(); ++k) {
                 contacts.push_back(c.objects[k]);

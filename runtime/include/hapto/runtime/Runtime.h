@@ -20,6 +20,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -35,7 +36,8 @@ class TraceRecorder;
 /// No object: a ContactReport slot that holds no contact.
 inline constexpr ObjectId kNoObject = 0xFFFFFFFFu;
 
-/// What a servo thread tells the control thread about its contacts, every tick (world frame).
+/// What a servo thread tells the control thread every tick: the force it sent and its contacts
+/// (world frame); Runtime::lastTick() reads the newest.
 struct ContactReport {
     std::uint64_t tick = 0; ///< The servo tick it describes.
     Vec3 devicePoint{0.0};  ///< Device point (m).
@@ -223,8 +225,11 @@ public:
     /// One line per device for a terminal live view. [control]
     std::string liveLine(std::size_t i) const;
 
-    /// The newest contact report of device i; false before its first tick. [any thread]
-    bool contact(std::size_t i, ContactReport& report) const;
+    /// What device i's servo last sent: its newest tick's force (N, world, external force
+    /// included), device point, proxy and contacts; once its servo has stopped (stop(), a
+    /// fault), zero force and no contacts: the force the device feels at the end of a session.
+    /// False before its first tick. [any thread]
+    bool lastTick(std::size_t i, ContactReport& report) const;
     /// Adds a world-frame force (N) to every force device i renders from its next tick on,
     /// before the safety filter (e.g. the weight of a carried object). [control]
     void setExternalForce(std::size_t i, const Vec3& forceN);
@@ -236,6 +241,8 @@ public:
     /// EffectSet::kCapacity or one fails checkForceEffect(), std::out_of_range for a bad i.
     /// [control]
     void setEffects(std::size_t i, std::span<const ForceEffect> effects);
+    /// As above, from a list: `setEffects(0, {ForceEffect::damper(2.0)})`. [control]
+    void setEffects(std::size_t i, std::initializer_list<ForceEffect> effects);
     /// Turns effect k of device i on or off from its next tick on, as setEffects(). Throws
     /// std::out_of_range when there is no such device or effect. [control]
     void setEffectEnabled(std::size_t i, std::size_t k, bool enabled);

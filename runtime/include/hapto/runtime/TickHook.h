@@ -17,6 +17,7 @@
 #include "hapto/runtime/GodObjectRenderer.h"
 
 #include <span>
+#include <type_traits>
 
 namespace hapto {
 
@@ -36,10 +37,54 @@ struct TickHookArgs {
 /// so calling it never allocates.
 using TickHookFn = Vec3 (*)(void* context, const TickHookArgs& args) noexcept;
 
-/// A hook and its context; no hook when `fn` is null.
+namespace detail {
+/// What TickHook's constructor was given as its function: a hook, or which rule it breaks.
+enum class HookForm { Hook, NotNoexcept, Captures, Other };
+template <typename F> constexpr HookForm hookForm() {
+    if constexpr (std::is_convertible_v<F, TickHookFn>) {
+        return HookForm::Hook;
+    } else if constexpr (std::is_convertible_v<F, Vec3 (*)(void*, const TickHookArgs&)>) {
+        return HookForm::NotNoexcept;
+    } else if constexpr (std::is_class_v<F> &&
+                         std::is_invocable_v<F&, void*, const TickHookArgs&>) {
+        return HookForm::Captures; // a callable object: a lambda with captures, or a functor
+    } else {
+        return HookForm::Other;
+    }
+}
+} // namespace detail
+
+/// A hook and its context; no hook when `fn` is null. `TickHook{&fn, &data}` or
+/// `{[](void* context, const TickHookArgs& tick) noexcept { ... }, &data}`: a function or a
+/// lambda that captures nothing, declared noexcept; its data comes through the context pointer.
+/// Anything else stops the compilation with a message saying which rule it breaks.
 struct TickHook {
     TickHookFn fn = nullptr; ///< Called every tick on the servo thread, or null.
     void* context = nullptr; ///< Passed back to fn; must stay valid while ticks run.
+
+    /// No hook.
+    constexpr TickHook() noexcept = default;
+    /// `hook` called with `hookContext` every tick. [any thread]
+    template <typename F, typename C> constexpr TickHook(F hook, C hookContext) noexcept {
+        constexpr detail::HookForm form = detail::hookForm<F>();
+        static_assert(form != detail::HookForm::NotNoexcept,
+                      "hapto::TickHook: declare the hook noexcept: "
+                      "Vec3 hook(void* context, const TickHookArgs& tick) noexcept");
+        static_assert(form != detail::HookForm::Captures,
+                      "hapto::TickHook: a hook cannot capture (it is a plain function pointer): "
+                      "pass its data through the context pointer, TickHook{hook, &data}, and "
+                      "declare it noexcept");
+        static_assert(form != detail::HookForm::Other,
+                      "hapto::TickHook: a hook is "
+                      "Vec3 hook(void* context, const TickHookArgs& tick) noexcept");
+        static_assert(std::is_convertible_v<C, void*>,
+                      "hapto::TickHook: the context pointer is a void*: a pointer to data the "
+                      "hook may change (not a pointer to const), or nullptr");
+        if constexpr (form == detail::HookForm::Hook && std::is_convertible_v<C, void*>) {
+            fn = hook;
+            context = hookContext;
+        }
+    }
 };
 
 } // namespace hapto
