@@ -1,10 +1,11 @@
-# ctest "install: the README's two_hands snippet builds against an installed hapto".
+# ctest "install: README's two_hands snippet and pkg-config line build against an installed hapto".
 # Run as: cmake -DBINARY_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DGENERATOR=... -DCXX=...
 #         [-DLAUNCHER=...] [-DCXX_FLAGS=...] [-DLINKER_FLAGS=...] -P InstallTest.cmake
 # Installs the build into WORK_DIR/prefix, configures and builds tools/examples/two_hands
 # against it with find_package(hapto) (no CMAKE_CXX_STANDARD: C++20 must come from the
 # exported targets), checks the README shows that CMakeLists.txt exactly, and that the
-# pkg-config file, the udev rule, the licence and hapto/Version.h are installed.
+# pkg-config file, the udev rule, the licence and hapto/Version.h are installed; then builds
+# tools/cmake/PkgConfigApp.cpp with README's pkg-config line and runs it.
 cmake_minimum_required(VERSION 3.25)
 foreach(var BINARY_DIR SOURCE_DIR WORK_DIR GENERATOR CXX)
   if(NOT DEFINED ${var})
@@ -70,19 +71,32 @@ run(${CMAKE_COMMAND} ${args})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/two_hands)
 message(STATUS "two_hands built against ${prefix}")
 
-# 4. pkg-config finds the installed hapto from the prefix it was installed into.
-find_program(PKG_CONFIG pkg-config)
-if(PKG_CONFIG)
-  list(GET pc 0 pcfile)
-  get_filename_component(pcdir ${pcfile} DIRECTORY)
-  set(ENV{PKG_CONFIG_PATH} ${pcdir})
-  execute_process(COMMAND ${PKG_CONFIG} --cflags hapto OUTPUT_VARIABLE cflags RESULT_VARIABLE rc)
-  if(NOT rc EQUAL 0 OR NOT cflags MATCHES "-std=c\\+\\+20")
-    message(FATAL_ERROR "pkg-config --cflags hapto failed or lacks -std=c++20: ${cflags}")
-  endif()
-  execute_process(COMMAND ${PKG_CONFIG} --variable=includedir hapto OUTPUT_VARIABLE inc
-                  OUTPUT_STRIP_TRAILING_WHITESPACE)
-  if(NOT EXISTS ${inc}/hapto/Version.h)
-    message(FATAL_ERROR "pkg-config's includedir (${inc}) does not hold hapto/Version.h")
-  endif()
+# 4. README's pkg-config line builds and links a program against the installed hapto (static
+#    libraries: the .pc file must bring every dependency), and the program runs. The line is
+#    taken from README as it is; only its leading `c++` becomes this build's compiler and flags.
+find_program(PKG_CONFIG pkg-config REQUIRED)
+string(REGEX MATCHALL "\n(c\\+\\+ [^\n]*\\$\\(pkg-config [^\n]*)" lines "${readme}")
+list(LENGTH lines count)
+if(NOT count EQUAL 1)
+  message(FATAL_ERROR "README.md should show one line `c++ ... $(pkg-config ...) ...` building "
+                      "a program against hapto; found ${count}")
+endif()
+string(STRIP "${lines}" line)
+string(REGEX REPLACE "^c\\+\\+ " "" rest "${line}")
+list(GET pc 0 pcfile)
+get_filename_component(pcdir ${pcfile} DIRECTORY)
+set(ENV{PKG_CONFIG_PATH} ${pcdir})
+set(app ${WORK_DIR}/pkg-config)
+file(MAKE_DIRECTORY ${app})
+configure_file(${SOURCE_DIR}/tools/cmake/PkgConfigApp.cpp ${app}/app.cpp COPYONLY)
+run(sh -c "cd '${app}' && '${CXX}' ${CXX_FLAGS} ${rest} ${LINKER_FLAGS}")
+execute_process(COMMAND ${app}/app RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "force at the end 0 N")
+  message(FATAL_ERROR "the program README's line built (${line}) failed (${rc}):\n${out}")
+endif()
+message(STATUS "README's line built and ran a program: ${line}\n${out}")
+execute_process(COMMAND ${PKG_CONFIG} --variable=includedir hapto OUTPUT_VARIABLE inc
+                OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT EXISTS ${inc}/hapto/Version.h)
+  message(FATAL_ERROR "pkg-config's includedir (${inc}) does not hold hapto/Version.h")
 endif()
