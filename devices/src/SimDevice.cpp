@@ -75,6 +75,8 @@ DeviceStatus SimDevice::open() {
     mTick = 0;
     mForceN = Vec3(0.0);
     mTargetWorld = mConfig.transform.positionToWorld(mSim.start);
+    mPressNormal = mConfig.transform.forceToDevice(mScript->contactNormal());
+    mPressExtraM = 0.0;
     mPhase = mScript->keyframes().size() > 1 ? mScript->keyframes()[1].phase
                                              : mScript->keyframes()[0].phase;
     mPublishedPhase.store(mPhase, std::memory_order_relaxed);
@@ -129,9 +131,23 @@ void SimDevice::periodsSkipped(std::uint64_t periods) noexcept {
 
 void SimDevice::advance() noexcept {
     ++mTick;
-    mTargetWorld = mScript->targetAt(timeS(), mCursor, mPhase);
+    const ScriptSample sample = mScript->targetAt(timeS(), mCursor);
+    mTargetWorld = sample.target;
+    mPhase = sample.phase;
     mPublishedPhase.store(mPhase, std::memory_order_relaxed);
-    mHand.step(mConfig.transform.positionToDevice(mTargetWorld), mForceN, mDtS);
+    adjustPress(sample.pressing);
+    mHand.step(mConfig.transform.positionToDevice(mTargetWorld) - mPressNormal * mPressExtraM,
+               mForceN, mDtS);
+}
+
+void SimDevice::adjustPress(bool pressing) noexcept {
+    const double felt = glm::dot(mForceN, mPressNormal); // the surface pushing the hand out
+    if (pressing && felt > 0.0) {
+        mPressExtraM += mDtS * (mSim.pressForceN - felt) / (mSim.handStiffness * kPressTimeS);
+    } else if (!pressing) {
+        mPressExtraM -= mPressExtraM * std::min(1.0, mDtS / kPressTimeS);
+    }
+    mPressExtraM = std::clamp(mPressExtraM, 0.0, kMaxPressExtraM);
 }
 
 DeviceStatus SimDevice::write(const Vec3& forceN) noexcept {

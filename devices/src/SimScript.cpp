@@ -43,8 +43,10 @@ public:
     double time() const { return mKeys.back().timeS; }
     std::size_t size() const { return mKeys.size(); }
     void moveTo(const Vec3& p, double durationS, ScriptPhase phase, bool smooth = true) {
-        mKeys.push_back({time() + durationS, p, phase, smooth});
+        mKeys.push_back({time() + durationS, p, phase, smooth, mPressing});
     }
+    // The knots added from now on hold a press (ScriptKeyframe::pressing), or stop holding it.
+    void holdPress(bool pressing) { mPressing = pressing; }
     void moveAt(const Vec3& p, double peakSpeed, ScriptPhase phase) {
         moveTo(p, moveDuration(glm::length(p - last()), peakSpeed), phase);
     }
@@ -58,6 +60,7 @@ public:
 
 private:
     std::vector<ScriptKeyframe> mKeys;
+    bool mPressing = false;
 };
 
 // A* over a voxel grid around a and b (voxels blocked within kFreeMarginM + one voxel of a
@@ -348,7 +351,7 @@ SimScript::SimScript(std::vector<ScriptKeyframe> keyframes, std::optional<std::s
     }
 }
 
-Vec3 SimScript::targetAt(double timeS, std::size_t& cursor, ScriptPhase& phase) const {
+ScriptSample SimScript::targetAt(double timeS, std::size_t& cursor) const {
     const ScriptKeyframe& back = mKeyframes.back();
     if (mLoopStart && timeS > back.timeS) {
         const double t0 = mKeyframes[*mLoopStart].timeS;
@@ -358,8 +361,7 @@ Vec3 SimScript::targetAt(double timeS, std::size_t& cursor, ScriptPhase& phase) 
         }
     }
     if (mKeyframes.size() < 2 || timeS >= back.timeS) {
-        phase = back.phase;
-        return back.target;
+        return {back.target, back.phase, back.pressing};
     }
     if (timeS < 0.0) {
         timeS = 0.0;
@@ -373,8 +375,8 @@ Vec3 SimScript::targetAt(double timeS, std::size_t& cursor, ScriptPhase& phase) 
     const ScriptKeyframe& a = mKeyframes[cursor - 1];
     const ScriptKeyframe& b = mKeyframes[cursor];
     const double tau = (timeS - a.timeS) / (b.timeS - a.timeS);
-    phase = b.phase;
-    return a.target + (b.target - a.target) * (b.smooth ? minJerk(tau) : tau);
+    return {a.target + (b.target - a.target) * (b.smooth ? minJerk(tau) : tau), b.phase,
+            b.pressing};
 }
 
 SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec3& startWorld) {
@@ -384,6 +386,10 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
     std::optional<ObjectId> object;
     Vec3 contactNormal(0.0);
     const double cap = config.maxSpeedMPerS;
+    // How far a press puts the target past the surface: F / k_hand, the whole press on an
+    // unyielding surface. On a surface of stiffness k the hand would feel only F k / (k +
+    // k_hand) there; while the stretch holds the press, SimDevice moves the target further in
+    // until it feels F.
     const double depth = config.pressForceN / config.handStiffness;
 
     if (config.script == HandScript::Walk) {
@@ -455,6 +461,7 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
             approach(plan, scene, sp.point + sp.normal * kStandOffM);
             const Vec3 pressed = sp.point - sp.normal * depth;
             plan.moveAt(pressed, kPressSpeed, ScriptPhase::Press);
+            plan.holdPress(true);
             if (config.script == HandScript::Touch) {
                 plan.hold(0.5, ScriptPhase::Hold);
             } else {
@@ -581,12 +588,14 @@ SimScript SimScript::plan(const SimConfig& config, const Scene& scene, const Vec
             using G = GraspTimes;
             plan.moveTo(surface, G::kReachEnd - G::kApproachEnd, ScriptPhase::Reach);
             plan.moveTo(squeezed, 0.5 * (G::kSqueezeEnd - G::kReachEnd), ScriptPhase::Squeeze);
+            plan.holdPress(true);
             plan.holdUntil(G::kSqueezeEnd, ScriptPhase::Squeeze);
             plan.moveTo(squeezed + config.lift, G::kLiftEnd - G::kSqueezeEnd, ScriptPhase::Lift);
             plan.moveTo(squeezed + config.lift + config.carry, G::kCarryEnd - G::kLiftEnd,
                         ScriptPhase::Carry);
             plan.moveTo(squeezed + config.carry, G::kPutDownEnd - G::kCarryEnd,
                         ScriptPhase::PutDown);
+            plan.holdPress(false);
             plan.moveTo(standOff + config.carry, G::kReleaseEnd - G::kPutDownEnd,
                         ScriptPhase::Release);
             plan.hold(0.5, ScriptPhase::Done);

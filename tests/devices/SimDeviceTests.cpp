@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -196,34 +197,79 @@ TEST_CASE("sim free: never enters a solid over a long run in random scenes") {
     }
 }
 
-TEST_CASE("sim touch: ends up pressing on the nearest surface, steadily") {
+TEST_CASE("sim touch: presses on the nearest surface with press_n, whatever its stiffness") {
+    // The hand's 300 N/m spring is in series with the surface: pressing its target a fixed
+    // F / 300 m past the surface gave F k / (k + 300) (1.09 N at 800 N/m for 1.5 N).
     const Scene scene = makeDefaultScene();
-    DeviceConfig c = simConfig("touch", 1, Vec3(0.01, 0.0, 0.0));
-    SimDevice d(c, scene);
-    REQUIRE(d.open() == DeviceStatus::Ok);
-    REQUIRE(d.script()->object().has_value());
-    const SceneObject& o = scene.object(*scene.slotOf(*d.script()->object()));
-    const Vec3 n = d.script()->contactNormal();
-    const double kSurface = 800.0;
-    DeviceState s;
-    Vec3 force(0.0);
-    std::vector<double> depths;
-    for (int i = 0; i < 12000; ++i) {
-        REQUIRE(d.write(force) == DeviceStatus::Ok);
-        REQUIRE(d.read(s) == DeviceStatus::Ok);
-        const Vec3 p = c.transform.positionToWorld(s.position);
-        force = penaltyForce(o, n, p, kSurface);
-        if (i >= 11000) {
-            depths.push_back(o.contains(p) ? depthBelowFace(o, n, p) : -1.0);
+    for (const double kSurface : {300.0, 800.0, 1000.0, 3000.0, 10000.0}) {
+        for (const double pressN : {0.5, 1.5, 4.0}) {
+            INFO("surface " << kSurface << " N/m, press_n " << pressN << " N");
+            DeviceConfig c = simConfig("touch", 1, Vec3(0.01, 0.0, 0.0));
+            sim(c).pressForceN = pressN;
+            sim(c).noiseM = 0.0; // exact readings: at 10^4 N/m a 10 um quantum is 0.1 N
+            sim(c).resolutionM = 0.0;
+            SimDevice d(c, scene);
+            REQUIRE(d.open() == DeviceStatus::Ok);
+            REQUIRE(d.script()->object().has_value());
+            const SceneObject& o = scene.object(*scene.slotOf(*d.script()->object()));
+            const Vec3 n = d.script()->contactNormal();
+            DeviceState s;
+            Vec3 force(0.0);
+            std::vector<double> depths, forces;
+            for (int i = 0; i < 12000; ++i) {
+                REQUIRE(d.write(force) == DeviceStatus::Ok);
+                REQUIRE(d.read(s) == DeviceStatus::Ok);
+                const Vec3 p = c.transform.positionToWorld(s.position);
+                force = penaltyForce(o, n, p, kSurface);
+                if (i >= 11000) {
+                    depths.push_back(o.contains(p) ? depthBelowFace(o, n, p) : -1.0);
+                    forces.push_back(glm::dot(force, n));
+                }
+            }
+            CHECK(d.phase() == ScriptPhase::Hold);
+            // Steady at press_n, within 0.1 %, as deep as that force needs.
+            const auto [lo, hi] = std::minmax_element(forces.begin(), forces.end());
+            CHECK(*lo == Approx(pressN).epsilon(0.001));
+            CHECK(*hi == Approx(pressN).epsilon(0.001));
+            const auto [shallow, deep] = std::minmax_element(depths.begin(), depths.end());
+            CHECK(*shallow == Approx(pressN / kSurface).epsilon(0.001));
+            CHECK(*deep == Approx(pressN / kSurface).epsilon(0.001));
+            CHECK(d.pressExtraM() > 0.0);
         }
     }
-    CHECK(d.phase() == ScriptPhase::Hold);
-    const auto [lo, hi] = std::minmax_element(depths.begin(), depths.end());
-    // Pressing with 1.5 N through the hand's 300 N/m against 800 N/m: about 1.4 mm deep.
-    CHECK(*lo > 0.0005);
-    CHECK(*hi < 0.003);
-    CHECK(*hi - *lo < 5e-5); // steady
-    CHECK(glm::length(force) == Approx(1.5 * 800.0 / 1100.0).epsilon(0.05));
+}
+
+TEST_CASE("sim touch: the press never overshoots press_n, and does not wind up while it feels "
+          "nothing") {
+    const Scene scene = makeDefaultScene();
+    for (const double kSurface : {300.0, 800.0, 3000.0}) {
+        INFO("surface " << kSurface << " N/m");
+        DeviceConfig c = simConfig("touch", 1, Vec3(0.01, 0.0, 0.0));
+        sim(c).noiseM = 0.0;
+        sim(c).resolutionM = 0.0;
+        SimDevice d(c, scene);
+        REQUIRE(d.open() == DeviceStatus::Ok);
+        const SceneObject& o = scene.object(*scene.slotOf(*d.script()->object()));
+        const Vec3 n = d.script()->contactNormal();
+        DeviceState s;
+        Vec3 force(0.0);
+        double most = 0.0;
+        for (int i = 0; i < 12000; ++i) {
+            REQUIRE(d.write(force) == DeviceStatus::Ok);
+            REQUIRE(d.read(s) == DeviceStatus::Ok);
+            force = penaltyForce(o, n, c.transform.positionToWorld(s.position), kSurface);
+            most = std::max(most, glm::dot(force, n));
+        }
+        CHECK(most <= 1.5 * 1.002);
+        CHECK(glm::dot(force, n) == Approx(1.5).epsilon(1e-4));
+        // The surface gone (nothing felt), the press holds its depth: it does not wind up.
+        const double extra = d.pressExtraM();
+        for (int i = 0; i < 2000; ++i) {
+            REQUIRE(d.write(Vec3(0.0)) == DeviceStatus::Ok);
+            REQUIRE(d.read(s) == DeviceStatus::Ok);
+        }
+        CHECK(d.pressExtraM() == extra);
+    }
 }
 
 TEST_CASE("sim slide: moves along the surface while pressing on it") {

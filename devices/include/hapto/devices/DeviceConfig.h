@@ -49,7 +49,9 @@ struct SimConfig {
                                          ///< (grasp). JSON `object`.
     Vec3 near{0.0};               ///< Grasp scripts pick the object nearest this world point (m)
                                   ///< when `object` is not given, so two hands agree. JSON `near`.
-    double pressForceN = 1.5;     ///< How hard touch, slide and grasp press (N), >= 0. `press_n`.
+    double pressForceN = 1.5;     ///< The force touch, slide and grasp press with (N), >= 0:
+                                  ///< felt once a press settles, whatever the surface's
+                                  ///< stiffness (SimDevice). `press_n`.
     double maxSpeedMPerS = 0.5;   ///< Speed cap of scripted motion (m/s), > 0. `max_speed_m_per_s`.
     Vec3 lift{0.0, 0.05, 0.0};    ///< Grasp: lift of the object, world (m); +y is up. `lift`.
     Vec3 carry{0.10, 0.0, 0.0};   ///< Grasp: sideways carry after the lift, world (m). `carry`.

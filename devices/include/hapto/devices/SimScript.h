@@ -40,6 +40,17 @@ struct ScriptKeyframe {
     Vec3 target{0.0};                      ///< Hand target, world (m).
     ScriptPhase phase = ScriptPhase::Move; ///< Phase of the stretch ending here.
     bool smooth = true;                    ///< Minimum-jerk from the previous knot (else linear).
+    /// The stretch ending here holds a press (touch's hold, slide's slides, a grasp from the
+    /// squeeze's hold to the put-down): the target is already pressed in, and the hand moves it
+    /// further in or out until it feels SimConfig::pressForceN (SimDevice).
+    bool pressing = false;
+};
+
+/// Where a plan has the hand at one time (SimScript::targetAt).
+struct ScriptSample {
+    Vec3 target{0.0};                      ///< Hand target, world (m).
+    ScriptPhase phase = ScriptPhase::Move; ///< Phase of the stretch the time is in.
+    bool pressing = false;                 ///< That stretch holds a press (ScriptKeyframe).
 };
 
 /// Fixed grasp timetable (s since open), the same for both hands so they squeeze, lift and
@@ -69,9 +80,9 @@ public:
     /// set. [control]
     SimScript(std::vector<ScriptKeyframe> keyframes, std::optional<std::size_t> loopStart);
 
-    /// Target (m, world) and phase at `timeS`; `cursor` starts at 0 and is only ever handed back
-    /// to this function (it makes evaluation O(1) for increasing times). [servo]
-    Vec3 targetAt(double timeS, std::size_t& cursor, ScriptPhase& phase) const;
+    /// Target (m, world), phase and press at `timeS`; `cursor` starts at 0 and is only ever
+    /// handed back to this function (it makes evaluation O(1) for increasing times). [servo]
+    ScriptSample targetAt(double timeS, std::size_t& cursor) const;
 
     /// The knots. [any thread]
     std::span<const ScriptKeyframe> keyframes() const { return mKeyframes; }
