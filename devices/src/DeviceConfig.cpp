@@ -275,13 +275,17 @@ ForceEffect parseEffect(const Source& w, const Json& j, const Path& path) {
         if (direction || normal) {
             const char* field = direction ? "direction" : "normal";
             const Vec3 axis = vec3(w, direction ? *direction : *normal, path / field);
-            const double length = glm::length(axis);
-            if (!(length > 0) || !std::isfinite(length)) {
-                w.fail(path / field, std::string("the ") + field + " must not be zero (got " +
-                                         describe(direction ? *direction : *normal) + ")");
+            // Scaled by its largest component first: the squares of [1e308, 1e308, 0] overflow
+            // and those of [1e-200, 1e-200, 0] underflow, yet both are directions.
+            const double largest = std::max({std::abs(axis.x), std::abs(axis.y), std::abs(axis.z)});
+            if (!(largest > 0)) {
+                w.fail(path / field, std::string("the ") + field + " must not be zero (got [" +
+                                         show(axis.x) + ", " + show(axis.y) + ", " + show(axis.z) +
+                                         "])");
             }
             e.target = direction ? SpringTarget::Line : SpringTarget::Plane;
-            e.axis = axis / length;
+            const Vec3 scaled = axis / largest;
+            e.axis = scaled / glm::length(scaled);
         }
     } else if (type == "damper") {
         checkKeys(w, j, path, {"type", "enabled", "damping_n_s_per_m", "region"});
@@ -348,8 +352,9 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
     DeviceConfig d;
     d.name = string(w, required(w, j, path, "name"), path / "name");
     if (!validName(d.name)) {
-        w.fail(path / "name", "a device name is 1 to 63 letters, digits, '-' or '_' (got \"" +
-                                  d.name + "\"); it also names trace files");
+        w.fail(path / "name", "a device name is 1 to 63 letters, digits, '-' or '_' (got " +
+                                  describe(required(w, j, path, "name")) +
+                                  "); it also names trace files");
     }
     const std::string kind = string(w, required(w, j, path, "kind"), path / "kind");
     const std::optional<DeviceKind> parsedKind = parseDeviceKind(kind);

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <unordered_set>
 #include <vector>
@@ -42,6 +44,19 @@ std::pair<std::size_t, std::size_t> lineColumn(std::string_view text, std::size_
         }
     }
     return {line, col};
+}
+
+/// The byte order mark `text` starts with when it is UTF-16 or UTF-32 (JSON files are UTF-8),
+/// else nullptr.
+const char* utf16Or32(std::string_view text) {
+    using namespace std::string_view_literals;
+    if (text.starts_with("\xFF\xFE\0\0"sv) || text.starts_with("\0\0\xFE\xFF"sv)) {
+        return "a UTF-32 byte order mark";
+    }
+    if (text.starts_with("\xFF\xFE"sv) || text.starts_with("\xFE\xFF"sv)) {
+        return "a UTF-16 byte order mark";
+    }
+    return nullptr;
 }
 
 } // namespace
@@ -147,16 +162,26 @@ Json parseText(std::string_view text, const Source& source,
     try {
         return Json::parse(text.begin(), text.end(), checked);
     } catch (const Json::parse_error& e) {
-        const auto [line, col] = lineColumn(text, e.byte == 0 ? 0 : e.byte - 1);
+        if (const char* mark = utf16Or32(text)) {
+            throw InputError(std::string(source.name()) +
+                             ": not UTF-8 text: the file starts with " + mark +
+                             "; save it as UTF-8");
+        }
+        const std::size_t at = e.byte == 0 ? 0 : e.byte - 1;
+        const auto [line, col] = lineColumn(text, at);
         std::string what = e.what();
         // Drop nlohmann's "[json.exception.parse_error.101] parse error at line 1, column 2: ".
         if (const auto p = what.find(": "); p != std::string::npos && what.rfind("[json", 0) == 0) {
             what = what.substr(p + 2);
         }
+        if (const std::size_t nul = text.substr(0, at + 1).find('\0'); nul != text.npos) {
+            what = "a NUL byte (byte " + std::to_string(nul) +
+                   "); JSON is UTF-8 text: is the file UTF-16 or binary?";
+        }
         throw InputError(std::string(source.name()) + ":" + std::to_string(line) + ":" +
-                         std::to_string(col) + ": not valid JSON: " + what);
+                         std::to_string(col) + ": not valid JSON: " + printable(what));
     } catch (const Json::exception& e) {
-        throw InputError(std::string(source.name()) + ": not valid JSON: " + e.what());
+        throw InputError(std::string(source.name()) + ": not valid JSON: " + printable(e.what()));
     }
 }
 
@@ -176,9 +201,63 @@ std::string typeName(const Json& j) {
 }
 
 std::string show(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
+    char text[32];
+    for (int digits = 6;; ++digits) {
+        std::snprintf(text, sizeof text, "%.*g", digits, v);
+        if (digits >= 17 || !std::isfinite(v) || std::strtod(text, nullptr) == v) {
+            return text; // 17 significant digits always read back as the same double
+        }
+    }
+}
+
+std::string printable(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    const auto escape = [&out](unsigned char c) {
+        static constexpr char kHex[] = "0123456789ABCDEF";
+        switch (c) {
+        case '\n':
+            out += "\\n";
+            break;
+        case '\t':
+            out += "\\t";
+            break;
+        case '\r':
+            out += "\\r";
+            break;
+        default:
+            out += {'\\', 'x', kHex[c >> 4], kHex[c & 15]};
+        }
+    };
+    for (std::size_t i = 0; i < text.size();) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x80) {
+            if (c < 0x20 || c == 0x7F) {
+                escape(c);
+            } else {
+                out += static_cast<char>(c);
+            }
+            ++i;
+            continue;
+        }
+        // A whole UTF-8 sequence is kept, except a C1 control (U+0080..U+009F: C2 80..C2 9F).
+        const std::size_t n = c >= 0xC2 && c <= 0xDF   ? 2
+                              : c >= 0xE0 && c <= 0xEF ? 3
+                              : c >= 0xF0 && c <= 0xF4 ? 4
+                                                       : 0;
+        bool whole = n > 0 && i + n <= text.size();
+        for (std::size_t k = 1; whole && k < n; ++k) {
+            whole = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+        }
+        if (whole && !(c == 0xC2 && static_cast<unsigned char>(text[i + 1]) < 0xA0)) {
+            out.append(text.substr(i, n));
+            i += n;
+        } else {
+            escape(c);
+            ++i;
+        }
+    }
+    return out;
 }
 
 std::string describe(const Json& j) {
@@ -248,6 +327,15 @@ std::string string(const Source& s, const Json& j, const Path& path) {
         s.fail(path, "expected a string, got " + typeName(j));
     }
     return j.get<std::string>();
+}
+
+std::string printableString(const Source& s, const Json& j, const Path& path, const char* what) {
+    std::string text = string(s, j, path);
+    if (printable(text) != text) {
+        s.fail(path, std::string(what) + " must not contain control characters (got " +
+                         describe(j) + ")");
+    }
+    return text;
 }
 
 bool boolean(const Source& s, const Json& j, const Path& path) {

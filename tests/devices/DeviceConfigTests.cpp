@@ -10,6 +10,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 using namespace hapto;
@@ -523,4 +525,66 @@ TEST_CASE("tool_tip, a sim stylus and the replay's own settings parse, bad ones 
                Catch::Contains("bad.json: devices[0].sim.orientation"));
     CHECK_THAT(errorOf(withDevice(R"("sim": {"spin_rad_per_s": [0, 0, 1000]})")),
                Catch::Contains("bad.json: devices[0].sim.spin_rad_per_s[2]"));
+}
+
+TEST_CASE("a value just past a limit is shown with the digits that put it past the limit") {
+    CHECK_THAT(errorOf(withDevice(R"("tool_tip": [0, 0.5000001, 0])")),
+               Catch::Contains("bad.json: devices[0].tool_tip[1]: a tool tip component is at "
+                               "most 0.5 m (got 0.5000001)"));
+    CHECK_THAT(errorOf(withDevice(R"("effects": [{"type": "damper",
+                                                  "damping_n_s_per_m": 100.0000001}])")),
+               Catch::Contains("effects[0].damping_n_s_per_m: the damping (N·s/m) must be in "
+                               "0..100 (got 100.0000001)"));
+    CHECK_THAT(errorOf(withDevice(R"("sim": {"hand_damping_ratio": 100.00000000000001})")),
+               Catch::Contains("the damping ratio must be <= 100 (got 100.00000000000001)"));
+    // Round values stay short.
+    CHECK_THAT(errorOf(withDevice(R"("rate_hz": 1e9)")),
+               Catch::Contains("the rate (Hz) must be <= 100000 (got 1e+09)"));
+}
+
+TEST_CASE("a spring's direction may have any length but zero, and a zero one is shown") {
+    const auto spring = [](const std::string& axis) {
+        return withDevice(R"("effects": [{"type": "spring", "anchor": [0, 0, 0],
+                                          "stiffness_n_per_m": 100, "direction": )" +
+                          axis + "}]");
+    };
+    // Its squares overflow (or underflow), yet it is a direction.
+    const ForceEffect huge = parseDeviceConfig(spring("[1e308, 1e308, 0]"), "a.json")[0].effects[0];
+    CHECK(huge.axis.x == Approx(std::sqrt(0.5)));
+    CHECK(huge.axis.y == Approx(std::sqrt(0.5)));
+    CHECK(huge.axis.z == 0.0);
+    const ForceEffect tiny =
+        parseDeviceConfig(spring("[0, -1e-200, 1e-200]"), "a.json")[0].effects[0];
+    CHECK(tiny.axis.y == Approx(-std::sqrt(0.5)));
+    CHECK(tiny.axis.z == Approx(std::sqrt(0.5)));
+    CHECK(errorOf(spring("[0, 0, -0.0]")) ==
+          "bad.json: devices[0].effects[0].direction: the direction must not be zero (got [0, 0, "
+          "-0])");
+}
+
+TEST_CASE("a device file in UTF-16, or with a NUL or a stray byte, is named as such, escaped") {
+    const std::string json = withDevice("");
+    std::string utf16 = "\xFF\xFE";
+    for (const char c : json) {
+        utf16 += c;
+        utf16 += '\0';
+    }
+    CHECK(errorOf(utf16) == "bad.json: not UTF-8 text: the file starts with a UTF-16 byte order "
+                            "mark; save it as UTF-8");
+    // Without its mark: the first NUL is named.
+    CHECK_THAT(errorOf(utf16.substr(2)),
+               Catch::Contains("bad.json:1:2: not valid JSON: a NUL byte (byte 1)"));
+    // A byte that is not UTF-8 is written as an escape, never as itself.
+    const std::string stray = errorOf("{\"format\": \xFF}");
+    CHECK_THAT(stray, Catch::Contains("bad.json:1:12: not valid JSON:"));
+    CHECK_THAT(stray, Catch::Contains("\\xFF"));
+    CHECK(stray.find('\xFF') == std::string::npos);
+}
+
+TEST_CASE("a device name with control characters is shown escaped in its message") {
+    const std::string e = errorOf(
+        withDevice("").replace(withDevice("").find("\"a\""), 3, R"("a\nb\u0000c\u001b[2J")"));
+    CHECK_THAT(e, Catch::Contains("bad.json: devices[0].name: a device name is 1 to 63 letters"));
+    CHECK_THAT(e, Catch::Contains(R"((got "a\nb\u0000c\u001b[2J"))"));
+    CHECK(std::none_of(e.begin(), e.end(), [](char c) { return c >= 0 && c < 0x20; }));
 }

@@ -59,8 +59,13 @@ std::string readFile(const std::filesystem::path& path, std::string_view what);
 
 /// "a number", "an integer", "a string", "an array", ... for messages.
 std::string typeName(const Json& j);
-/// A number in shortest form for messages.
+/// A number for messages: as few significant digits as show it exactly (at least 6: "0.5",
+/// "1e+06", but "100.0000001"), so a value just past a limit never reads as the limit.
 std::string show(double v);
+/// Text for messages and figures: control characters, DEL and bytes that are not UTF-8 written
+/// as escapes (\n, \t, \r, \xHH), so a name or a file's bytes cannot break a line or a
+/// terminal. [any thread]
+std::string printable(std::string_view text);
 /// A value for messages: a scalar as JSON text (a long string cut short), an array or object
 /// only by its type, so a deeply nested value cannot exhaust the stack (dump() recurses).
 std::string describe(const Json& j);
@@ -80,6 +85,9 @@ std::int64_t integer(const Source& s, const Json& j, const Path& path, std::int6
                      std::int64_t hi);
 /// A string.
 std::string string(const Source& s, const Json& j, const Path& path);
+/// A string without control characters (a name shown in messages, plots and file names);
+/// `what` names it in the message.
+std::string printableString(const Source& s, const Json& j, const Path& path, const char* what);
 /// true or false.
 bool boolean(const Source& s, const Json& j, const Path& path);
 /// An array of exactly N finite numbers.
