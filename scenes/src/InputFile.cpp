@@ -63,6 +63,14 @@ std::string nonRegularKind(const std::filesystem::path& path) {
 InputFile::InputFile(const std::filesystem::path& path, std::string_view what,
                      std::uint64_t maxBytes)
     : mPath(path.string()), mWhat(what), mMaxBytes(maxBytes) {
+    if (const std::size_t nul = mPath.find('\0'); nul != std::string::npos) {
+        std::string shown;
+        for (const char c : mPath) {
+            shown += c == '\0' ? std::string("\\0") : std::string(1, c);
+        }
+        throw InputError(shown + ": a NUL byte (\\0) in the " + mWhat + "'s path (at character " +
+                         std::to_string(nul) + "; the system would read the path only up to it)");
+    }
     const auto refuse = [&](const std::string& kind) {
         throw InputError(mPath + ": is " + kind + ", not a regular file (give the " + mWhat +
                          " as a file on disk)");
@@ -107,6 +115,28 @@ InputFile::~InputFile() {
     if (mFd >= 0) {
         ::close(mFd);
     }
+}
+
+std::string InputFile::readHead(std::size_t bytes) {
+    std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(bytes, mSize)), '\0');
+    std::size_t used = 0;
+    while (used < head.size()) {
+        const ssize_t n =
+            ::pread(mFd, head.data() + used, head.size() - used, static_cast<off_t>(used));
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n < 0) {
+            throw InputError(mPath + ": cannot read the " + mWhat + " (" + std::strerror(errno) +
+                             ")");
+        }
+        if (n == 0) {
+            break;
+        }
+        used += static_cast<std::size_t>(n);
+    }
+    head.resize(used);
+    return head;
 }
 
 std::string InputFile::readAll() {

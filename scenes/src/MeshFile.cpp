@@ -76,6 +76,9 @@ public:
     void Close(Assimp::IOStream* stream) override { delete stream; }
 };
 
+/// How much of a model file checkHead looks at before the file is read whole (bytes).
+constexpr std::size_t kHeadBytes = 4096;
+
 void checkScale(const std::string& name, double scale) {
     if (!(std::isfinite(scale) && scale > 0.0)) {
         throw InputError(name + ": the scale must be a finite number > 0");
@@ -160,7 +163,8 @@ std::shared_ptr<const TriangleMesh> loadMeshFile(const std::filesystem::path& pa
     checkScale(name, source.scale);
     // Opened first, so a folder or a FIFO is named as such whatever its name.
     InputFile file(path, "model file");
-    knownFormat(path);
+    // A file its first bytes and size refuse (a 2 GB STL of zeros) is never read whole.
+    detail::checkHead(knownFormat(path), file.readHead(kHeadBytes), file.size(), name);
     return parseMeshFile(file.readAll(), path, std::move(source));
 }
 
@@ -177,13 +181,14 @@ parseMeshFile(std::string bytes, const std::filesystem::path& path, MeshSource s
         if (bytes.starts_with("\xEF\xBB\xBF")) {
             bytes.erase(0, 3); // a UTF-8 byte order mark: assimp 5.2.5 would lose the first line
         }
-        detail::checkObj(bytes, name);
+        detail::blankObjComments(bytes);
+        detail::checkObj(bytes, name, source.scale);
         break;
     case detail::MeshFormat::Stl:
-        detail::checkStl(bytes, name);
+        detail::checkStl(bytes, name, source.scale);
         break;
     case detail::MeshFormat::Ply:
-        detail::checkPly(bytes, name);
+        detail::checkPly(bytes, name, source.scale);
         break;
     }
 

@@ -10,6 +10,7 @@
 #include "MeshFileChecks.h"
 
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/JsonInput.h"
 #include "hapto/scenes/TriangleMesh.h"
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <initializer_list>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -120,6 +122,46 @@ void refuseNul(std::string_view text, const std::string& name, const char* what)
     }
 }
 
+/// What is wrong with a number assimp reads as a 32-bit float, or "": not finite, or past the
+/// largest float (assimp would make it infinite). The text follows the number's name.
+std::string floatProblem(double v) {
+    if (!std::isfinite(v)) {
+        return "is not finite";
+    }
+    if (std::abs(v) > std::numeric_limits<float>::max()) {
+        return "is beyond the largest 32-bit float, 3.4e+38 (assimp reads coordinates as floats "
+               "and would make it infinite)";
+    }
+    return "";
+}
+
+/// What is wrong with a vertex coordinate `v` as the file gives it, or "": floatProblem, or,
+/// times `scale`, farther than TriangleMesh::kMaxCoordinate from the origin.
+std::string coordinateProblem(double v, double scale) {
+    if (std::string p = floatProblem(v); !p.empty()) {
+        return p;
+    }
+    const double scaled = v * scale;
+    if (!std::isfinite(scaled)) {
+        return "times the scale " + json::show(scale) + " is not finite";
+    }
+    if (std::abs(scaled) > TriangleMesh::kMaxCoordinate) {
+        return "times the scale " + json::show(scale) + " is " + json::show(scaled) +
+               " m, beyond the " + json::show(TriangleMesh::kMaxCoordinate) +
+               " m a mesh vertex may lie from its origin";
+    }
+    return "";
+}
+
+/// Refuses a face (or line, or point) of more vertices than assimp reads.
+void checkFaceSize(std::uint64_t vertices, const std::string& place, const char* what) {
+    if (vertices > kMaxFaceVertices) {
+        fail(place + "a " + what + " of " + std::to_string(vertices) +
+             " vertices; assimp reads at most " + std::to_string(kMaxFaceVertices) +
+             " (split it into smaller polygons)");
+    }
+}
+
 void checkTriangleLimit(std::uint64_t triangles, const std::string& name) {
     if (triangles > TriangleMesh::kMaxTriangles) {
         fail(name + ": more than " + std::to_string(TriangleMesh::kMaxTriangles) +
@@ -186,7 +228,7 @@ void checkObjIndex(std::string_view token, std::string_view part, const char* wh
         fail(place() + what + " index " + std::to_string(*i) + " is out of range (the file has " +
              std::to_string(total) + " " + plural + ")");
     }
-    if (*i < 0 && -*i > soFar) {
+    if (*i < 0 && *i < -soFar) { // not -*i: INT64_MIN has no negation
         fail(place() + "relative " + what + " index " + std::to_string(*i) +
              " is out of range (only " + std::to_string(soFar) + " " + plural +
              " come before this line)");
@@ -222,22 +264,70 @@ void readAsAssimpDoes(std::string_view line, std::string_view key, const Place& 
     }
 }
 
-} // namespace
-
-void checkObj(std::string_view text, const std::string& name) {
-    refuseNul(text, name, "an OBJ text file");
-    // assimp also ends an OBJ line at a carriage return or a form feed, so one inside a line
-    // would split its statement.
-    for (std::size_t i = text.find_first_of("\r\f"); i != std::string_view::npos;
-         i = text.find_first_of("\r\f", i + 1)) {
-        if (text[i] == '\f' || (i + 1 < text.size() && text[i + 1] != '\n')) {
-            const auto line = 1 + std::count(text.begin(), text.begin() + i, '\n');
-            fail(atLine(name, static_cast<std::size_t>(line)) +
-                 (text[i] == '\f' ? "a form feed" : "a carriage return") +
-                 " inside a line (assimp would end the line there; lines end with \\n or "
-                 "\\r\\n)");
+/// A `v` line's x y z [w], already read as numbers: each coordinate passes floatProblem, a
+/// weight w is not 0 as a float (assimp divides x y z by it, in floats), and every x / w
+/// passes coordinateProblem at `scale`.
+template <class Place>
+void checkObjVertex(const std::vector<std::string_view>& tok, double scale, const Place& place) {
+    double w = 1.0;
+    if (tok.size() == 5) {
+        w = *parseNumber(tok[4]);
+        if (const std::string p = floatProblem(w); !p.empty()) {
+            fail(place() + "the vertex's weight w " + quoted(tok[4]) + " " + p);
+        }
+        if (static_cast<float>(w) == 0.0f) {
+            fail(place() + "the vertex's weight w is 0" +
+                 (w == 0.0 ? std::string() : " as a 32-bit float (" + quoted(tok[4]) + ")") +
+                 " (x y z are divided by it)");
         }
     }
+    for (std::size_t k = 1; k <= 3; ++k) {
+        const double v = *parseNumber(tok[k]);
+        std::string p = floatProblem(v);
+        if (p.empty()) {
+            p = coordinateProblem(v / w, scale);
+            if (!p.empty() && tok.size() == 5) {
+                p = "divided by the weight w " + quoted(tok[4]) + " " + p;
+            }
+        }
+        if (!p.empty()) {
+            fail(place() + "vertex coordinate " + quoted(tok[k]) + " " + p);
+        }
+    }
+}
+
+/// Refuses the characters assimp reads otherwise than the checks: it ends an OBJ line at a
+/// carriage return or a form feed, so one inside a line would split its statement, and does
+/// not take a vertical tab for a space, so one would join two words.
+void checkObjCharacters(std::string_view text, const std::string& name) {
+    for (std::size_t i = text.find_first_of("\r\f\v"); i != std::string_view::npos;
+         i = text.find_first_of("\r\f\v", i + 1)) {
+        if (text[i] != '\r' || (i + 1 < text.size() && text[i + 1] != '\n')) {
+            const auto line = 1 + std::count(text.begin(), text.begin() + i, '\n');
+            fail(atLine(name, static_cast<std::size_t>(line)) +
+                 (text[i] == '\v'   ? "a vertical tab (assimp would not read it as a space but "
+                                      "as part of a word; separate values with spaces or tabs)"
+                  : text[i] == '\f' ? "a form feed inside a line (assimp would end the line "
+                                      "there; lines end with \\n or \\r\\n)"
+                                    : "a carriage return inside a line (assimp would end the "
+                                      "line there; lines end with \\n or \\r\\n)"));
+        }
+    }
+}
+
+} // namespace
+
+void blankObjComments(std::string& text) {
+    for (std::size_t i = text.find('#'); i != std::string::npos; i = text.find('#', i)) {
+        for (; i < text.size() && text[i] != '\n' && text[i] != '\r' && text[i] != '\0'; ++i) {
+            text[i] = ' ';
+        }
+    }
+}
+
+void checkObj(std::string_view text, const std::string& name, double scale) {
+    refuseNul(text, name, "an OBJ text file");
+    checkObjCharacters(text, name);
     std::vector<std::string_view> tok;
     ObjCounts total;
     forEachObjLine(text, [&](std::size_t, std::string_view line) {
@@ -289,16 +379,7 @@ void checkObj(std::string_view text, const std::string& name) {
         };
         if (key == "v") {
             numbers({3, 4, 6}, "x y z, x y z w or x y z r g b");
-            const std::size_t n = tok.size() == 5 ? 4 : 3; // x y z w; or x y z r g b
-            for (std::size_t k = 1; k <= n; ++k) {
-                const auto v = parseNumber(tok[k]);
-                if (!std::isfinite(*v)) {
-                    fail(place() + "vertex coordinate " + quoted(tok[k]) + " is not finite");
-                }
-                if (k == 4 && *v == 0.0) {
-                    fail(place() + "the vertex's weight w is 0 (x y z are divided by it)");
-                }
-            }
+            checkObjVertex(tok, scale, place);
             ++seen.v;
         } else if (key == "vt") {
             numbers({2, 3}, "u v or u v w");
@@ -309,14 +390,12 @@ void checkObj(std::string_view text, const std::string& name) {
         } else if (key == "f" || key == "l" || key == "p") {
             // Lines and points make no triangles, but assimp reads their indices too.
             const std::size_t least = key == "f" ? 3 : key == "l" ? 2 : 1;
+            const char* what = key == "f" ? "face" : key == "l" ? "line" : "point";
             if (tok.size() < least + 1) {
-                fail(place() + "a " +
-                     (key == "f"   ? "face"
-                      : key == "l" ? "line"
-                                   : "point") +
-                     " needs at least " + std::to_string(least) + " vertices, got " +
-                     std::to_string(tok.size() - 1));
+                fail(place() + "a " + what + " needs at least " + std::to_string(least) +
+                     " vertices, got " + std::to_string(tok.size() - 1));
             }
+            checkFaceSize(tok.size() - 1, place(), what);
             for (std::size_t k = 1; k < tok.size(); ++k) {
                 const std::string_view t = tok[k];
                 const std::size_t s1 = t.find('/');
@@ -372,28 +451,27 @@ float readF32le(const char* p) {
 
 constexpr const char* kAxis[3] = {"x", "y", "z"};
 
-void checkBinaryStl(std::string_view b, std::uint32_t count, const std::string& name) {
-    if (count == 0) {
-        fail(name + ": no triangles (the binary STL header declares 0 facets)");
-    }
-    checkTriangleLimit(count, name);
+void checkBinaryStl(std::string_view b, std::uint32_t count, const std::string& name,
+                    double scale) {
     for (std::uint64_t f = 0; f < count; ++f) {
         const std::uint64_t facet = 84 + 50 * f;
         for (int v = 0; v < 3; ++v) {
             for (int c = 0; c < 3; ++c) {
                 const std::uint64_t at = facet + 12 + 12 * v + 4 * c;
                 const float x = readF32le(b.data() + at);
-                if (!std::isfinite(x)) {
+                if (const std::string p = coordinateProblem(x, scale); !p.empty()) {
                     fail(atByte(name, at) + "facet " + std::to_string(f) + ", vertex " +
-                         std::to_string(v) + ": " + kAxis[c] + " is not finite (" +
-                         (std::isnan(x) ? "NaN" : "infinite") + ")");
+                         std::to_string(v) + ": " + kAxis[c] + " " + p +
+                         (std::isfinite(x) ? ""
+                          : std::isnan(x)  ? " (NaN)"
+                                           : " (infinite)"));
                 }
             }
         }
     }
 }
 
-void checkAsciiStl(std::string_view text, const std::string& name) {
+void checkAsciiStl(std::string_view text, const std::string& name, double scale) {
     for (std::size_t i = 0; i < text.size(); ++i) {
         const auto c = static_cast<unsigned char>(text[i]);
         if (c == 0 || (c < 32 && !isSpace(static_cast<char>(c)) && c != '\n')) {
@@ -428,9 +506,8 @@ void checkAsciiStl(std::string_view text, const std::string& name) {
                     fail(place() + what + std::string(kAxis[c]) + " " + quoted(t) +
                          " is not a number");
                 }
-                if (finite && !std::isfinite(*v)) {
-                    fail(place() + what + std::string(kAxis[c]) + " " + quoted(t) +
-                         " is not finite");
+                if (const std::string p = finite ? coordinateProblem(*v, scale) : ""; !p.empty()) {
+                    fail(place() + what + std::string(kAxis[c]) + " " + quoted(t) + " " + p);
                 }
             }
         };
@@ -500,35 +577,51 @@ void checkAsciiStl(std::string_view text, const std::string& name) {
     }
 }
 
-} // namespace
+enum class StlKind { Binary, Ascii };
 
-void checkStl(std::string_view bytes, const std::string& name) {
-    // Told apart as assimp's STLImporter does: binary when the size matches the count.
-    if (bytes.size() >= 84) {
-        const std::uint32_t count = readU32le(bytes.data() + 80);
-        if (bytes.size() == 84 + 50 * static_cast<std::uint64_t>(count)) {
-            checkBinaryStl(bytes, count, name);
-            return;
+/// Tells binary STL from ASCII as assimp's STLImporter does, from the first bytes and the size
+/// alone: binary when the size is 84 + 50 n for the header's count n (which must be 1 to the
+/// triangle limit), else ASCII when it begins with 'solid' (after white space). `head` holds
+/// the first bytes (at least 84 of them, or the whole file); a head of only white space, when
+/// more follows, is taken for ASCII, for the whole file's check to decide.
+StlKind stlKind(std::string_view head, std::uint64_t size, const std::string& name) {
+    if (size >= 84 && head.size() >= 84) {
+        const std::uint32_t count = readU32le(head.data() + 80);
+        if (size == 84 + 50 * static_cast<std::uint64_t>(count)) {
+            if (count == 0) {
+                fail(name + ": no triangles (the binary STL header declares 0 facets)");
+            }
+            checkTriangleLimit(count, name);
+            return StlKind::Binary;
         }
     }
     std::size_t i = 0;
-    while (i < bytes.size() && (isSpace(bytes[i]) || bytes[i] == '\n')) {
+    while (i < head.size() && (isSpace(head[i]) || head[i] == '\n')) {
         ++i;
     }
-    if (bytes.substr(i, 5) == "solid") {
-        checkAsciiStl(bytes, name);
-        return;
+    if (head.substr(i, 5) == "solid" || (i == head.size() && head.size() < size)) {
+        return StlKind::Ascii;
     }
-    if (bytes.size() < 84) {
-        fail(name + ": " + std::to_string(bytes.size()) +
+    if (size < 84) {
+        fail(name + ": " + std::to_string(size) +
              " bytes: not ASCII STL (it does not begin with 'solid') and too short for binary "
              "STL (an 84-byte header, then 50 bytes per facet)");
     }
-    const std::uint32_t count = readU32le(bytes.data() + 80);
+    const std::uint32_t count = readU32le(head.data() + 80);
     fail(name + ": not ASCII STL (it does not begin with 'solid'), and as binary STL its size, " +
-         std::to_string(bytes.size()) + " bytes, is not the 84 + 50 x " + std::to_string(count) +
-         " = " + std::to_string(84 + 50 * static_cast<std::uint64_t>(count)) +
+         std::to_string(size) + " bytes, is not the 84 + 50 x " + std::to_string(count) + " = " +
+         std::to_string(84 + 50 * static_cast<std::uint64_t>(count)) +
          " bytes its header's facet count (bytes 80..83) declares (truncated or padded?)");
+}
+
+} // namespace
+
+void checkStl(std::string_view bytes, const std::string& name, double scale) {
+    if (stlKind(bytes, bytes.size(), name) == StlKind::Binary) {
+        checkBinaryStl(bytes, readU32le(bytes.data() + 80), name, scale);
+    } else {
+        checkAsciiStl(bytes, name, scale);
+    }
 }
 
 namespace {
@@ -733,7 +826,7 @@ private:
 
 } // namespace
 
-void checkPly(std::string_view bytes, const std::string& name) {
+void checkPly(std::string_view bytes, const std::string& name, double scale) {
     // The header: lines up to end_header.
     std::vector<PlyElement> elements;
     std::optional<PlyFormat> format;
@@ -760,7 +853,11 @@ void checkPly(std::string_view bytes, const std::string& name) {
             }
             continue;
         }
-        if (tok.empty() || tok[0] == "comment" || tok[0] == "obj_info") {
+        if (tok.empty()) {
+            fail(place() + "a blank line in the PLY header (the format has none, and assimp 5.2.5 "
+                           "misreads some: remove it)");
+        }
+        if (tok[0] == "comment" || tok[0] == "obj_info") {
             continue;
         }
         if (tok[0] == "format") {
@@ -890,8 +987,9 @@ void checkPly(std::string_view bytes, const std::string& name) {
                     if (&e == vertex &&
                         (static_cast<int>(k) == xyz[0] || static_cast<int>(k) == xyz[1] ||
                          static_cast<int>(k) == xyz[2])) {
-                        if (!std::isfinite(*value)) {
-                            fail(place() + what() + ": " + p.name + " is not finite");
+                        if (const std::string problem = coordinateProblem(*value, scale);
+                            !problem.empty()) {
+                            fail(place() + what() + ": " + p.name + " " + problem);
                         }
                     }
                     continue;
@@ -904,6 +1002,9 @@ void checkPly(std::string_view bytes, const std::string& name) {
                 if (isIndices && n < 3) {
                     fail(place() + what() + ": a face needs at least 3 vertices, got " +
                          std::to_string(static_cast<long long>(n)));
+                }
+                if (isIndices) {
+                    checkFaceSize(static_cast<std::uint64_t>(n), place() + what() + ": ", "face");
                 }
                 for (std::uint64_t j = 0; j < static_cast<std::uint64_t>(n); ++j) {
                     mark = r.mark();
@@ -930,6 +1031,24 @@ void checkPly(std::string_view bytes, const std::string& name) {
         fail(r.place(r.mark()) + "data after the last element the header declares (" +
              std::to_string(face->count) + " faces, " + std::to_string(vertex->count) +
              " vertices)");
+    }
+}
+
+void checkHead(MeshFormat format, std::string_view head, std::uint64_t size,
+               const std::string& name) {
+    if (size == 0) {
+        return; // empty, or a file that reports no size (/proc): the whole file's check decides
+    }
+    switch (format) {
+    case MeshFormat::Obj:
+        refuseNul(head, name, "an OBJ text file");
+        break;
+    case MeshFormat::Stl:
+        stlKind(head, size, name);
+        break;
+    case MeshFormat::Ply:
+        refuseNul(head.substr(0, head.find("end_header")), name, "a PLY file (its header is text)");
+        break;
     }
 }
 

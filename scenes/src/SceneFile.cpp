@@ -18,6 +18,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -171,6 +172,14 @@ std::shared_ptr<const TriangleMesh> makeInlineMesh(const Source& w, const Path& 
         if (!finite(scaled)) {
             w.fail(vp[i], "the vertex times the scale " + show(scale) + " is not finite");
         }
+        const double out = std::max({std::abs(scaled.x), std::abs(scaled.y), std::abs(scaled.z)});
+        if (out > TriangleMesh::kMaxCoordinate) {
+            w.fail(vp[i], std::string("the vertex") +
+                              (scale == 1.0 ? "" : " times the scale " + show(scale)) + " lies " +
+                              show(out) + " m out, beyond the " +
+                              show(TriangleMesh::kMaxCoordinate) +
+                              " m a mesh vertex may lie from its origin");
+        }
         vertices[i] = scaled;
     }
     const std::size_t count = vertices.size();
@@ -308,6 +317,10 @@ std::shared_ptr<const TriangleMesh> parseFileMesh(const Source& w, const Json& j
     const std::string file = string(w, required(w, j, path, "file"), fp);
     if (file.empty()) {
         w.fail(fp, "expected the model file's path (relative to the scene file), got \"\"");
+    }
+    if (const std::size_t nul = file.find('\0'); nul != std::string::npos) {
+        w.fail(fp, "a NUL character (\\u0000) in the model file's path, at character " +
+                       std::to_string(nul) + " (the system would read the path only up to it)");
     }
     try {
         return loadModel(context.models, context.baseDir, file, scale);
@@ -466,10 +479,29 @@ template <class Flush> void appendMesh(std::string& out, const TriangleMesh& mes
     out += ']';
 }
 
+/// Refuses a NUL byte in a JSON scene's text (JSON has none: a control character must be
+/// escaped even in a string), naming its line, column and byte; the parser would stop there
+/// with "unexpected end of input". [control]
+void refuseNulInJson(std::string_view text, std::string_view sourceName) {
+    const void* p = std::memchr(text.data(), '\0', text.size());
+    if (!p) {
+        return;
+    }
+    const auto at = static_cast<std::size_t>(static_cast<const char*>(p) - text.data());
+    const std::string_view before = text.substr(0, at);
+    const auto line = 1 + std::count(before.begin(), before.end(), '\n');
+    const std::size_t column = at - (before.rfind('\n') + 1) + 1; // npos + 1 is 0
+    throw InputError(std::string(sourceName) + ":" + std::to_string(line) + ":" +
+                     std::to_string(column) + ": not valid JSON: a NUL byte (byte " +
+                     std::to_string(at) +
+                     "); a scene file is JSON text or a binary hapto scene (HAPTOSCN)");
+}
+
 } // namespace
 
 Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
                         const std::filesystem::path& baseDir) {
+    refuseNulInJson(text, sourceName);
     const Source w(sourceName);
     const Path top;
     const Path objectsPath = top / "objects";
@@ -593,12 +625,19 @@ namespace {
 /// the end, and finds them in the string's capacity instead of copying the text.
 constexpr std::size_t kReadPadding = 64;
 
+/// How much of a scene file is looked at for a NUL byte before it is read whole (bytes).
+constexpr std::size_t kHeadBytes = 4096;
+
 /// The scene file's bytes, read once into a string of exactly their size (a file that reports
-/// no size, as in /proc, is read as it comes). [control]
+/// no size, as in /proc, is read as it comes). A JSON scene with a NUL byte in its first
+/// kHeadBytes (a file of zeros) is refused before it is read whole. [control]
 std::string readSceneFile(const std::filesystem::path& path) {
     InputFile file(path, "scene file");
     if (file.size() == 0) {
         return file.readAll();
+    }
+    if (const std::string head = file.readHead(kHeadBytes); !isBinaryScene(head)) {
+        refuseNulInJson(head, path.string());
     }
     std::string text;
     text.reserve(file.size() + kReadPadding);

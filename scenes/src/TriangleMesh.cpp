@@ -2,8 +2,11 @@
 
 #include "hapto/core/Finite.h"
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/JsonInput.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -27,6 +30,96 @@ bool degenerate(const TriangleIndices& t, std::span<const Vec3> v) {
     const double longest2 = std::max({glm::dot(e0, e0), glm::dot(e1, e1), glm::dot(e2, e2)});
     const Vec3 c = glm::cross(e0, e1);
     return !(glm::dot(c, c) > kDegenerateRelative2 * longest2 * longest2);
+}
+
+/// A triangle's corner positions in lexicographic order, -0 read as +0: two triangles with the
+/// same three corner positions, in any order, have equal keys.
+using CornerKey = std::array<Vec3, 3>;
+
+CornerKey cornerKey(const TriangleIndices& t, std::span<const Vec3> v) {
+    CornerKey k{v[t[0]] + Vec3(0.0), v[t[1]] + Vec3(0.0), v[t[2]] + Vec3(0.0)};
+    const auto less = [](const Vec3& a, const Vec3& b) {
+        return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+    };
+    if (less(k[1], k[0])) {
+        std::swap(k[0], k[1]);
+    }
+    if (less(k[2], k[1])) {
+        std::swap(k[1], k[2]);
+    }
+    if (less(k[1], k[0])) {
+        std::swap(k[0], k[1]);
+    }
+    return k;
+}
+
+std::uint64_t hashOf(const CornerKey& k) {
+    std::uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (const Vec3& p : k) {
+        for (int i = 0; i < 3; ++i) {
+            h = (h ^ std::bit_cast<std::uint64_t>(p[i])) * 0xFF51AFD7ED558CCDull;
+            h ^= h >> 32;
+        }
+    }
+    return h;
+}
+
+/// Keeps the first of every set of triangles with the same corner positions (in any order) and
+/// returns how many others it dropped. Open addressing in a table of at least twice as many
+/// slots as triangles, each holding a kept triangle's position: O(n) expected, 8 bytes or
+/// less per triangle.
+std::uint64_t dropDuplicates(std::vector<TriangleIndices>& triangles, std::span<const Vec3> v) {
+    constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
+    std::size_t slots = 16;
+    while (slots < 2 * triangles.size()) {
+        slots *= 2;
+    }
+    std::vector<std::uint32_t> table(slots, kEmpty);
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        const CornerKey key = cornerKey(triangles[i], v);
+        std::size_t slot = hashOf(key) & (slots - 1);
+        while (table[slot] != kEmpty && cornerKey(triangles[table[slot]], v) != key) {
+            slot = (slot + 1) & (slots - 1);
+        }
+        if (table[slot] == kEmpty) {
+            table[slot] = static_cast<std::uint32_t>(kept);
+            triangles[kept++] = triangles[i];
+        }
+    }
+    const std::uint64_t dropped = triangles.size() - kept;
+    triangles.resize(kept);
+    return dropped;
+}
+
+/// Refuses a vertex beyond kMaxCoordinate, and triangles whose corners span less than
+/// kMinSize (but are not all one point: those are degenerate).
+void checkExtent(std::span<const Vec3> vertices, std::span<const TriangleIndices> triangles,
+                 double scale, const std::string& where) {
+    const std::string scaled = scale == 1.0 ? "" : " (after the scale " + json::show(scale) + ")";
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const Vec3& p = vertices[i];
+        if (std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) >
+            TriangleMesh::kMaxCoordinate) {
+            throw InputError(where + ": vertices[" + std::to_string(i) + "] (" + json::show(p.x) +
+                             ", " + json::show(p.y) + ", " + json::show(p.z) + ")" + scaled +
+                             " lies beyond " + json::show(TriangleMesh::kMaxCoordinate) +
+                             " m from the mesh's origin, the farthest a mesh vertex may be");
+        }
+    }
+    Aabb box = Aabb::empty();
+    for (const TriangleIndices& t : triangles) {
+        for (const std::uint32_t i : t) {
+            box.expand(vertices[i]);
+        }
+    }
+    const Vec3 size = triangles.empty() ? Vec3(0.0) : box.size();
+    const double across = std::max({size.x, size.y, size.z});
+    if (across > 0.0 && across < TriangleMesh::kMinSize) {
+        throw InputError(where + ": the mesh is " + json::show(across) + " m across" + scaled +
+                         ", less than the " + json::show(TriangleMesh::kMinSize) +
+                         " m a mesh must span");
+    }
 }
 
 /// True when every undirected edge is used by exactly two triangles.
@@ -74,19 +167,22 @@ std::shared_ptr<const TriangleMesh> TriangleMesh::make(std::vector<Vec3> vertice
                              "] is not finite (after scaling)");
         }
     }
-    auto mesh = std::shared_ptr<TriangleMesh>(new TriangleMesh());
-    mesh->mSource = std::move(source);
-    std::size_t kept = 0;
     for (std::size_t i = 0; i < triangles.size(); ++i) {
-        const TriangleIndices t = triangles[i];
         for (int k = 0; k < 3; ++k) {
-            if (t[k] >= vertices.size()) {
+            if (triangles[i][k] >= vertices.size()) {
                 throw InputError(where + ": triangles[" + std::to_string(i) + "][" +
-                                 std::to_string(k) + "]: vertex index " + std::to_string(t[k]) +
+                                 std::to_string(k) + "]: vertex index " +
+                                 std::to_string(triangles[i][k]) +
                                  " is out of range (the mesh has " +
                                  std::to_string(vertices.size()) + " vertices)");
             }
         }
+    }
+    checkExtent(vertices, triangles, source.scale, where);
+    auto mesh = std::shared_ptr<TriangleMesh>(new TriangleMesh());
+    mesh->mSource = std::move(source);
+    std::size_t kept = 0;
+    for (const TriangleIndices& t : triangles) {
         if (degenerate(t, vertices)) {
             ++mesh->mDropped;
             continue;
@@ -94,6 +190,7 @@ std::shared_ptr<const TriangleMesh> TriangleMesh::make(std::vector<Vec3> vertice
         triangles[kept++] = t;
     }
     triangles.resize(kept);
+    mesh->mDuplicates = dropDuplicates(triangles, vertices);
     if (triangles.empty()) {
         throw InputError(where + ": no triangles" +
                          (mesh->mDropped > 0

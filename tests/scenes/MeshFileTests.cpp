@@ -16,6 +16,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <vector>
 
@@ -265,6 +266,13 @@ TEST_CASE("bad model files are refused with the file and the place") {
     std::string truncatedPly = binaryPly(kTet, kTetFaces);
     truncatedPly.resize(truncatedPly.size() - 3);
     std::string negativePly = binaryPly(kTet, {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, -1}});
+    std::string hugeFace;
+    std::string hugePlyFace = "40000";
+    for (int i = 0; i < 40000; ++i) {
+        hugeFace += " " + std::to_string(1 + i % 3);
+        hugePlyFace += " " + std::to_string(i % 3);
+    }
+    hugePlyFace += "\n";
     // end_header followed by a tab, and no newline anywhere in the body: the checker once read
     // its body from past the end of the file (found by fuzz_mesh_file, under ASan).
     std::string tabPly = binaryPly(kTet, kTetFaces);
@@ -367,6 +375,39 @@ TEST_CASE("bad model files are refused with the file and the place") {
          "float y\nproperty float z\nend_header\n0 0 0\n",
          "no triangles (the PLY header declares no 'face' element)"},
         {"notply.ply", "solid t\n", ":1: not a PLY file"},
+        // Float overflow, found by attacking it: assimp reads coordinates as 32-bit floats, and
+        // the infinity it made was reported with the wrong coordinates and no line.
+        {"float.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n",
+         ":2: vertex coordinate '1e39' is beyond the largest 32-bit float"},
+        {"float.stl",
+         "solid t\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1e308 0 0\n"
+         "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n",
+         ":5: x '1e308' is beyond the largest 32-bit float"},
+        {"double.ply",
+         "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+         "property double z\nelement face 1\nproperty list uchar int vertex_indices\n"
+         "end_header\n0 0 0\n1 0 0\n0 1e300 0\n3 0 1 2\n",
+         ":12: vertex element 2: y is beyond the largest 32-bit float"},
+        // Farther than a mesh vertex may be (TriangleMesh::kMaxCoordinate), before degenerate
+        // triangles could take the blame for the overflow in their area.
+        {"far.obj", "v 0 0 0\nv 1e20 0 0\nv 0 1 0\nf 1 2 3\n",
+         ":2: vertex coordinate '1e20' times the scale 1 is 1e+20 m, beyond the 1e+09 m"},
+        // A weight that is 0 as a float: assimp's "Division by zero", with no line.
+        {"weight.obj", "v 0 0 0 1e-320\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+         ":1: the vertex's weight w is 0 as a 32-bit float ('1e-320')"},
+        {"min-index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9223372036854775808\n",
+         ":4: relative vertex index -9223372036854775808 is out of range"},
+        {"vtab.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1\v2 3\n", ":4: a vertical tab"},
+        {"huge-face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf" + hugeFace + "\n",
+         ":4: a face of 40000 vertices; assimp reads at most 32767"},
+        {"huge-face.ply", plyHeader("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n" + hugePlyFace,
+         ":14: face element 0: a face of 40000 vertices; assimp reads at most 32767"},
+        // A blank header line: assimp 5.2.5 refused this one ("Missing format specification").
+        {"blank.ply",
+         "ply\n \r\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float "
+         "y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+         "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+         ":2: a blank line in the PLY header"},
         {"model.3ds", "anything", "unknown model format '.3ds' (hapto reads .obj, .stl and .ply)"},
     };
     for (const Case& c : cases) {
@@ -387,9 +428,87 @@ TEST_CASE("bad model files are refused with the file and the place") {
                    Catch::Contains(": byte " + std::to_string(at) +
                                    ": vertex element 1: x is not finite"));
     }
-    // A scale that takes a finite vertex past the largest double.
-    test::writeFile(dir / "big.obj", "v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n");
-    CHECK_THAT(errorOf(dir / "big.obj", 1e10), Catch::Contains("times the scale"));
+    // A scale that takes a vertex farther than a mesh vertex may be, and one so small that
+    // every triangle's area underflows (which once read as "all 4 were degenerate").
+    test::writeFile(dir / "big.obj", "v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n");
+    CHECK_THAT(errorOf(dir / "big.obj", 1e10),
+               Catch::Contains("big.obj:2: vertex coordinate '1e30' times the scale 1e+10 is "
+                               "1e+40 m, beyond the 1e+09 m a mesh vertex may lie"));
+    test::writeFile(dir / "tet.obj", objText(kTet, kTetFaces));
+    CHECK_THAT(errorOf(dir / "tet.obj", 1e-320),
+               Catch::Contains("tet.obj: the mesh is ") &&
+                   Catch::Contains(" m across (after the scale ") &&
+                   Catch::Contains("less than the 1e-09 m a mesh must span"));
+}
+
+TEST_CASE("a comment after a face is read as a comment") {
+    // Legal OBJ that assimp 5.2.5 refused ("Invalid face index", no line): the loader blanks
+    // comments before the check and assimp read the file.
+    test::TempDir dir;
+    test::writeFile(dir / "comment.obj",
+                    "v 0 0 0 # a corner\nv 1 0 0\nv 0 1 0\nf 1 2 3 # c\n# f 1 2 9\n");
+    const auto mesh = loadMeshFile(dir / "comment.obj", MeshSource{"comment.obj", 1.0});
+    CHECK(mesh->triangleCount() == 1);
+    // A NUL in a comment is still a NUL: refused, at its byte.
+    CHECK_THAT(parseErrorOf(std::string("v 0 0 0 #") + '\0' + "\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                            dir / "nul.obj"),
+               Catch::Contains("nul.obj: byte 9: a NUL byte"));
+}
+
+TEST_CASE("duplicate triangles in a model file are dropped and counted") {
+    // The tetrahedron with its first face twice more (once turned, once reversed): the corners
+    // are welded, so the copies name the same vertices.
+    test::TempDir dir;
+    Faces faces = kTetFaces;
+    faces.push_back({2, 1, 0});
+    faces.push_back({1, 0, 2});
+    test::writeFile(dir / "dup.stl", binaryStl(kTet, faces, 6));
+    const auto mesh = loadMeshFile(dir / "dup.stl", MeshSource{"dup.stl", 1.0});
+    CHECK(mesh->triangleCount() == 4);
+    CHECK(mesh->droppedDuplicate() == 2);
+    CHECK(mesh->droppedDegenerate() == 0);
+    CHECK(mesh->closed());
+}
+
+namespace {
+
+/// The process's peak resident memory so far (bytes).
+std::uint64_t peakResidentBytes() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;
+}
+
+} // namespace
+
+TEST_CASE("a 2 GB model file its first bytes refuse is refused without being read") {
+    // A sparse file of 2 GiB of zeros: as binary STL its size does not match its count (0),
+    // and it does not begin with 'solid'. Before, it was read whole (2 GB and more in memory).
+    test::TempDir dir;
+    const std::uint64_t size = std::uint64_t(2) << 30;
+    for (const char* file : {"zeros.stl", "zeros.obj", "zeros.ply"}) {
+        INFO(file);
+        test::writeFile(dir / file, "");
+        std::filesystem::resize_file(dir / file, size);
+        const std::uint64_t before = peakResidentBytes();
+        const std::string message = errorOf(dir / file);
+        CHECK(peakResidentBytes() - before < (std::uint64_t(64) << 20));
+        CHECK_THAT(message, Catch::StartsWith((dir / file).string()));
+        if (std::string(file) == "zeros.stl") {
+            CHECK_THAT(message, Catch::Contains("not ASCII STL (it does not begin with 'solid'), "
+                                                "and as binary STL its size, 2147483648 bytes, "
+                                                "is not the 84 + 50 x 0 = 84 bytes"));
+        } else {
+            CHECK_THAT(message, Catch::Contains(": byte 0: a NUL byte"));
+        }
+        std::filesystem::remove(dir / file);
+    }
+    // A binary STL whose count is past the triangle limit, refused by its header.
+    std::string header(80, ' ');
+    putU32(header, 20000000);
+    test::writeFile(dir / "many.stl", header);
+    std::filesystem::resize_file(dir / "many.stl", 84 + 50 * std::uint64_t(20000000));
+    CHECK_THAT(errorOf(dir / "many.stl"), Catch::Contains("more than 16777216 triangles"));
 }
 
 TEST_CASE("a model file that is missing, a folder or a FIFO is refused without blocking") {

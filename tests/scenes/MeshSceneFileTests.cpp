@@ -191,6 +191,7 @@ TEST_CASE("a mesh scene round-trips through save and load") {
 TEST_CASE("bad mesh objects are refused with the file, the JSON path and the place") {
     test::TempDir dir;
     test::writeFile(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    test::writeFile(dir / "tet.obj", kTetObj);
     const std::string tet = kTetFields;
     struct Case {
         const char* name;
@@ -237,6 +238,27 @@ TEST_CASE("bad mesh objects are refused with the file, the JSON path and the pla
          scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0], "scale": 1e300,
              "vertices": [[0,0,0],[1e10,0,0],[0,1,0]], "triangles": [[0,1,2]]})"),
          "bad.json: objects[0].vertices[1]: the vertex times the scale 1e+300 is not finite"},
+        // Found by attacking it: scales and vertices whose triangles' areas over- or underflow
+        // were refused as "no triangles left (all 4 were degenerate)".
+        {"a scale that takes a vertex too far",
+         scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0], "scale": 1e300, )" + tet + "}"),
+         "bad.json: objects[0].vertices[1]: the vertex times the scale 1e+300 lies 1e+300 m out, "
+         "beyond the 1e+09 m a mesh vertex may lie from its origin"},
+        {"vertices at 1e308", scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0],
+             "vertices": [[1e308,0,0],[-1e308,0,0],[0,1,0]], "triangles": [[0,1,2]]})"),
+         "bad.json: objects[0].vertices[0]: the vertex lies 1e+308 m out, beyond the 1e+09 m"},
+        {"a scale that shrinks the mesh to nothing",
+         scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0], "scale": 1e-320, )" + tet + "}"),
+         "bad.json: objects[0]: the mesh is "},
+        {"a scale that shrinks a model file to nothing",
+         scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0], "scale": 1e-320,
+             "file": "tet.obj"})"),
+         "bad.json: objects[0].file: " + (dir / "tet.obj").string() + ": the mesh is "},
+        // A NUL cut the path (and the message) short: "tet.obj\u0000.stl" was read as STL.
+        {"a NUL in the file's name",
+         scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0], "file": "tet.obj\u0000.stl"})"),
+         "bad.json: objects[0].file: a NUL character (\\u0000) in the model file's path, at "
+         "character 7"},
         {"scale 0",
          scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0], "scale": 0, )" + tet + "}"),
          "bad.json: objects[0].scale: the scale must be > 0"},
@@ -275,6 +297,34 @@ TEST_CASE("bad mesh objects are refused with the file, the JSON path and the pla
         INFO(c.name);
         CHECK_THAT(errorOf(c.text, dir.path()), Catch::Contains(c.expected));
     }
+}
+
+TEST_CASE("duplicate triangles are dropped and counted, however their corners are ordered") {
+    // 250,000 copies of one triangle loaded as 250,000 triangles, and a run over them took
+    // 811 MB and faulted both hands. Copies by the same indices, turned, reversed, or through
+    // other vertices at the same positions are one triangle.
+    std::string triangles = "[0,1,2]";
+    for (int i = 1; i < 250000; ++i) {
+        triangles += ",[0,1,2]";
+    }
+    const Scene many = parseScene(scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0],
+        "vertices": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [)" +
+                                         triangles + "]}"),
+                                  "many.json");
+    CHECK(many.object(0).mesh->triangleCount() == 1);
+    CHECK(many.object(0).mesh->droppedDuplicate() == 249999);
+    const Scene turned = parseScene(scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0],
+        "vertices": [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[0,-0.0,0],[1,0,0]],
+        "triangles": [[0,2,1],[0,1,3],[0,3,2],[1,2,3],[2,1,0],[1,0,2],[4,5,2],[0,1,2]]})"),
+                                    "turned.json");
+    const TriangleMesh& mesh = *turned.object(0).mesh;
+    CHECK(mesh.triangleCount() == 4);
+    CHECK(mesh.droppedDuplicate() == 4);
+    CHECK(mesh.droppedDegenerate() == 0);
+    CHECK(mesh.closed());
+    // The first of each is kept, in order.
+    CHECK(mesh.triangles()[0] == TriangleIndices{0, 2, 1});
+    CHECK(mesh.triangles()[3] == TriangleIndices{1, 2, 3});
 }
 
 TEST_CASE("the README's inline mesh loads, and the README shows it as tested") {

@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <regex>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -377,4 +378,42 @@ TEST_CASE("input files are read whole up to a size limit, and refused above it")
     // Files that report size 0 (as /proc does) are still read to their end.
     CHECK_THAT(InputFile("/proc/self/status", "test file").readAll(), Catch::Contains("Name:"));
     CHECK(kMaxInputFileBytes == std::uint64_t(4) << 30);
+}
+
+TEST_CASE("a NUL byte in a JSON scene is named with its line, column and byte") {
+    // Before, nlohmann stopped at the NUL: "1:1: ... unexpected end of input".
+    const std::string text = std::string("{\"format\": \"hapto-scene\",\n  ") + '\0' +
+                             "\"version\": 1, \"objects\": []}";
+    CHECK(errorOf(text) == "bad.json:2:3: not valid JSON: a NUL byte (byte 28); a scene file is "
+                           "JSON text or a binary hapto scene (HAPTOSCN)");
+}
+
+TEST_CASE("a 2 GB scene file of zeros is refused from its first bytes, not read whole") {
+    // Before, it was read whole (2.1 GB) and refused as "1:1: unexpected end of input".
+    test::TempDir dir;
+    const auto path = dir / "zeros.json";
+    test::writeFile(path, "");
+    std::filesystem::resize_file(path, std::uint64_t(2) << 30);
+    rusage before{};
+    getrusage(RUSAGE_SELF, &before);
+    CHECK(loadError(path) == path.string() +
+                                 ":1:1: not valid JSON: a NUL byte (byte 0); a scene file is JSON "
+                                 "text or a binary hapto scene (HAPTOSCN)");
+    rusage after{};
+    getrusage(RUSAGE_SELF, &after);
+    CHECK(after.ru_maxrss - before.ru_maxrss < 64 * 1024); // KiB: less than 64 MiB more
+}
+
+TEST_CASE("InputFile reads a file's head without moving where readAll starts") {
+    test::TempDir dir;
+    const auto path = dir / "ten.txt";
+    test::writeFile(path, "0123456789");
+    InputFile file(path, "test file");
+    CHECK(file.readHead(4) == "0123");
+    CHECK(file.readHead(40) == "0123456789");
+    CHECK(file.readAll() == "0123456789");
+    // A path holding a NUL byte is refused, not cut short at it.
+    const std::string nul = (dir / "ten.txt").string() + std::string(1, '\0') + ".json";
+    CHECK_THROWS_WITH(InputFile(nul, "test file"),
+                      Catch::Contains("ten.txt\\0.json: a NUL byte (\\0) in the test file's path"));
 }

@@ -24,7 +24,8 @@ inline constexpr std::uint64_t kMaxInputFileBytes = std::uint64_t(4) << 30;
 class InputFile {
 public:
     /// Opens and checks `path`; `what` names it in messages ("scene file"). Throws InputError
-    /// naming the path and the reason. [control]
+    /// naming the path and the reason (a path holding a NUL byte, which the system would cut
+    /// there, is refused before anything is opened). [control]
     InputFile(const std::filesystem::path& path, std::string_view what,
               std::uint64_t maxBytes = kMaxInputFileBytes);
     ~InputFile();
@@ -33,6 +34,11 @@ public:
 
     /// The size the file had when opened (bytes). [control]
     std::uint64_t size() const noexcept { return mSize; }
+    /// The file's first `bytes` bytes (fewer when it is shorter), read without moving the
+    /// position readAll() and releaseToStdio() start from: enough to refuse a file by its
+    /// header and size before reading it whole. Throws InputError when reading fails.
+    /// [control]
+    std::string readHead(std::size_t bytes);
     /// Reads the whole file; throws InputError when reading fails or it has grown past the
     /// limit since it was opened. [control]
     std::string readAll();

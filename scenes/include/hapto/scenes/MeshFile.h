@@ -17,15 +17,19 @@ bool isMeshFile(const std::filesystem::path& path);
 /// units times the scale must give metres). `path` is where to open it; `source.file` is how the
 /// scene names it (kept for writing the scene back). Polygons are triangulated, points and
 /// lines ignored, vertices at the same position merged (so triangles sharing an edge share its
-/// vertex indices, across the file's groups and objects too), degenerate triangles dropped and
-/// counted (TriangleMesh::make).
+/// vertex indices, across the file's groups and objects too), degenerate and duplicate
+/// triangles dropped and counted (TriangleMesh::make). A file its first bytes and size refuse
+/// (an STL neither ASCII nor of its header's size, a NUL byte in a text format) is refused
+/// before it is read whole.
 ///
 /// Throws InputError naming the file and, where the format has one, the place ("m.obj:12:
 /// vertex index 9 is out of range (the file has 8 vertices)", "m.stl: byte 146: facet 1, vertex
 /// 0: x is not finite (NaN)", "m.ply:14: face element 3: ...") for: a file that is missing,
 /// unreadable or not a regular file (a folder, a FIFO...), an unknown extension, a file its
-/// format's reader refuses, a non-finite vertex (or one the scale makes non-finite), an index
-/// out of range, no triangles, more than TriangleMesh::kMaxTriangles triangles. [control]
+/// format's reader refuses, a vertex coordinate that is not finite, past a 32-bit float (as
+/// which assimp reads it) or, times the scale, past TriangleMesh::kMaxCoordinate, a mesh less
+/// than TriangleMesh::kMinSize across, an index out of range, a face of more vertices than
+/// assimp reads, no triangles, more than TriangleMesh::kMaxTriangles triangles. [control]
 std::shared_ptr<const TriangleMesh> loadMeshFile(const std::filesystem::path& path,
                                                  MeshSource source);
 

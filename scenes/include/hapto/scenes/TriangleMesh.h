@@ -65,20 +65,32 @@ public:
     static constexpr std::uint32_t kMaxTriangles = 1u << 24;
     /// The most vertices one mesh may have (three per triangle).
     static constexpr std::uint32_t kMaxVertices = 3 * kMaxTriangles;
+    /// The farthest a vertex may lie from its mesh's origin on any axis (m, scale applied):
+    /// 1e9. The degeneracy test takes a triangle's size to the 4th power, which overflows near
+    /// 1e77 m (and the local BVH keeps float bounds, which end at 3.4e38); 1e9 m keeps every
+    /// such product exact in range and is far beyond any haptic scene.
+    static constexpr double kMaxCoordinate = 1e9;
+    /// The smallest a mesh may be across (m, scale applied: the largest side of its vertices'
+    /// box, when they are not all one point): 1e-9. Below about 1e-75 m a triangle's area
+    /// underflows and every triangle would read as degenerate; a nanometre is far below what
+    /// any haptic device resolves.
+    static constexpr double kMinSize = 1e-9;
 
     /// Builds a mesh from local vertices (m, scale applied) and triangles. Drops degenerate
     /// triangles (a repeated vertex, or an area below 1e-24 m^2 relative to the squared longest
-    /// edge) and counts them. Throws InputError, naming `where` and the element (e.g.
-    /// "triangles[12][2]: vertex index 40 is out of range (the mesh has 12 vertices)") for a
-    /// non-finite vertex, an index out of range, too many vertices or triangles, or no
-    /// triangle left. [control]
+    /// edge) and counts them; drops and counts duplicates too (a triangle whose three corners
+    /// are at the positions of an earlier one's, in any order: the first is kept). Throws
+    /// InputError, naming `where` and the element (e.g. "triangles[12][2]: vertex index 40 is
+    /// out of range (the mesh has 12 vertices)") for a non-finite vertex, one beyond
+    /// kMaxCoordinate, vertices spanning less than kMinSize, an index out of range, too many
+    /// vertices or triangles, or no triangle left. [control]
     static std::shared_ptr<const TriangleMesh> make(std::vector<Vec3> vertices,
                                                     std::vector<TriangleIndices> triangles,
                                                     MeshSource source, const std::string& where);
 
     /// The vertices, local frame (m). [any thread]
     std::span<const Vec3> vertices() const noexcept { return mVertices; }
-    /// The triangles kept (degenerate ones dropped). [any thread]
+    /// The triangles kept (degenerate and duplicate ones dropped). [any thread]
     std::span<const TriangleIndices> triangles() const noexcept { return mTriangles; }
     /// Number of triangles kept. [any thread]
     std::uint32_t triangleCount() const noexcept {
@@ -95,6 +107,9 @@ public:
     std::size_t faceBytes() const noexcept { return mFaces.size() * sizeof(TriangleFace); }
     /// Degenerate triangles dropped when the mesh was made. [any thread]
     std::uint64_t droppedDegenerate() const noexcept { return mDropped; }
+    /// Duplicate triangles dropped when the mesh was made (the same three corner positions as
+    /// a triangle kept, in any order). [any thread]
+    std::uint64_t droppedDuplicate() const noexcept { return mDuplicates; }
     /// The tightest local AABB of the vertices used by triangles (m). [any thread]
     const Aabb& localBounds() const noexcept { return mBounds; }
     /// The largest distance from the local origin to a vertex (m): the radius of the bounding
@@ -136,6 +151,7 @@ private:
     Aabb mBounds = Aabb::empty();
     double mRadius = 0.0;
     std::uint64_t mDropped = 0;
+    std::uint64_t mDuplicates = 0;
     bool mClosed = false;
     std::vector<MeshBvhNode> mBvhNodes;   // depth first
     std::vector<std::uint32_t> mBvhOrder; // triangle numbers, each leaf one run
