@@ -54,10 +54,10 @@ TEST_CASE("the trace document: world-frame points and forces, contacts, frames a
         t.samples.push_back(s);
     }
     const auto doc = nlohmann::json::parse(viewTraceJson(scene, {t}, 50.0));
-    CHECK(doc["durationS"].get<double>() == Approx(0.98));
+    CHECK(doc["durationS"].get<double>() == Approx(0.999));
     const auto& frames = doc["devices"][0]["frames"];
     CHECK(doc["devices"][0]["name"] == "left");
-    CHECK(frames.size() == 50); // one per 20 ms
+    CHECK(frames.size() == 51); // one per 20 ms, and the last tick
     bool sawContact = false;
     for (const auto& f : frames) {
         const double t_s = f["t"];
@@ -245,7 +245,7 @@ TEST_CASE("the trace document shows a version 2 trace's proxies in the world fra
     }
     const auto doc = nlohmann::json::parse(viewTraceJson(scene, {t}, 100.0));
     const auto& frames = doc["devices"][0]["frames"];
-    REQUIRE(frames.size() == 10);
+    REQUIRE(frames.size() == 11);
     bool apart = false;
     for (const auto& f : frames) {
         REQUIRE(f.contains("proxy"));
@@ -261,4 +261,103 @@ TEST_CASE("the trace document shows a version 2 trace's proxies in the world fra
     for (const auto& f : old["devices"][0]["frames"]) {
         CHECK_FALSE(f.contains("proxy"));
     }
+}
+
+namespace {
+
+/// One tick as the servo ran it: how late it woke after its deadline and how long it took from
+/// waking to writing its force (ns).
+struct ServoTick {
+    std::uint64_t latenessNs = 2'000;
+    std::uint64_t computeNs = 100'000;
+};
+
+/// The trace a 1 kHz servo records for `ticks` (ServoLoop.cpp): the first deadline
+/// `firstDeadlineNs` into the session, each next one a period on, or past every slot a late
+/// force overran.
+ViewTrace servoTrace(const std::vector<ServoTick>& ticks, std::uint64_t firstDeadlineNs) {
+    constexpr std::uint64_t kPeriodNs = 1'000'000;
+    ViewTrace t;
+    t.header.name = "left";
+    t.header.rateHz = 1000;
+    std::uint64_t deadlineNs = firstDeadlineNs;
+    for (std::uint64_t i = 0; i < ticks.size(); ++i) {
+        TraceSample s;
+        s.tick = i;
+        s.timeNs = deadlineNs + ticks[i].latenessNs;
+        s.computeNs = static_cast<std::uint32_t>(ticks[i].computeNs);
+        t.samples.push_back(s);
+        const std::uint64_t doneNs = s.timeNs + s.computeNs;
+        deadlineNs += kPeriodNs;
+        while (doneNs > deadlineNs) {
+            deadlineNs += kPeriodNs;
+        }
+    }
+    return t;
+}
+
+/// The misses each frame of the trace document's only device shows, with its tick count.
+std::vector<std::pair<std::uint64_t, std::uint64_t>> ticksAndMisses(const ViewTrace& trace) {
+    const Scene scene(Aabb{Vec3(-1.0), Vec3(1.0)}, {});
+    const auto doc = nlohmann::json::parse(viewTraceJson(scene, {trace}, 60.0));
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> out;
+    for (const auto& f : doc["devices"][0]["frames"]) {
+        out.emplace_back(f["ticks"].get<std::uint64_t>(), f["misses"].get<std::uint64_t>());
+    }
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("the trace document counts the misses the runtime counted: a force written after the "
+          "next deadline, the deadlines running from the first tick, which comes 2 ms into the "
+          "session") {
+    std::vector<ServoTick> ticks(2000);
+    ticks[0].latenessNs = 0;           // on its deadline (as in the step mode): the chain is exact
+    ticks[500].computeNs = 1'500'000;  // overruns the next deadline: a miss
+    ticks[900].latenessNs = 2'500'000; // woke 2.5 periods late: a miss
+    ticks[1200].computeNs = 1'000'000 - 2'000;     // written on the next deadline: on time
+    ticks[1300].computeNs = 1'000'000 - 2'000 + 1; // 1 ns after it: a miss
+    const auto frames = ticksAndMisses(servoTrace(ticks, 2'100'000));
+    REQUIRE(frames.size() >= 100);
+    for (const auto& [count, misses] : frames) {
+        const std::uint64_t expected = (count > 500) + (count > 900) + (count > 1300);
+        CHECK(misses == expected);
+    }
+    // The last frame is the last tick: the totals the run's report gives.
+    CHECK(frames.back() == std::pair<std::uint64_t, std::uint64_t>{2000, 3});
+}
+
+TEST_CASE("the trace document's misses: a first tick that woke late and ticks the recorder "
+          "dropped do not move the deadlines") {
+    std::vector<ServoTick> ticks(1000);
+    ticks[0].latenessNs = 60'000;                      // later than any other wake-up
+    ticks[300].computeNs = 1'000'000 - 2'000 + 20'000; // 20 us past the next deadline: a miss
+    ViewTrace trace = servoTrace(ticks, 1'900'000);
+    // Ticks 400 to 599 never reached the file (the recorder's ring was full).
+    trace.samples.erase(trace.samples.begin() + 400, trace.samples.begin() + 600);
+    const auto frames = ticksAndMisses(trace);
+    REQUIRE(frames.size() >= 40);
+    for (const auto& [count, misses] : frames) {
+        CHECK(misses == (count > 300 ? 1u : 0u));
+    }
+    CHECK(frames.back() == std::pair<std::uint64_t, std::uint64_t>{1000, 1});
+}
+
+TEST_CASE("the trace document's misses: after a miss whose force came just after one of the "
+          "servo's slots, the next tick is on time, and two late ticks in a row are two misses") {
+    // Every wake-up 30 us late: the trace cannot place the slots closer than that.
+    std::vector<ServoTick> ticks(1000, ServoTick{30'000, 100'000});
+    // Starved: its force comes 10 us after a slot, so the servo skips that one too (a miss).
+    ticks[300] = {3'000'000 - 20'000, 30'000};
+    // Two late wake-ups in a row, each a miss.
+    ticks[600].latenessNs = 2'500'000;
+    ticks[601].latenessNs = 1'500'000;
+    const auto frames = ticksAndMisses(servoTrace(ticks, 2'000'000));
+    REQUIRE(frames.size() >= 40);
+    for (const auto& [count, misses] : frames) {
+        const std::uint64_t expected = (count > 300) + (count > 600) + (count > 601);
+        CHECK(misses == expected);
+    }
+    CHECK(frames.back() == std::pair<std::uint64_t, std::uint64_t>{1000, 3});
 }

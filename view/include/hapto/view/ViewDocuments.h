@@ -43,12 +43,14 @@ struct ViewTrace {
     std::vector<TraceSample> samples; ///< As recorded (device frame).
 };
 
-/// The recording as frames at `frameHz` (at most one per frame time per device): time (s),
-/// device point, force and (version 2 traces) the god-object proxy in the world frame, the
-/// objects whose solid holds the point (a
-/// god-object device point is inside what it touches), and the load over the last second
-/// (p50, p99.9 of compute time over the period) and the misses so far (a force written after
-/// the next deadline: lateness plus compute beyond one period). [control]
+/// The recording as frames at `frameHz` (at most one per frame time per device, and its last
+/// tick): time (s), device point, force and (version 2 traces) the god-object proxy in the
+/// world frame, the objects whose solid holds the point (a god-object device point is inside
+/// what it touches), and the load over the last second (p50, p99.9 of compute time over the
+/// period) and the misses so far: the runtime's rule (a force written after the next deadline;
+/// the deadlines move past the slots a late force overran) over deadlines rebuilt from the
+/// recorded wake-ups, starting at the first tick's (ViewDocuments.cpp, MissCounter). A trace
+/// records no cursor leaves or candidates; the frames carry none. [control]
 std::string viewTraceJson(const Scene& scene, const std::vector<ViewTrace>& traces,
                           double frameHz = 60.0);
 
