@@ -3,12 +3,17 @@
 #include "hapto/experiments/Plot.h"
 
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/JsonInput.h"
 #include "hapto/scenes/OutputFile.h"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fcntl.h>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -18,25 +23,26 @@
 namespace hapto::experiments {
 namespace {
 
-/// Quotes a string for gnuplot's double-quoted strings.
-std::string gq(const std::string& s) {
+/// A gnuplot string constant holding `s` as plain text, in ASCII: double-quoted, with every byte
+/// that could mean anything to gnuplot written as an octal escape (\ooo): the quotes, the
+/// backslash, the backquote (gnuplot runs `...` as a shell command even inside a string), @
+/// (macros), $, and every byte outside printable ASCII. Control characters are first made
+/// visible by json::printable (a newline shows as \n), so no name or path can end a command.
+/// (Single quotes would need no escapes, but gnuplot 5.4 misreads '' at a string's start or
+/// twice in a row, e.g. '''a'.)
+std::string quoted(const std::string& s) {
+    constexpr std::string_view kSpecial = "\"\\`@$'";
     std::string q = "\"";
-    for (const char c : s) {
-        if (c == '"' || c == '\\') {
-            q += '\\';
+    for (const char ch : json::printable(s)) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c < 0x20 || c > 0x7E || kSpecial.find(ch) != std::string_view::npos) {
+            q += {'\\', static_cast<char>('0' + (c >> 6)), static_cast<char>('0' + ((c >> 3) & 7)),
+                  static_cast<char>('0' + (c & 7))};
+        } else {
+            q += ch;
         }
-        q += c;
     }
     return q + "\"";
-}
-
-/// Quotes a string for /bin/sh.
-std::string shq(const std::string& s) {
-    std::string q = "'";
-    for (const char c : s) {
-        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    }
-    return q + "'";
 }
 
 bool usable(const PlotPanel& p, const std::pair<double, double>& xy) {
@@ -96,15 +102,15 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
                          : std::max<std::size_t>(1, spec.panels.size());
     const std::size_t rows = (spec.panels.size() + columns - 1) / columns;
     if (multi) {
-        s << "set multiplot layout " << rows << "," << columns << " title " << gq(spec.title)
+        s << "set multiplot layout " << rows << "," << columns << " title " << quoted(spec.title)
           << "\n";
     }
     const std::optional<std::pair<double, double>> shared = sharedYRange(spec);
     for (std::size_t i = 0; i < spec.panels.size(); ++i) {
         const PlotPanel& p = spec.panels[i];
         s << "set title "
-          << gq(multi ? p.title : spec.title + (p.title.empty() ? "" : ": ") + p.title) << "\n";
-        s << "set xlabel " << gq(p.xLabel) << "\nset ylabel " << gq(p.yLabel) << "\n";
+          << quoted(multi ? p.title : spec.title + (p.title.empty() ? "" : ": ") + p.title) << "\n";
+        s << "set xlabel " << quoted(p.xLabel) << "\nset ylabel " << quoted(p.yLabel) << "\n";
         s << (p.logX ? "set logscale x\n" : "unset logscale x\n");
         s << (p.logY ? "set logscale y\n" : "unset logscale y\n");
         s << "set grid\nset key below\n";
@@ -114,7 +120,7 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
             for (std::size_t k = 0; k < p.xTics.size(); ++k) {
                 const std::string label =
                     k < p.xTicLabels.size() ? p.xTicLabels[k] : number(p.xTics[k]);
-                s << (k ? ", " : "") << gq(label) << " " << number(p.xTics[k]);
+                s << (k ? ", " : "") << quoted(label) << " " << number(p.xTics[k]);
             }
             s << ")\n";
         } else {
@@ -138,7 +144,7 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
             // A key entry for the shading (a box of its colour drawn nowhere).
             plots.push_back("keyentry with boxes fillcolor rgb '#dddddd' fillstyle solid 1.0 "
                             "title " +
-                            gq(p.spanTitle));
+                            quoted(p.spanTitle));
         }
         for (std::size_t k = 0; k < blocks[i].size(); ++k) {
             if (!blocks[i][k].empty()) {
@@ -146,27 +152,27 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
                 // look in every panel even when another series has no points there.
                 const PlotSeries& series = p.series[k];
                 const int style = series.style > 0 ? series.style : static_cast<int>(k) + 1;
-                plots.push_back(blocks[i][k] + " using 1:2 with " +
-                                (series.linesOnly ? "lines" : "linespoints") + " lc " +
-                                std::to_string(style) +
-                                (series.linesOnly ? "" : " pt " + std::to_string(style)) +
-                                (series.dashed ? " dt 2" : " dt 1") + " title " + gq(series.title));
+                plots.push_back(
+                    blocks[i][k] + " using 1:2 with " +
+                    (series.linesOnly ? "lines" : "linespoints") + " lc " + std::to_string(style) +
+                    (series.linesOnly ? "" : " pt " + std::to_string(style)) +
+                    (series.dashed ? " dt 2" : " dt 1") + " title " + quoted(series.title));
             }
         }
         if (!unstableBlocks[i].empty()) {
             plots.push_back(unstableBlocks[i] +
                             " using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb 'black' title " +
-                            gq(spec.unstableTitle));
+                            quoted(spec.unstableTitle));
         }
         if (p.limitY) {
             plots.push_back(number(*p.limitY) + " with lines dt 3 lc rgb 'red' title " +
-                            gq(p.limitTitle));
+                            quoted(p.limitTitle));
         }
         const std::size_t decorations =
             (p.limitY ? 1u : 0u) + (!p.spans.empty() && !p.spanTitle.empty() ? 1u : 0u);
         if (plots.empty() || plots.size() == decorations) {
             s << "set label 1 'no data' at graph 0.5, 0.5 center\n";
-            plots = {"[1:10] 1/0 notitle"};
+            plots = {"[1:10] [1:2] 3 notitle"}; // above the range (log axes too): nothing drawn
         }
         s << "plot ";
         for (std::size_t k = 0; k < plots.size(); ++k) {
@@ -181,9 +187,8 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
     return s.str();
 }
 
-} // namespace
-
-bool gnuplotAvailable() {
+/// The gnuplot executable on PATH (an absolute path), if any.
+std::optional<std::filesystem::path> gnuplotPath() {
     const char* path = std::getenv("PATH");
     std::istringstream dirs(path ? path : "");
     std::string dir;
@@ -191,10 +196,66 @@ bool gnuplotAvailable() {
         const std::filesystem::path exe =
             std::filesystem::path(dir.empty() ? "." : dir) / "gnuplot";
         if (access(exe.c_str(), X_OK) == 0) {
-            return true;
+            std::error_code ec;
+            const std::filesystem::path absolute = std::filesystem::absolute(exe, ec);
+            return ec ? exe : absolute; // gnuplot starts in another folder
         }
     }
-    return false;
+    return std::nullopt;
+}
+
+/// Runs `gnuplot -e "out='OUT'" SCRIPT` in `dir`, started directly (fork and execv, no shell),
+/// its output to `log`: the only text it reads as code is the script and `outStem`, a name
+/// hapto made. Returns gnuplot's exit code, -1 when it could not start or died on a signal.
+int runGnuplot(const std::filesystem::path& dir, const std::string& script,
+               const std::string& outStem, const std::filesystem::path& log) {
+    const std::optional<std::filesystem::path> exe = gnuplotPath();
+    if (!exe) {
+        return -1;
+    }
+    std::string program = "gnuplot", e = "-e", define = "out=" + quoted(outStem);
+    std::string file = "./" + script; // never read as an option
+    std::array<char*, 5> argv = {program.data(), e.data(), define.data(), file.data(), nullptr};
+    const int logFd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const int nullFd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+    if (logFd < 0 || nullFd < 0) {
+        ::close(logFd);
+        ::close(nullFd);
+        return -1;
+    }
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        // The child: only async-signal-safe calls until execv.
+        if (::chdir(dir.c_str()) == 0 && ::dup2(nullFd, 0) == 0 && ::dup2(logFd, 1) == 1 &&
+            ::dup2(logFd, 2) == 2) {
+            ::execv(exe->c_str(), argv.data());
+        }
+        ::_exit(127);
+    }
+    ::close(logFd);
+    ::close(nullFd);
+    int status = 0;
+    if (pid < 0) {
+        return -1;
+    }
+    while (::waitpid(pid, &status, 0) < 0) {
+        if (errno != EINTR) {
+            return -1;
+        }
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/// A name for temporaries no other drawing in this or another process uses at the same time.
+std::string temporaryStem() {
+    static std::atomic<unsigned> counter{0};
+    return ".hapto-plot.tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+} // namespace
+
+bool gnuplotAvailable() {
+    return gnuplotPath().has_value();
 }
 
 std::optional<std::pair<double, double>> sharedYRange(const PlotSpec& spec) {
@@ -207,8 +268,8 @@ std::optional<std::pair<double, double>> sharedYRange(const PlotSpec& spec) {
 
 std::string plotScript(const PlotSpec& spec) {
     std::ostringstream script;
-    script << "# " << spec.title << " (generated by hapto experiment; run: gnuplot " << spec.name
-           << ".gp)\n";
+    script << "# " << quoted(spec.title) << " (generated by hapto; run: gnuplot "
+           << json::printable(spec.name) << ".gp)\n";
     // Data as datablocks, one per series, and one per panel for its unstable points.
     std::vector<std::vector<std::string>> blocks(spec.panels.size());
     std::vector<std::string> unstableBlocks(spec.panels.size());
@@ -251,7 +312,7 @@ std::string plotScript(const PlotSpec& spec) {
     // `out` names the images without their extension; hapto sets it (gnuplot -e) to a
     // temporary name and renames the finished images into place, so a figure is never half
     // written. Run by hand, the script writes NAME.png and NAME.svg directly.
-    script << "if (!exists(\"out\")) out = " << gq(spec.name) << "\n";
+    script << "if (!exists(\"out\")) out = " << quoted(spec.name) << "\n";
     if (spec.png) {
         script << "set terminal pngcairo size " << width << "," << height
                << " noenhanced font 'sans,10'\nset output out.\".png\"\n"
@@ -280,11 +341,8 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
         return r;
     }
     const std::string log = spec.name + ".gp.log";
-    const std::string temporary = spec.name + ".tmp-plot-" + std::to_string(::getpid());
-    const std::string cmd = "cd " + shq(dir.string()) + " && gnuplot -e " +
-                            shq("out=" + gq(temporary)) + " " + shq(spec.name + ".gp") + " > " +
-                            shq(log) + " 2>&1";
-    const int status = std::system(cmd.c_str());
+    const std::string temporary = temporaryStem();
+    const int status = runGnuplot(dir, spec.name + ".gp", temporary, dir / log);
     const auto dropTemporaries = [&] {
         std::error_code ignored;
         for (const char* ext : {".png", ".svg"}) {
@@ -293,9 +351,8 @@ PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec) {
     };
     if (status != 0) {
         dropTemporaries();
-        r.problem = "gnuplot failed on " + gp.string() + " (exit " +
-                    std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + "; see " +
-                    (dir / log).string() + ")";
+        r.problem = "gnuplot failed on " + gp.string() + " (exit " + std::to_string(status) +
+                    "; see " + (dir / log).string() + ")";
         return r;
     }
     std::error_code ec;
@@ -340,11 +397,10 @@ void drawPlotFile(const PlotSpec& spec, const std::filesystem::path& out,
             (script.empty() ? std::string() : ", wrote " + script.string()));
     }
     // Script, log and image all go to temporaries beside `out` (same file system: the final
-    // rename is one step), named after this process.
+    // rename is one step), named by hapto: gnuplot runs in that folder and never sees `out`.
     const std::filesystem::path dir =
         out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
-    const std::string stem =
-        "." + out.filename().string() + ".tmp-plot-" + std::to_string(::getpid());
+    const std::string stem = temporaryStem();
     const std::filesystem::path gp = dir / (stem + ".gp");
     const std::filesystem::path log = dir / (stem + ".log");
     const std::filesystem::path image = dir / (stem + ext);
@@ -362,17 +418,15 @@ void drawPlotFile(const PlotSpec& spec, const std::filesystem::path& out,
             throw std::runtime_error(gp.string() + ": cannot write the plot script");
         }
     }
-    const std::string cmd = "gnuplot -e " + shq("out=" + gq((dir / stem).string())) + " " +
-                            shq(gp.string()) + " > " + shq(log.string()) + " 2>&1";
-    const int status = std::system(cmd.c_str());
+    const int status = runGnuplot(dir, stem + ".gp", stem, log);
     if (status != 0 || !std::filesystem::exists(image)) {
         std::string why;
         std::ifstream in(log);
         std::getline(in, why);
         cleanUp();
-        throw std::runtime_error("gnuplot failed drawing " + out.string() + " (exit " +
-                                 std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
-                                 (why.empty() ? "" : ": " + why) + ")");
+        throw std::runtime_error("gnuplot failed drawing " + json::printable(out.string()) +
+                                 " (exit " + std::to_string(status) +
+                                 (why.empty() ? "" : ": " + json::printable(why)) + ")");
     }
     std::error_code ec;
     std::filesystem::rename(image, out, ec); // whole, in one step

@@ -1,12 +1,16 @@
 // Figures as gnuplot scripts: p50 beside p99.9, one y range across panels, a tic at every
-// measured x, unstable points marked and named in the key. No gnuplot needed: the script is
-// checked as text.
+// measured x, unstable points marked and named in the key; checked as text. Hostile names are
+// also drawn by the real gnuplot (gnuplot-nox), which must run none of them as a command.
 
 #include "hapto/experiments/Plot.h"
 #include "hapto/experiments/Sweep.h"
+#include "hapto/scenes/InputError.h"
+
+#include "TestSupport.h"
 
 #include <catch2/catch.hpp>
 
+#include <filesystem>
 #include <set>
 #include <sstream>
 #include <string>
@@ -132,4 +136,110 @@ TEST_CASE("a panel with no usable point says so instead of failing") {
     const std::string script = plotScript(spec);
     CHECK(script.find("'no data'") != std::string::npos);
     CHECK(script.find("$d0_0") == std::string::npos);
+    // gnuplot draws it (a v1 trace has no proxy panel data): `plot 1/0` was an error.
+    test::TempDir dir;
+    spec.panels.push_back(spec.panels[0]);
+    spec.panels[1].logY = false;
+    drawPlotFile(spec, dir / "empty.svg");
+    CHECK_THAT(test::readFile(dir / "empty.svg"), Catch::Contains("no data"));
+}
+
+namespace {
+
+/// Text that runs `touch PWNED-<tag>-N` (relative: in gnuplot's folder) if gnuplot or a shell
+/// ever reads it as code, with quotes, a backslash, a newline and a NUL around it.
+std::string hostile(const std::string& tag) {
+    return "x`touch PWNED-" + tag + "-1`y $(touch PWNED-" + tag + "-2) '\"\\ @out\nz" +
+           std::string(1, '\0') + "'; system('touch PWNED-" + tag + "-3'); '";
+}
+
+/// The files named PWNED-* anywhere under `root`.
+std::vector<std::string> pwned(const std::filesystem::path& root) {
+    std::vector<std::string> out;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(root)) {
+        if (e.path().filename().string().rfind("PWNED", 0) == 0) {
+            out.push_back(e.path().string());
+        }
+    }
+    return out;
+}
+
+/// Runs the enclosing scope in `dir` (a relative command in a name would act there).
+class InFolder {
+public:
+    explicit InFolder(const std::filesystem::path& dir) : mOld(std::filesystem::current_path()) {
+        std::filesystem::current_path(dir);
+    }
+    ~InFolder() { std::filesystem::current_path(mOld); }
+    InFolder(const InFolder&) = delete;
+    InFolder& operator=(const InFolder&) = delete;
+
+private:
+    std::filesystem::path mOld;
+};
+
+/// A one-panel figure with `text` in every place a text reaches the script.
+PlotSpec figureNamed(const std::string& text) {
+    PlotSpec spec;
+    spec.name = "hostile";
+    spec.title = text;
+    spec.unstableTitle = text;
+    PlotPanel p;
+    p.title = p.xLabel = p.yLabel = p.limitTitle = p.spanTitle = text;
+    p.series.push_back({text, {{1, 1}, {2, 3}}, {false, true}, false, -1});
+    p.xTics = {1, 2};
+    p.xTicLabels = {text, text};
+    p.limitY = 2.0;
+    p.spans = {{1.2, 1.5}};
+    spec.panels = {p, p};
+    return spec;
+}
+
+} // namespace
+
+TEST_CASE("every text of a figure is an ASCII string constant, every special byte escaped") {
+    const std::string script = plotScript(figureNamed("it's a `b` \"c\" @m $d\\\nd\xC3\xA9"));
+    // Quotes, backslash, backquote, @, $ and non-ASCII bytes in octal; a newline shown as \n.
+    const std::string q = R"("it\047s a \140b\140 \042c\042 \100m \044d\134\134nd\303\251")";
+    CHECK(count(script, "set title " + q) == 4); // two panels, PNG and SVG
+    CHECK(count(script, "set xlabel " + q) == 4);
+    CHECK(count(script, "set xtics (" + q + " 1, " + q + " 2)") == 4);
+    for (const char* before : {"dt 1", "lc rgb 'black'", "lc rgb 'red'", "solid 1.0"}) {
+        INFO(before); // the series, the unstable mark, the limit, the span's key
+        CHECK(count(script, std::string(before) + " title " + q) == 4);
+    }
+    CHECK(count(script, "set multiplot layout 1,2 title " + q) == 2);
+    // No backquote anywhere: gnuplot substitutes backquotes even inside strings.
+    CHECK(script.find('`') == std::string::npos);
+    // Every line is one command: the name's newline did not end one.
+    CHECK(script.find("\nd") == std::string::npos);
+}
+
+TEST_CASE("gnuplot draws hostile names as text and runs none of them") {
+    test::TempDir root;
+    // The output's folder is hostile too (no NUL: a path cannot hold one).
+    std::string folder = hostile("dir");
+    folder.erase(folder.find('\0'), 1);
+    const std::filesystem::path dir = root / folder;
+    std::filesystem::create_directories(dir);
+    const InFolder inRoot(root.path());
+    for (const std::string ext : {".png", ".svg"}) {
+        INFO(ext);
+        const std::filesystem::path out = dir / ("plot" + ext);
+        drawPlotFile(figureNamed(hostile("name")), out, dir / "plot.gp");
+        CHECK(std::filesystem::file_size(out) > 0);
+        const PlotResult r = drawPlot(dir, figureNamed(hostile("figure")));
+        CHECK(r.problem == "");
+        CHECK(r.files.size() == 2);
+    }
+    CHECK_THAT(test::readFile(dir / "plot.svg"),
+               Catch::Contains("x`touch PWNED-name-1`y $(touch PWNED-name-2)"));
+    CHECK(pwned(root.path()).empty());
+    // Only the outputs are left: no temporary, no log.
+    std::set<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+        names.insert(e.path().filename().string());
+    }
+    CHECK(names == std::set<std::string>{"plot.png", "plot.svg", "plot.gp", "hostile.gp",
+                                         "hostile.png", "hostile.svg"});
 }

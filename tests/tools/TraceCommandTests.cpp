@@ -200,3 +200,127 @@ TEST_CASE("hapto report plot draws a run report per device") {
     REQUIRE(png.exitCode == 0);
     CHECK(startsWith(test::readFile(dir / "report.png"), "\x89PNG\r\n\x1a\n"));
 }
+
+namespace {
+
+/// `s` as one word for the shell that runs test::runHapto's command line.
+std::string shellWord(const std::string& s) {
+    std::string q = "'";
+    for (const char c : s) {
+        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    }
+    return q + "'";
+}
+
+/// The files named PWNED* anywhere under `root`: made by a name run as a command.
+std::vector<std::string> pwned(const std::filesystem::path& root) {
+    std::vector<std::string> out;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(root)) {
+        if (e.path().filename().string().rfind("PWNED", 0) == 0) {
+            out.push_back(e.path().string());
+        }
+    }
+    return out;
+}
+
+/// Runs the enclosing scope in `dir`, so a relative command in a name (run by hapto, started
+/// from here) would act there.
+class InFolder {
+public:
+    explicit InFolder(const std::filesystem::path& dir) : mOld(std::filesystem::current_path()) {
+        std::filesystem::current_path(dir);
+    }
+    ~InFolder() { std::filesystem::current_path(mOld); }
+    InFolder(const InFolder&) = delete;
+    InFolder& operator=(const InFolder&) = delete;
+
+private:
+    std::filesystem::path mOld;
+};
+
+/// A run report, as `hapto report plot` reads it, of devices named by the JSON strings given.
+std::string reportOf(const std::vector<std::string>& jsonNames) {
+    std::string devices;
+    for (const std::string& name : jsonNames) {
+        devices += (devices.empty() ? "" : ", ") + std::string(R"({"name": )") + name +
+                   R"(, "ticks": 1000, "load": {"p50": 0.1, "p99": 0.2, "p999": 0.3, "max": 0.4},
+                      "lateness_ns": {"p50": 1000, "p99": 2000, "max": 3000},
+                      "contact_ticks": 10, "missed_deadlines": 1})";
+    }
+    return R"({"devices": [)" + devices + "]}";
+}
+
+/// A folder name with backquotes, $(...), quotes and a newline.
+const std::string kHostileFolder = "d`touch PWNED-dir1`$(touch PWNED-dir2)'\"\\\nx";
+
+} // namespace
+
+TEST_CASE("hapto report plot draws hostile names and paths as text and runs none of them") {
+    test::TempDir root;
+    const std::filesystem::path dir = root / kHostileFolder;
+    std::filesystem::create_directories(dir);
+    test::writeFile(dir / "report.json",
+                    reportOf({R"("x`touch PWNED1`y")", R"x("$(touch PWNED2)")x",
+                              R"("a'b\"c\\ @out")", R"("'; system('touch PWNED3'); '")"}));
+    const InFolder inRoot(root.path());
+    const auto r = test::runHapto("report plot " + shellWord((dir / "report.json").string()) +
+                                  " -o " + shellWord((dir / "report.svg").string()) + " --script " +
+                                  shellWord((dir / "report.gp").string()));
+    INFO(r.output);
+    CHECK(r.exitCode == 0);
+    const std::string svg = test::readFile(dir / "report.svg");
+    CHECK_THAT(svg, Catch::Contains("x`touch PWNED1`y"));
+    CHECK_THAT(svg, Catch::Contains("$(touch PWNED2)"));
+    CHECK(pwned(root.path()).empty());
+}
+
+TEST_CASE("hapto report plot refuses a device name with a control character, naming it") {
+    test::TempDir dir;
+    for (const std::string name : {R"("left\nright")", R"("left\u0000x")", R"("\u001b[2J")"}) {
+        INFO(name);
+        test::writeFile(dir / "report.json", reportOf({R"("ok")", name}));
+        const auto r = test::runHapto("report plot " + (dir / "report.json").string() + " -o " +
+                                      (dir / "report.svg").string());
+        CHECK(r.exitCode == 2);
+        CHECK_THAT(r.output, Catch::Contains("report.json: devices[1].name: the device name must "
+                                             "not contain control characters (got " +
+                                             name + ")"));
+        CHECK_FALSE(std::filesystem::exists(dir / "report.svg"));
+    }
+}
+
+TEST_CASE("hapto trace plot draws hostile device names and paths as text and runs none") {
+    test::TempDir root;
+    const std::filesystem::path dir = root / kHostileFolder;
+    std::filesystem::create_directories(dir);
+    // A device-name header of printable ASCII that gnuplot would run in a double-quoted string.
+    writeContactTrace(dir / "left.trace", "x`touch PWNED4`$(touch PWNED5)'\"\\@out", -1.0);
+    writeContactTrace(dir / "right.trace", "'; system('touch PWNED6'); '", 1.0);
+    const InFolder inRoot(root.path());
+    for (const std::string ext : {".png", ".svg"}) {
+        const auto r = test::runHapto("trace plot " + shellWord((dir / "left.trace").string()) +
+                                      " " + shellWord((dir / "right.trace").string()) + " -o " +
+                                      shellWord((dir / ("t" + ext)).string()));
+        INFO(r.output);
+        CHECK(r.exitCode == 0);
+        CHECK(std::filesystem::file_size(dir / ("t" + ext)) > 0);
+    }
+    CHECK_THAT(test::readFile(dir / "t.svg"), Catch::Contains("x`touch PWNED4`$(touch PWNED5)"));
+    // One trace: its path is in the title.
+    const auto one = test::runHapto("trace plot " + shellWord((dir / "left.trace").string()) +
+                                    " -o " + shellWord((dir / "one.svg").string()));
+    INFO(one.output);
+    CHECK(one.exitCode == 0);
+    CHECK_THAT(test::readFile(dir / "one.svg"), Catch::Contains("touch PWNED-dir1"));
+    CHECK(pwned(root.path()).empty());
+}
+
+TEST_CASE("hapto trace plot refuses a device name with a control character, naming the field") {
+    test::TempDir dir;
+    writeContactTrace(dir / "left.trace", "left\nright", -1.0);
+    const auto r = test::runHapto("trace plot " + (dir / "left.trace").string() + " -o " +
+                                  (dir / "t.svg").string());
+    CHECK(r.exitCode == 2);
+    CHECK_THAT(r.output, Catch::Contains("left.trace: byte 64: the name field"));
+    CHECK_FALSE(std::filesystem::exists(dir / "t.svg"));
+}

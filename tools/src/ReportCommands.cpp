@@ -45,7 +45,7 @@ std::vector<ReportDevice> readReport(const std::string& path) {
         const Path at = devicesPath[i];
         const Json& d = object(w, devices[i], at);
         ReportDevice r;
-        r.name = string(w, required(w, d, at, "name"), at / "name");
+        r.name = printableString(w, required(w, d, at, "name"), at / "name", "the device name");
         r.ticks = ranged(w, required(w, d, at, "ticks"), at / "ticks", 0.0, kUnbounded, false,
                          "the tick count");
         const Path loadPath = at / "load";

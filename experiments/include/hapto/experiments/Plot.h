@@ -59,14 +59,17 @@ struct PlotResult {
 /// panels: positive values only), widened a little; nullopt when there is no data. [any thread]
 std::optional<std::pair<double, double>> sharedYRange(const PlotSpec& spec);
 
-/// The gnuplot script drawPlot runs: data inline, a PNG then an SVG of the panels. [any thread]
+/// The gnuplot script drawPlot runs: data inline, a PNG then an SVG of the panels. Every text
+/// (titles, labels, names) is a string constant with every special byte escaped, so no name or
+/// path can run as gnuplot code or a shell command. [any thread]
 std::string plotScript(const PlotSpec& spec);
 
 /// True when a `gnuplot` executable is on PATH. [control]
 bool gnuplotAvailable();
 
-/// Writes DIR/NAME.gp (data inline) and runs gnuplot on it to make DIR/NAME.png and
-/// DIR/NAME.svg. Never throws for a missing or failing gnuplot: says so in `problem`. [control]
+/// Writes DIR/NAME.gp (data inline) and runs gnuplot on it (directly, no shell, in DIR) to make
+/// DIR/NAME.png and DIR/NAME.svg. Never throws for a missing or failing gnuplot: says so in
+/// `problem`. [control]
 PlotResult drawPlot(const std::filesystem::path& dir, const PlotSpec& spec);
 
 /// Draws one image, `out` (PNG or SVG by its extension, ".png" or ".svg"), through a temporary
