@@ -2,14 +2,18 @@
 
 #include "hapto/view/ViewServer.h"
 
+#include "BoundedHttpServer.h"
 #include "ViewAssets.h"
 
-#include <httplib.h>
-
 #include <arpa/inet.h>
+#include <netinet/in.h>
 #include <sys/socket.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -29,28 +33,113 @@ std::string readAsset(const std::filesystem::path& path) {
     return text.str();
 }
 
-// "host:port" or "[v6]:port" without the port.
-std::string hostName(const std::string& hostHeader) {
-    if (!hostHeader.empty() && hostHeader.front() == '[') {
-        const auto close = hostHeader.find(']');
-        return close == std::string::npos ? hostHeader : hostHeader.substr(1, close - 1);
+// An IP address in IPv6 form (IPv4 as ::ffff:a.b.c.d), whatever its spelling; nullopt when the
+// text is not an address.
+std::optional<in6_addr> parseAddress(const std::string& text) {
+    in6_addr v6{};
+    if (inet_pton(AF_INET6, text.c_str(), &v6) == 1) {
+        return v6;
     }
-    return hostHeader.substr(0, hostHeader.rfind(':'));
+    in_addr v4{};
+    if (inet_pton(AF_INET, text.c_str(), &v4) != 1) {
+        return std::nullopt;
+    }
+    v6.s6_addr[10] = v6.s6_addr[11] = 0xff;
+    std::memcpy(&v6.s6_addr[12], &v4, sizeof v4);
+    return v6;
+}
+
+bool isLoopback(const in6_addr& a) {
+    return IN6_IS_ADDR_LOOPBACK(&a) || (IN6_IS_ADDR_V4MAPPED(&a) && a.s6_addr[12] == 127);
+}
+
+bool isWildcard(const in6_addr& a) {
+    static const in6_addr anyV4 = *parseAddress("0.0.0.0");
+    return IN6_IS_ADDR_UNSPECIFIED(&a) || std::memcmp(&a, &anyV4, sizeof a) == 0;
+}
+
+std::string lowerCase(std::string text) {
+    std::transform(text.begin(), text.end(), text.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return text;
+}
+
+// The host a Host header names, lower case: "name", "name:port", "[v6]" or "[v6]:port" and
+// nothing else (no user part, no text after the address or the port); nullopt otherwise.
+std::optional<std::string> hostOf(const std::string& header) {
+    std::string host, rest;
+    if (!header.empty() && header.front() == '[') {
+        const std::size_t close = header.find(']');
+        in6_addr v6{};
+        if (close == std::string::npos ||
+            inet_pton(AF_INET6, header.substr(1, close - 1).c_str(), &v6) != 1) {
+            return std::nullopt; // brackets hold an IPv6 address and only that
+        }
+        host = header.substr(1, close - 1);
+        rest = header.substr(close + 1);
+    } else {
+        const std::size_t colon = header.find(':');
+        host = header.substr(0, colon);
+        rest = colon == std::string::npos ? "" : header.substr(colon);
+        const auto nameChar = [](unsigned char c) {
+            return std::isalnum(c) != 0 || c == '-' || c == '.';
+        };
+        if (host.empty() || !std::all_of(host.begin(), host.end(), nameChar)) {
+            return std::nullopt;
+        }
+    }
+    const auto digit = [](unsigned char c) { return std::isdigit(c) != 0; };
+    if (!rest.empty() && (rest.size() < 2 || rest.size() > 6 || rest.front() != ':' ||
+                          !std::all_of(rest.begin() + 1, rest.end(), digit))) {
+        return std::nullopt;
+    }
+    return lowerCase(host);
+}
+
+// A path as a cpp-httplib route (a regular expression) that matches that path only.
+std::string exactly(const std::string& path) {
+    std::string pattern;
+    for (const char c : path) {
+        if (std::strchr("\\^$.|?*+()[]{}", c) != nullptr) {
+            pattern += '\\';
+        }
+        pattern += c;
+    }
+    return pattern;
 }
 
 } // namespace
 
 bool isLoopbackAddress(const std::string& address) {
-    if (address == "localhost" || address == "::1") {
-        return true;
+    const auto parsed = parseAddress(address);
+    return lowerCase(address) == "localhost" || (parsed && isLoopback(*parsed));
+}
+
+bool hostHeaderAllowed(const std::string& bindAddress, const std::string& hostHeader) {
+    const auto host = hostOf(hostHeader);
+    if (!host) {
+        return false;
     }
-    in_addr v4{};
-    return inet_pton(AF_INET, address.c_str(), &v4) == 1 &&
-           (ntohl(v4.s_addr) >> 24) == 127; // 127.0.0.0/8
+    const auto hostAddress = parseAddress(*host);
+    const bool loopbackName = *host == "localhost" || (hostAddress && isLoopback(*hostAddress));
+    const auto bound = parseAddress(bindAddress);
+    if (!bound) { // bound by name: that name (or, for "localhost", any loopback name)
+        return lowerCase(bindAddress) == "localhost" ? loopbackName
+                                                     : *host == lowerCase(bindAddress);
+    }
+    if (isLoopback(*bound)) {
+        return loopbackName;
+    }
+    if (isWildcard(*bound)) {
+        return loopbackName || hostAddress.has_value();
+    }
+    return hostAddress && std::memcmp(&*hostAddress, &*bound, sizeof(in6_addr)) == 0;
 }
 
 ViewServer::ViewServer(ViewServerOptions options)
-    : mOptions(std::move(options)), mServer(std::make_unique<httplib::Server>()) {
+    : mOptions(std::move(options)),
+      mServer(std::make_unique<BoundedHttpServer>(HttpLimits{
+          .headTimeout = mOptions.requestTimeout, .writeTimeout = mOptions.writeTimeout})) {
     mThreeJs = readAsset(mOptions.threeJsDir / "build" / "three.min.js");
     mOrbitControls =
         readAsset(mOptions.threeJsDir / "examples" / "js" / "controls" / "OrbitControls.js");
@@ -75,26 +164,8 @@ std::string ViewServer::url() const {
            std::to_string(mPort) + "/";
 }
 
-bool ViewServer::hostAllowed(const std::string& host) const {
-    // Bound to loopback, a page reached under another name is a DNS-rebinding attempt.
-    return !isLoopbackAddress(mOptions.bindAddress) || isLoopbackAddress(hostName(host));
-}
-
-int ViewServer::start() {
+void ViewServer::route() {
     httplib::Server& s = *mServer;
-    const std::size_t threads = mOptions.maxStreamClients + 4; // streams + page loads
-    s.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-    s.set_write_timeout(
-        std::chrono::duration_cast<std::chrono::microseconds>(mOptions.writeTimeout));
-    s.set_read_timeout(std::chrono::seconds(5));
-    s.set_payload_max_length(4096); // nothing is uploaded
-    // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, which would let a second
-    // server share (and take over part of) a port already in use.
-    s.set_socket_options([](socket_t sock) {
-        int yes = 1;
-        setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-    });
-
     // Read-only, one host: every request passes here first.
     s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
         if (req.method != "GET" && req.method != "HEAD") {
@@ -103,15 +174,16 @@ int ViewServer::start() {
             res.set_content("the view is read-only: only GET and HEAD\n", "text/plain");
             return httplib::Server::HandlerResponse::Handled;
         }
-        if (!hostAllowed(req.get_header_value("Host"))) {
+        if (!hostHeaderAllowed(mOptions.bindAddress, req.get_header_value("Host"))) {
             res.status = 403;
-            res.set_content("this view answers only to a loopback host name\n", "text/plain");
+            res.set_content("this view answers only to the host name it listens on\n",
+                            "text/plain");
             return httplib::Server::HandlerResponse::Handled;
         }
         return httplib::Server::HandlerResponse::Unhandled;
     });
     const auto fixed = [&s](const std::string& path, const std::string* body, const char* type) {
-        s.Get(path, [body, type](const httplib::Request&, httplib::Response& res) {
+        s.Get(exactly(path), [body, type](const httplib::Request&, httplib::Response& res) {
             res.set_header("Cache-Control", "no-store");
             res.set_content(*body, type);
         });
@@ -125,6 +197,9 @@ int ViewServer::start() {
     fixed("/three/OrbitControls.js", &mOrbitControls, "text/javascript; charset=utf-8");
     for (const auto& [path, body] : mDocuments) {
         fixed(path, &body, "application/json");
+    }
+    if (!mOptions.liveStream) {
+        return;
     }
     s.Get("/stream", [this](const httplib::Request& req, httplib::Response& res) {
         // EventSource sends Origin on a cross-origin request; the page's own has none or ours.
@@ -169,6 +244,20 @@ int ViewServer::start() {
             },
             [this](bool) { mStreams.fetch_sub(1); });
     });
+}
+
+int ViewServer::start() {
+    httplib::Server& s = *mServer;
+    const std::size_t threads = mOptions.maxStreamClients + 4; // streams + page loads
+    s.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+    s.set_payload_max_length(4096); // nothing is uploaded
+    // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, which would let a second
+    // server share (and take over part of) a port already in use.
+    s.set_socket_options([](socket_t sock) {
+        int yes = 1;
+        setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
+    route();
     s.set_error_handler([](const httplib::Request&, httplib::Response& res) {
         if (res.body.empty()) {
             res.set_content(std::to_string(res.status) + "\n", "text/plain");
@@ -198,6 +287,7 @@ void ViewServer::stop() {
     }
     mFrameChanged.notify_all();
     if (mListener.joinable()) {
+        mServer->closeClients(); // a worker blocked on a client returns now
         mServer->stop();
         mListener.join();
     }

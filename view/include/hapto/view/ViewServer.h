@@ -13,11 +13,9 @@
 #include <string>
 #include <thread>
 
-namespace httplib {
-class Server;
-}
-
 namespace hapto {
+
+class BoundedHttpServer;
 
 /// Where Debian's libjs-three puts three.js (build/three.min.js, examples/js/controls/...).
 inline constexpr const char* kDefaultThreeJsDir = "/usr/share/javascript/three";
@@ -28,12 +26,26 @@ struct ViewServerOptions {
     int port = 0;                          ///< TCP port; 0 takes any free one.
     std::size_t maxStreamClients = 4;      ///< Live streams served at once; more get 503.
     std::filesystem::path threeJsDir = kDefaultThreeJsDir; ///< libjs-three's folder.
-    /// A stream whose viewer does not take a frame within this long is dropped.
+    /// A connection whose client takes none of the bytes queued for it for this long (a
+    /// stalled viewer, once its receive buffer is full) is dropped.
     std::chrono::milliseconds writeTimeout{2000};
+    /// A request's head must arrive whole within this long (an idle keep-alive connection is
+    /// closed after it too).
+    std::chrono::milliseconds requestTimeout{2000};
+    /// Serves `/stream` (a live session); a recording has no stream (404).
+    bool liveStream = true;
 };
 
-/// True for 127.0.0.0/8, ::1 and "localhost". [any thread]
+/// True for 127.0.0.0/8, ::1 (in any spelling, IPv4-mapped included) and "localhost".
+/// [any thread]
 bool isLoopbackAddress(const std::string& address);
+
+/// True when a request's Host header (`name[:port]`, `[v6][:port]`, nothing else) names a
+/// server bound to `bindAddress`, addresses compared parsed: bound to loopback, "localhost"
+/// or a loopback address; bound to a wildcard (0.0.0.0, ::), those or any IP address (an
+/// address cannot be rebound by DNS); bound to another address or name, that one only.
+/// Anything else is a DNS-rebinding attempt. [any thread]
+bool hostHeaderAllowed(const std::string& bindAddress, const std::string& hostHeader);
 
 /// Serves the view. Design note: the page is read-only by construction: only GET and HEAD
 /// are answered (anything else is 405), and only a fixed list of paths: the page and its
@@ -41,10 +53,14 @@ bool isLoopbackAddress(const std::string& address);
 /// the documents set with setDocument(); any other path, a traversal ("/../") included, is
 /// 404 without touching the file system. The live stream (`/stream`, text/event-stream) sends
 /// the newest frame given to publish(): a viewer that is slow skips frames, one that stalls is
-/// dropped after the write timeout, and neither is ever waited for by the publisher. A stream
-/// request from another origin (its Origin header is not this server) is 403, and when bound
-/// to loopback a request naming another host (DNS rebinding) is 403 too. The HTTP work runs
-/// on cpp-httplib's own threads (a pool sized for the stream limit plus a few page loads).
+/// dropped once it has taken nothing for the write timeout, and neither is ever waited for by
+/// the publisher. A stream request from another origin (its Origin header is not this server)
+/// is 403, and so is a request naming a host the binding does not admit (hostHeaderAllowed:
+/// DNS rebinding). Several ranges in one request are 416 (one range is served). The HTTP
+/// work runs on cpp-httplib's threads (a pool sized for the stream limit plus a few page
+/// loads) under BoundedHttpServer's limits: a request head within requestTimeout, at most
+/// 64 header lines and 16 KiB (431), bounded keep-alive, and a stop() that shuts every client
+/// connection down instead of waiting for it.
 class ViewServer {
 public:
     /// Checks that three.js is where it should be; throws std::runtime_error naming the file
@@ -59,7 +75,8 @@ public:
     /// Binds and starts serving; returns the port. Throws std::runtime_error when the address
     /// cannot be bound. [control]
     int start();
-    /// Ends every stream and stops serving; waits for the server's threads. [control]
+    /// Ends every stream, shuts every client connection down and stops serving; waits for the
+    /// server's threads, never for a client. [control]
     void stop();
     /// The port served (after start()). [any thread]
     int port() const { return mPort; }
@@ -76,10 +93,10 @@ public:
     std::size_t streamClients() const { return mStreams.load(); }
 
 private:
-    bool hostAllowed(const std::string& host) const;
+    void route();
 
     ViewServerOptions mOptions;
-    std::unique_ptr<httplib::Server> mServer;
+    std::unique_ptr<BoundedHttpServer> mServer;
     std::thread mListener;
     std::map<std::string, std::string> mDocuments; // fixed once started
     std::string mThreeJs, mOrbitControls;          // read at construction
