@@ -72,7 +72,7 @@ class Dom(html.parser.HTMLParser):
 
     def __init__(self, text):
         super().__init__()
-        self.devices, self.status, self.clock = {}, {}, {}
+        self.devices, self.status, self.clock, self.leaves_option = {}, {}, {}, {}
         self._device, self._field = None, None
         self.feed(text)
 
@@ -85,6 +85,8 @@ class Dom(html.parser.HTMLParser):
             self.status = a
         if a.get("id") == "clock":
             self.clock = a
+        if a.get("id") == "leavesOption":
+            self.leaves_option = a
         self._field = a.get("data-field")
 
     def handle_data(self, data):
@@ -141,7 +143,7 @@ def live(hapto, browser, workdir):
     # Long enough for both viewers to be following before it ends: on a busy two-core machine
     # Chromium took 3 s to start and 5 s more to load the page (two of them at once).
     duration = 30.0
-    proc, url = start([hapto, "run", "--view", "0", "--duration", str(duration), "--no-realtime",
+    proc, url = start([hapto, "run", "--view", "--view-port", "0", "--duration", str(duration), "--no-realtime",
                        "--quiet", "--report", report_path, "--record", record],
                       os.path.join(workdir, "run.log"))
     shot = os.path.join(workdir, "live.png")
@@ -226,8 +228,8 @@ def live(hapto, browser, workdir):
     return record, report
 
 
-def offline(hapto, browser, workdir, record):
-    proc, url = start([hapto, "view", "--trace", record, "--port", "0", "--duration", "600"],
+def offline(hapto, browser, workdir, record, report):
+    proc, url = start([hapto, "view", "--trace", record, "--view-port", "0", "--duration", "600"],
                       os.path.join(workdir, "view.log"))
     try:
         early = Dom(chromium(browser, workdir, "early", url, 1000, "--dump-dom"))
@@ -242,6 +244,16 @@ def offline(hapto, browser, workdir, record):
         check(0 < int(a.get("ticks", "0")) < int(b.get("ticks", "0")),
               "%s: the recorded ticks advance with the player (%s, then %s)" %
               (name, a.get("ticks"), b.get("ticks")))
+        # Misses counted by the runtime's rule from what the trace records (its deadlines run
+        # from the first tick, 2 ms into the session), so no more than the whole run's.
+        reported = {d["name"]: d["missed_deadlines"] for d in report["devices"]}.get(name, 0)
+        check(int(b.get("misses", "-1")) in range(0, reported + 1),
+              "%s: misses on the player %s <= the report's %d" % (name, b.get("misses"), reported))
+        # A trace records no cursor leaves or candidates: the player claims neither.
+        check("leaf" not in b and "candidates" not in b,
+              "%s: no leaf or candidates shown for a trace (%s, %s)" %
+              (name, b.get("leaf"), b.get("candidates")))
+    check("hidden" in later.leaves_option, "the player offers no cursor leaves")
     check(early.status.get("data-frames", "0") != "0", "the player shows frames")
 
 
@@ -257,8 +269,8 @@ def main():
         sys.exit("chromium not found (%r): tools/setup.sh installs Debian's chromium" % browser)
     shutil.rmtree(workdir, ignore_errors=True)
     os.makedirs(workdir)
-    record, _ = live(hapto, browser, workdir)
-    offline(hapto, browser, workdir, record)
+    record, report = live(hapto, browser, workdir)
+    offline(hapto, browser, workdir, record, report)
     print("%d passed, %d failed" % (len(passes), len(failures)))
     return 1 if failures else 0
 

@@ -25,6 +25,9 @@ function setupScene(scene) {
   sun.position.set(1, 2, 1.5);
   world.add(sun);
 
+  // A trace records no cursor leaves and no candidates: the player offers and shows neither.
+  view.live = scene.mode !== 'trace';
+  document.getElementById('leavesOption').hidden = !view.live;
   const lo = v3(scene.bounds.min), hi = v3(scene.bounds.max);
   const centre = lo.clone().add(hi).multiplyScalar(0.5);
   const size = hi.clone().sub(lo).length();
@@ -168,9 +171,10 @@ function makeDevice(world, d, i) {
     '|F| <span data-field="forceN">-</span> N &middot; ticks <span data-field="ticks">0</span>' +
     ' &middot; misses <span data-field="misses">0</span><br>' +
     'load p50 <span data-field="loadP50">-</span> % &middot; p99.9 ' +
-    '<span data-field="loadP999">-</span> % &middot; candidates/tick ' +
-    '<span data-field="candidates">-</span> <span data-field="contacts"></span>' +
-    '<br><span data-field="leaf"></span>' +
+    '<span data-field="loadP999">-</span> %' +
+    (view.live ? ' &middot; candidates/tick <span data-field="candidates">-</span>' : '') +
+    ' <span data-field="contacts"></span>' +
+    (view.live ? '<br><span data-field="leaf"></span>' : '') +
     '<canvas width="254" height="56"></canvas>';
   row.querySelector('.name').textContent = d.name;
   row.querySelector('.name').style.color = '#' + color.toString(16).padStart(6, '0');
@@ -211,8 +215,10 @@ function showDevice(dev, f, touched) {
   field(dev, 'misses', String(f.misses));
   field(dev, 'loadP50', (100 * f.loadP50).toFixed(2));
   field(dev, 'loadP999', (100 * f.loadP999).toFixed(2));
-  if (f.candidates !== undefined) field(dev, 'candidates', f.candidates.toFixed(1));
-  showLeaf(dev, f);
+  if (view.live) {
+    if (f.candidates !== undefined) field(dev, 'candidates', f.candidates.toFixed(1));
+    showLeaf(dev, f);
+  }
   if (f.verdict !== undefined) {
     const v = dev.row.querySelector('[data-field="verdict"]');
     v.textContent = f.verdict;
@@ -225,7 +231,7 @@ function showDevice(dev, f, touched) {
   }
 }
 
-// The cursor leaf's box and what it lists (live frames only; a trace has no leaves).
+// The cursor leaf's box and what it lists (live only; a trace records no leaves).
 function showLeaf(dev, f) {
   const on = document.getElementById('leaves').checked;
   dev.leaf.visible = on && !!f.leaf;
