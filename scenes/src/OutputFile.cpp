@@ -43,6 +43,41 @@ fs::path resolved(const fs::path& p) {
     return ec ? absolute : canonical;
 }
 
+/// What a file of mode `mode` is, for a message: "a FIFO", "a socket", ...
+std::string kindOf(mode_t mode) {
+    if (S_ISDIR(mode)) {
+        return "a folder";
+    }
+    if (S_ISFIFO(mode)) {
+        return "a FIFO";
+    }
+    if (S_ISSOCK(mode)) {
+        return "a socket";
+    }
+    if (S_ISCHR(mode)) {
+        return "a character device";
+    }
+    if (S_ISBLK(mode)) {
+        return "a block device";
+    }
+    return "not a regular file";
+}
+
+/// Throws InputError when `target` (symlinks resolved) exists and is not a regular file;
+/// `what` names the output ("-o 'x'" or "'x'").
+void refuseNonFile(const fs::path& target, const std::string& what) {
+    struct stat st {};
+    if (::stat(target.c_str(), &st) != 0 || S_ISREG(st.st_mode)) {
+        return;
+    }
+    if (S_ISDIR(st.st_mode)) {
+        throw InputError(what + ": this is a folder; give a file name to write");
+    }
+    throw InputError(what + ": this is " + kindOf(st.st_mode) +
+                     ", not a regular file; give the name of a file (an output is written "
+                     "beside it and renamed into place)");
+}
+
 fs::path folderOf(const fs::path& path) {
     return path.has_parent_path() ? path.parent_path() : fs::path(".");
 }
@@ -96,7 +131,7 @@ private:
 
 struct AtomicOutputFile::Impl {
     fs::path target;    // where the contents end up (a symlink resolved)
-    fs::path temporary; // empty when writing the target directly (a device or a FIFO)
+    fs::path temporary; // beside the target, renamed onto it by commit()
     int fd = -1;
     std::unique_ptr<FdBuf> buf;
     std::unique_ptr<std::ostream> stream;
@@ -107,41 +142,32 @@ AtomicOutputFile::AtomicOutputFile(const fs::path& path)
     : mPath(path), mImpl(std::make_unique<Impl>()) {
     Impl& m = *mImpl;
     m.target = resolveTarget(path);
+    refuseNonFile(m.target, quoted(path));
     struct stat st {};
     const bool exists = ::stat(m.target.c_str(), &st) == 0;
-    if (exists && S_ISDIR(st.st_mode)) {
-        throw InputError(quoted(path) + " is a folder; give a file name to write");
+    std::random_device random;
+    const char* digits = "0123456789abcdefghijklmnopqrstuvwxyz";
+    for (int attempt = 0; attempt < 100 && m.fd < 0; ++attempt) {
+        std::string suffix = ".tmp-";
+        for (int i = 0; i < 6; ++i) {
+            suffix += digits[random() % 36];
+        }
+        m.temporary = m.target;
+        m.temporary += suffix;
+        // Created, never opened if it exists: a FIFO put there meanwhile cannot block this.
+        m.fd =
+            ::open(m.temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (m.fd < 0 && errno != EEXIST) {
+            break;
+        }
     }
-    if (exists && !S_ISREG(st.st_mode)) {
-        // A device, FIFO or socket cannot be replaced: write it as it is.
-        m.fd = ::open(m.target.c_str(), O_WRONLY | O_CLOEXEC);
-        if (m.fd < 0) {
-            throw InputError("cannot write " + quoted(path) + " (" + std::strerror(errno) + ")");
-        }
-    } else {
-        std::random_device random;
-        const char* digits = "0123456789abcdefghijklmnopqrstuvwxyz";
-        for (int attempt = 0; attempt < 100 && m.fd < 0; ++attempt) {
-            std::string suffix = ".tmp-";
-            for (int i = 0; i < 6; ++i) {
-                suffix += digits[random() % 36];
-            }
-            m.temporary = m.target;
-            m.temporary += suffix;
-            m.fd = ::open(m.temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC,
-                          0666);
-            if (m.fd < 0 && errno != EEXIST) {
-                break;
-            }
-        }
-        if (m.fd < 0) {
-            throw InputError("cannot write " + quoted(path) + " (" + std::strerror(errno) +
-                             "); check that the folder " + quoted(folderOf(m.target)) +
-                             " exists and is writable");
-        }
-        if (exists) {
-            (void)::fchmod(m.fd, st.st_mode & 07777); // a replaced file keeps its permissions
-        }
+    if (m.fd < 0) {
+        throw InputError("cannot write " + quoted(path) + " (" + std::strerror(errno) +
+                         "); check that the folder " + quoted(folderOf(m.target)) +
+                         " exists and is writable");
+    }
+    if (exists && S_ISREG(st.st_mode)) {
+        (void)::fchmod(m.fd, st.st_mode & 07777); // a replaced file keeps its permissions
     }
     m.buf = std::make_unique<FdBuf>(m.fd);
     m.stream = std::make_unique<std::ostream>(m.buf.get());
@@ -169,7 +195,7 @@ void AtomicOutputFile::commit() {
     const bool written = !m.buf->failed() && static_cast<bool>(*m.stream);
     int error = m.buf->failed() ? m.buf->error() : 0;
     bool ok = written;
-    if (ok && !m.temporary.empty() && ::fsync(m.fd) != 0) {
+    if (ok && ::fsync(m.fd) != 0) {
         ok = false;
         error = errno;
     }
@@ -178,7 +204,7 @@ void AtomicOutputFile::commit() {
         error = errno;
     }
     m.fd = -1;
-    if (ok && !m.temporary.empty() && ::rename(m.temporary.c_str(), m.target.c_str()) != 0) {
+    if (ok && ::rename(m.temporary.c_str(), m.target.c_str()) != 0) {
         ok = false;
         error = errno;
     }
@@ -226,14 +252,8 @@ void checkOutputFile(const fs::path& path, std::string_view option) {
     }
     const std::string what = std::string(option) + " " + quoted(path);
     const fs::path target = resolveTarget(path);
+    refuseNonFile(target, what);
     std::error_code ec;
-    const fs::file_status status = fs::status(target, ec);
-    if (fs::is_directory(status)) {
-        throw InputError(what + ": this is a folder; give a file name to write");
-    }
-    if (fs::exists(status) && !fs::is_regular_file(status)) {
-        return; // a device or FIFO: written as it is
-    }
     const fs::path folder = folderOf(target);
     if (!fs::exists(folder, ec)) {
         throw InputError(what + ": the folder " + quoted(folder) +
@@ -245,6 +265,12 @@ void checkOutputFile(const fs::path& path, std::string_view option) {
     if (::access(folder.c_str(), W_OK | X_OK) != 0) {
         throw InputError(what + ": the folder " + quoted(folder) + " is not writable (" +
                          std::strerror(errno) + ")");
+    }
+}
+
+void checkOutputKind(const fs::path& path, std::string_view option) {
+    if (!path.empty()) {
+        refuseNonFile(path, std::string(option) + " " + quoted(path));
     }
 }
 

@@ -10,8 +10,14 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <csignal>
+#include <fcntl.h>
 #include <filesystem>
+#include <sys/resource.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
 #include <vector>
 
 using namespace hapto;
@@ -28,6 +34,36 @@ std::vector<std::string> namesIn(const fs::path& dir) {
     std::sort(names.begin(), names.end());
     return names;
 }
+
+/// While it lives, no file of this process grows past `bytes`: a write beyond fails with EFBIG
+/// (SIGXFSZ ignored), as on a full disk.
+struct FileSizeLimit {
+    rlimit old{};
+    void (*oldHandler)(int);
+    explicit FileSizeLimit(rlim_t bytes) : oldHandler(std::signal(SIGXFSZ, SIG_IGN)) {
+        REQUIRE(getrlimit(RLIMIT_FSIZE, &old) == 0);
+        rlimit lower = old;
+        lower.rlim_cur = bytes;
+        REQUIRE(setrlimit(RLIMIT_FSIZE, &lower) == 0);
+    }
+    ~FileSizeLimit() {
+        setrlimit(RLIMIT_FSIZE, &old);
+        std::signal(SIGXFSZ, oldHandler);
+    }
+};
+
+/// A Unix socket bound at `path`, for as long as it lives.
+struct BoundSocket {
+    int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    explicit BoundSocket(const fs::path& path) {
+        sockaddr_un addr{};
+        addr.sun_family = AF_UNIX;
+        REQUIRE(path.string().size() < sizeof addr.sun_path);
+        std::copy_n(path.c_str(), path.string().size(), addr.sun_path);
+        REQUIRE(::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0);
+    }
+    ~BoundSocket() { ::close(fd); }
+};
 
 } // namespace
 
@@ -65,11 +101,16 @@ TEST_CASE("rows of text pass 1 MiB in pieces and land whole, and only at finish"
     }
     CHECK(readFile(dir / "rows.csv") == want);
     CHECK(namesIn(dir.path()) == std::vector<std::string>{"rows.csv"});
-    // A write that fails is an error naming the file, not a silent short file.
-    REQUIRE(fs::exists("/dev/full")); // Linux's always-full device
-    TextOutput full("/dev/full");
-    full.text() = "x\n";
-    CHECK_THROWS_WITH(full.finish(), Catch::Contains("/dev/full"));
+    // A write that fails is an error naming the file, not a silent short file; the old file
+    // stays and no temporary is left.
+    {
+        TextOutput full(dir / "rows.csv");
+        full.text() = std::string(64 * 1024, 'x');
+        const FileSizeLimit limit(4096); // as if the disk filled up after 4 KiB
+        CHECK_THROWS_WITH(full.finish(), Catch::Contains("rows.csv"));
+    }
+    CHECK(readFile(dir / "rows.csv") == want);
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"rows.csv"});
 }
 
 TEST_CASE("an output abandoned before commit leaves the old file and no temporary") {
@@ -108,17 +149,45 @@ TEST_CASE("a replaced file keeps its permissions") {
           (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
 }
 
-TEST_CASE("a device is written as it is, never replaced") {
-    writeFileAtomically("/dev/null", "into the void\n");
+TEST_CASE("a FIFO, a socket or a device is refused as an output, never opened or replaced") {
+    TempDir dir;
+    REQUIRE(::mkfifo((dir / "ff").c_str(), 0600) == 0);
+    // A reader holds the FIFO open, so a write that opened it would not block but succeed.
+    const int reader = ::open((dir / "ff").c_str(), O_RDONLY | O_NONBLOCK);
+    REQUIRE(reader >= 0);
+    CHECK_THROWS_WITH(checkOutputFile(dir / "ff", "-o"),
+                      Catch::Contains("-o") && Catch::Contains("ff") && Catch::Contains("a FIFO"));
+    CHECK_THROWS_WITH(writeFileAtomically(dir / "ff", "x"), Catch::Contains("a FIFO"));
+    CHECK_THROWS_AS(TextOutput(dir / "ff"), InputError);
+    char byte = 0;
+    CHECK(::read(reader, &byte, 1) == 0); // nothing was written into it
+    ::close(reader);
+    fs::create_symlink("ff", dir / "link");
+    CHECK_THROWS_WITH(checkOutputFile(dir / "link", "--report"),
+                      Catch::Contains("--report") && Catch::Contains("a FIFO"));
+
+    const BoundSocket socket(dir / "sock");
+    CHECK_THROWS_WITH(checkOutputFile(dir / "sock", "--json"),
+                      Catch::Contains("--json") && Catch::Contains("a socket"));
+    CHECK_THROWS_AS(AtomicOutputFile(dir / "sock"), InputError);
+
+    CHECK_THROWS_WITH(checkOutputFile("/dev/null", "-o"),
+                      Catch::Contains("/dev/null") && Catch::Contains("a character device"));
+    CHECK_THROWS_AS(writeFileAtomically("/dev/null", "into the void\n"), InputError);
     struct stat st {};
     REQUIRE(::stat("/dev/null", &st) == 0);
-    CHECK(S_ISCHR(st.st_mode));
-    // A failed write is reported at commit (here: /dev/full, always out of space).
-    if (fs::exists("/dev/full")) {
-        AtomicOutputFile file("/dev/full");
-        file.stream() << "x";
-        CHECK_THROWS_AS(file.commit(), std::runtime_error);
-    }
+    CHECK(S_ISCHR(st.st_mode)); // not replaced
+    CHECK(fs::is_fifo(dir / "ff"));
+    CHECK(fs::is_socket(dir / "sock"));
+    CHECK(namesIn(dir.path()) == std::vector<std::string>{"ff", "link", "sock"});
+
+    // checkOutputKind refuses by kind only: a missing file, even in a missing folder, passes.
+    CHECK_THROWS_WITH(checkOutputKind(dir / "ff", "--record (device 'left')"),
+                      Catch::Contains("--record (device 'left')") && Catch::Contains("a FIFO"));
+    CHECK_THROWS_WITH(checkOutputKind(dir.path(), "-o"), Catch::Contains("folder"));
+    CHECK_NOTHROW(checkOutputKind(dir / "missing" / "left.trace", "--record"));
+    writeFile(dir / "plain", "x");
+    CHECK_NOTHROW(checkOutputKind(dir / "plain", "-o"));
 }
 
 TEST_CASE("outputs that cannot be written are refused, naming the option and the path") {
@@ -132,7 +201,6 @@ TEST_CASE("outputs that cannot be written are refused, naming the option and the
     CHECK_THROWS_AS(AtomicOutputFile(dir / "sub"), InputError);
     CHECK_THROWS_AS(AtomicOutputFile(dir / "missing" / "r.json"), InputError);
     CHECK_NOTHROW(checkOutputFile(dir / "fine.json", "-o"));
-    CHECK_NOTHROW(checkOutputFile("/dev/null", "-o"));
 
     writeFile(dir / "file", "x");
     CHECK_THROWS_WITH(checkOutputFolder(dir / "file", "--record"),

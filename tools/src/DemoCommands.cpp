@@ -71,13 +71,6 @@ struct Felt {
 
 int runDemo(const DemoArgs& a) {
     StopSignals signals; // before any thread starts; see `hapto run`
-    // One copy of the scene: the world's first snapshot shares it with the hands and the view.
-    const auto shared = std::make_shared<const Scene>(
-        a.scene.empty() ? makeGraspScene() : loadSceneOrDefault(a.scene));
-    const Scene& scene = *shared;
-    if (!scene.slotOf(a.object)) {
-        throw InputError("--object: the scene has no object with id " + std::to_string(a.object));
-    }
     std::vector<DeviceConfig> configs =
         a.devices.empty() ? graspHands(a.object) : loadDeviceConfigFile(a.devices);
     if (configs.size() != 2) {
@@ -86,7 +79,14 @@ int runDemo(const DemoArgs& a) {
                          std::to_string(configs.size()));
     }
     useTraceSettings(configs);
-    checkSessionFiles({a.scene, a.devices, a.report, ""}, configs);
+    checkSessionFiles({a.scene, a.devices, a.report, ""}, configs); // before the scene loads
+    // One copy of the scene: the world's first snapshot shares it with the hands and the view.
+    const auto shared = std::make_shared<const Scene>(
+        a.scene.empty() ? makeGraspScene() : loadSceneOrDefault(a.scene));
+    const Scene& scene = *shared;
+    if (!scene.slotOf(a.object)) {
+        throw InputError("--object: the scene has no object with id " + std::to_string(a.object));
+    }
     World world(shared, sessionIndexSpec(a.index, scene, a.maxIndexMb));
     std::vector<RuntimeDevice> devices;
     std::vector<SimDevice*> sims;

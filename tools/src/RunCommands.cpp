@@ -125,10 +125,6 @@ int runSession(const RunArgs& a) {
     // First, before any thread starts (the index build's TBB workers included), so that every
     // thread inherits the blocked stop signals and only the signal thread takes them.
     StopSignals signals;
-    // One copy of the scene: the world's first snapshot shares it with the devices and the view.
-    const auto shared = std::make_shared<const Scene>(loadSceneOrDefault(a.scene));
-    const Scene& scene = *shared;
-    const IndexSpec spec = sessionIndexSpec(a.index, scene, a.maxIndexMb);
     std::vector<DeviceConfig> configs =
         a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
     if (a.rateHz > 0) {
@@ -136,8 +132,12 @@ int runSession(const RunArgs& a) {
             c.rateHz = a.rateHz;
         }
     }
-    prepareSession(a, configs);
-    World world(shared, spec);
+    prepareSession(a, configs); // the outputs are checked before the scene is loaded
+    // One copy of the scene: the world's first snapshot shares it with the devices and the view.
+    const auto shared = std::make_shared<const Scene>(loadSceneOrDefault(a.scene));
+    const Scene& scene = *shared;
+    const IndexSpec spec = sessionIndexSpec(a.index, scene, a.maxIndexMb);
+    World world(shared, spec); // the world is ready before any device, recording or view
 
     std::vector<std::unique_ptr<TraceRecorder>> recorders;
     if (!a.record.empty()) {

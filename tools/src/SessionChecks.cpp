@@ -71,11 +71,7 @@ void checkSessionFiles(const SessionPaths& paths, std::span<const DeviceConfig> 
                 throw InputError("--report " + paths.report + " is where --record writes device '" +
                                  c.name + "''s trace; give the report another name");
             }
-            std::error_code ec;
-            if (fs::is_directory(trace, ec)) {
-                throw InputError(option + ": " + trace.string() +
-                                 " is a folder, so the trace cannot be written there");
-            }
+            checkOutputKind(trace, option); // a folder, FIFO, socket or device there
         }
     }
 }

@@ -33,11 +33,12 @@ void checkDeviceCount(std::size_t devices, const std::string& source);
 /// every device at its rate. [control]
 void checkSpinAgainstRates(double spinUs, std::span<const DeviceConfig> configs);
 
-/// Refuses outputs that cannot be written or would destroy an input: a --report that is a
-/// folder, in a missing or read-only folder, or the same file as the scene, the device file or
-/// a replay device's trace; a --record folder that cannot be made or written, or whose
-/// `<name>.trace` would be a folder, an input (a trace a replay device of this session reads,
-/// the scene, the device file) or the report. Nothing is created. [control]
+/// Refuses outputs that cannot be written or would destroy an input: a --report that is not a
+/// regular file (a folder, FIFO, socket or device), in a missing or read-only folder, or the
+/// same file as the scene, the device file or a replay device's trace; a --record folder that
+/// cannot be made or written, or whose `<name>.trace` is not a regular file, an input (a trace a
+/// replay device of this session reads, the scene, the device file) or the report. Nothing is
+/// created. [control]
 void checkSessionFiles(const SessionPaths& paths, std::span<const DeviceConfig> configs);
 
 } // namespace hapto::cli

@@ -4,9 +4,9 @@
 #   run_bad_inputs.sh HAPTO [CASE...]     every case, or only the named ones
 #
 # For each case, in a fresh scratch folder holding a copy of the corpus, a folder (adir), a
-# FIFO nobody writes (fifo), outputs that already exist (outputs/*) and a symlink to an input
-# (outputs/link.json -> ../scenes/ok.json), it runs `hapto ARGS` from that folder under
-# `timeout 20` and checks that
+# FIFO nobody writes (fifo), a Unix socket nobody listens on (sock), outputs that already
+# exist (outputs/*) and a symlink to an input (outputs/link.json -> ../scenes/ok.json), it
+# runs `hapto ARGS` from that folder under `timeout 20` and checks that
 #   - it ends by itself within 20 s (a FIFO or /dev/zero must not make it hang),
 #   - it exits with code 2 (bad input),
 #   - its output contains the case's text (the message names the offending thing),
@@ -38,6 +38,7 @@ run_case() {
     cp -R "$corpus/scenes" "$corpus/devices" "$corpus/points" "$corpus/traces" "$corpus/reports" "$scratch/"
     mkdir "$scratch/adir" "$scratch/outputs"
     mkfifo "$scratch/fifo"
+    python3 -c 'import socket, sys; socket.socket(socket.AF_UNIX).bind(sys.argv[1])' "$scratch/sock"
     printf 'a report from before\n' >"$scratch/outputs/report.json"
     printf 'point,candidates\n0,1\n' >"$scratch/outputs/out.csv"
     printf '{"an": "older scene"}\n' >"$scratch/outputs/scene.json"

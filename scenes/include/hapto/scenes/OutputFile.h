@@ -6,10 +6,12 @@
 /// exclusively, never through a symlink) and is renamed onto the target only once it is
 /// complete and synced, so a failure or a kill leaves the old file as it was, never a half
 /// file. The temporary is removed when anything fails before the rename. A target that is a
-/// symlink is resolved first (the link stays, its file is replaced); a target that exists and
-/// is neither a regular file nor a folder (/dev/null, a FIFO, a terminal) is written directly,
-/// since it cannot be replaced. The checks run before any work starts, so bad output paths are
-/// refused (InputError, exit code 2) instead of being found after a long run.
+/// symlink is resolved first (the link stays, its file is replaced). A target that exists and
+/// is not a regular file (a folder, a FIFO, a socket, a device such as /dev/null or a terminal)
+/// is refused: it cannot be replaced, and opening a FIFO to write waits for a reader for ever.
+/// Paths are only stat()ed, never opened, before the temporary is made. The checks run before
+/// any work starts, so bad output paths are refused (InputError, exit code 2) instead of being
+/// found after a long run.
 
 #include <filesystem>
 #include <memory>
@@ -23,7 +25,8 @@ namespace hapto {
 /// place by commit(). Destroyed without commit(), it removes the temporary. [control]
 class AtomicOutputFile {
 public:
-    /// Creates the temporary. Throws InputError naming `path` when its folder cannot take it.
+    /// Creates the temporary. Throws InputError naming `path` when it is not a regular file
+    /// (checkOutputKind) or its folder cannot take it.
     explicit AtomicOutputFile(const std::filesystem::path& path);
     /// Removes the temporary unless commit() succeeded.
     ~AtomicOutputFile();
@@ -69,8 +72,13 @@ private:
 /// cannot take it, std::runtime_error when the write fails. [control]
 void writeFileAtomically(const std::filesystem::path& path, std::string_view content);
 
-/// Refuses (InputError naming `option`) an output file that cannot be written: a folder, or a
-/// path whose folder does not exist or is not writable. Nothing is created. [control]
+/// Refuses (InputError naming `option` and `path`) an output path that exists and is not a
+/// regular file once symlinks are followed: a folder, a FIFO, a socket, a character or block
+/// device. A missing path passes. Only stat()s the path, so it never blocks. [control]
+void checkOutputKind(const std::filesystem::path& path, std::string_view option);
+/// Refuses (InputError naming `option`) an output file that cannot be written: what
+/// checkOutputKind refuses, or a path whose folder does not exist or is not writable. Nothing
+/// is created. [control]
 void checkOutputFile(const std::filesystem::path& path, std::string_view option);
 /// Refuses (InputError naming `option`) an output folder that cannot be used: an existing
 /// non-folder, a folder not writable, or (when missing) a nearest existing parent that is not a
