@@ -1,6 +1,6 @@
-// How a `hapto run` session ends: on each of the four stop signals, and with its terminal
-// paused (Ctrl-S). [realtime]: real processes and a real pseudo-terminal; each test waits, with
-// a generous bound, for what must happen and asserts no counts of ticks or sleeps.
+// How a `hapto run` session ends: on each of the four stop signals, during its start-up, and
+// with its terminal paused (Ctrl-S). [realtime]: real processes and a real pseudo-terminal; each
+// test waits, with a generous bound, for what must happen and asserts no counts of ticks or sleeps.
 
 #include "TestSupport.h"
 
@@ -8,9 +8,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <fcntl.h>
+#include <fstream>
 #include <poll.h>
 #include <pty.h>
 #include <spawn.h>
@@ -93,6 +95,28 @@ struct Session {
     }
 };
 
+/// True once process `pid` catches SIGINT (/proc/PID/status, SigCgt): its StopSignals is
+/// installed, and the command's start-up under way.
+bool catchesSigint(pid_t pid) {
+    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+    std::string line;
+    while (std::getline(status, line)) {
+        if (line.rfind("SigCgt:", 0) == 0) {
+            return (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1;
+        }
+    }
+    return false;
+}
+
+std::vector<std::string> namesIn(const std::filesystem::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+        names.push_back(e.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
 bool waitForFile(const std::filesystem::path& p) {
     const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
     while (!std::filesystem::exists(p) && std::chrono::steady_clock::now() < until) {
@@ -171,4 +195,38 @@ TEST_CASE("a host stall (the process stopped 200 ms, then continued) is a fault 
         CHECK(d["reopens"] == d["faults"]); // every watchdog fault was recovered
         CHECK(d["ticks"].get<std::uint64_t>() > 0);
     }
+}
+
+TEST_CASE("a stop signal during start-up (a large scene loading, its index building) ends the "
+          "command then, with 128 + the signal and nothing left behind",
+          "[realtime]") {
+    TempDir dir;
+    // 3 * 10^5 cubes in an octree of 8: seconds of loading and index building, the window the
+    // signal lands in (the session itself would run, and exit 0).
+    const auto made =
+        runHapto("scene random --count 300000 --seed 7 -o " + (dir / "big.json").string());
+    REQUIRE(made.exitCode == 0);
+    for (const int sig : {SIGINT, SIGTERM}) {
+        INFO("signal " << sig);
+        Session s({"--scene", (dir / "big.json").string(), "--index", "octree:8:0.01", "--duration",
+                   "0", "--no-realtime", "--report", (dir / "r.json").string(), "--record",
+                   (dir / "rec").string()});
+        REQUIRE(eventually([&] { return catchesSigint(s.pid); }, std::chrono::seconds(20)));
+        REQUIRE(kill(s.pid, sig) == 0);
+        CHECK(s.finish() == 128 + sig);
+        // No report, no recording folder, no temporary: no session was started.
+        CHECK(namesIn(dir.path()) == std::vector<std::string>{"big.json"});
+    }
+}
+
+TEST_CASE("an orderly stop that cannot finish (its terminal paused) is forced after "
+          "StopSignals' limit: the command ends by itself with 128 + the signal",
+          "[realtime]") {
+    TempDir dir;
+    Session s({"--duration", "0", "--no-realtime", "--report", (dir / "r.json").string()});
+    REQUIRE(s.waitForOutput("hapto run:"));
+    s.pauseTerminal(); // the orderly exit blocks on its last lines, and no second signal comes
+    REQUIRE(kill(s.pid, SIGTERM) == 0);
+    REQUIRE(waitForFile(dir / "r.json")); // the devices were stopped and the report written
+    CHECK(s.finish() == 128 + SIGTERM);   // finish() waits 20 s, twice the limit
 }

@@ -88,6 +88,7 @@ int runDemo(const DemoArgs& a) {
         throw InputError("--object: the scene has no object with id " + std::to_string(a.object));
     }
     World world(shared, sessionIndexSpec(a.index, scene, a.maxIndexMb));
+    signals.endStartUp(); // a signal from now on stops the demo in order
     std::vector<RuntimeDevice> devices;
     std::vector<SimDevice*> sims;
     for (const DeviceConfig& c : configs) {

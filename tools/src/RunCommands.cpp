@@ -124,6 +124,7 @@ void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
 int runSession(const RunArgs& a) {
     // First, before any thread starts (the index build's TBB workers included), so that every
     // thread inherits the blocked stop signals and only the signal thread takes them.
+    // Until endStartUp() below, a signal ends the process at once: nothing is open or written.
     StopSignals signals;
     std::vector<DeviceConfig> configs =
         a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
@@ -138,6 +139,7 @@ int runSession(const RunArgs& a) {
     const Scene& scene = *shared;
     const IndexSpec spec = sessionIndexSpec(a.index, scene, a.maxIndexMb);
     World world(shared, spec); // the world is ready before any device, recording or view
+    signals.endStartUp();
 
     std::vector<std::unique_ptr<TraceRecorder>> recorders;
     if (!a.record.empty()) {

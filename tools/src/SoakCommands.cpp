@@ -30,6 +30,7 @@ int runSoakCommand(const SoakArgs& a) {
     if (options.index.empty()) {
         options.index = defaultIndexSpec(*scene);
     }
+    signals.endStartUp(); // the soak's own start-up stops in order
     experiments::SoakControl control;
     control.stopRequested = [&signals] { return signals.requested(); };
     control.onRuntime = [&signals](Runtime& runtime) {

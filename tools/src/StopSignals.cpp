@@ -1,10 +1,13 @@
 // StopSignals: the four stop signals are blocked in every thread and taken with sigtimedwait
 // on one thread of their own. A signal sent to the process while some thread (a TBB worker
 // made before) still has them unblocked runs the fallback handler, which only counts it; the
-// watcher picks the count up on its next pass.
+// watcher picks the count up on its next pass. During start-up the watcher ends the process
+// itself; the phase is one atomic the watcher and endStartUp() race for with a compare-exchange,
+// so either the process exits before anything is opened, or the signal is an orderly stop.
 
 #include "StopSignals.h"
 
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <ctime>
@@ -65,10 +68,20 @@ void StopSignals::onSecondSignal(std::function<void()> action) {
     mSecondSet.store(true);
 }
 
+void StopSignals::endStartUp() {
+    int phase = kStartUp;
+    if (!mPhase.compare_exchange_strong(phase, kSession) && phase == kExiting) {
+        for (;;) { // the signal thread is ending the process
+            std::this_thread::sleep_for(std::chrono::seconds(1));
+        }
+    }
+}
+
 void StopSignals::watch() {
     const sigset_t set = stopSet();
     const timespec pass{0, 20'000'000}; // 20 ms: how soon a quit or a handled signal is seen
     int seenHandled = 0;
+    std::chrono::steady_clock::time_point forceAt{};
     while (!mQuit.load()) {
         int sig = sigtimedwait(&set, nullptr, &pass);
         const int handled = gHandled.load();
@@ -76,18 +89,25 @@ void StopSignals::watch() {
             sig = gHandledFirst.load();
             seenHandled = handled;
         }
-        if (sig <= 0) {
+        const bool overdue = mCount.load() > 0 && std::chrono::steady_clock::now() >= forceAt;
+        if (sig <= 0 && !overdue) {
             continue;
         }
         int none = 0;
-        mFirst.compare_exchange_strong(none, sig);
-        if (mCount.fetch_add(1) >= 1) {
-            // The second: make the devices safe without the control thread, and leave.
+        mFirst.compare_exchange_strong(none, sig > 0 ? sig : SIGTERM);
+        int phase = kStartUp;
+        if (mPhase.compare_exchange_strong(phase, kExiting)) {
+            std::_Exit(128 + mFirst.load()); // start-up: nothing opened, nothing to finish
+        }
+        if (overdue || mCount.fetch_add(1) >= 1) {
+            // The second, or the first not done in time: make the devices safe without the
+            // control thread, and leave.
             if (mSecondSet.load()) {
                 mSecond();
             }
-            std::_Exit(128 + sig);
+            std::_Exit(128 + (overdue ? mFirst.load() : sig));
         }
+        forceAt = std::chrono::steady_clock::now() + std::chrono::seconds(kOrderlyStopLimitS);
     }
 }
 
