@@ -1,4 +1,4 @@
-// `hapto experiment devices`: haptic load against the number of devices sharing one world,
+// `hapto experiment scaling`: haptic load against the number of devices sharing one world,
 // and cursor steps per locate against N for the three cursor strategies.
 
 #include "hapto/experiments/Experiments.h"
@@ -71,7 +71,7 @@ std::vector<Vec3> clearStarts(const Scene& scene, const SpatialIndex& index, int
     }
     for (int attempt = 0; static_cast<int>(starts.size()) < count; ++attempt) {
         if (attempt == 200000) {
-            throw InputError("experiment devices: found only " + std::to_string(starts.size()) +
+            throw InputError("experiment scaling: found only " + std::to_string(starts.size()) +
                              " clear start points in the scene for " + std::to_string(count) +
                              " devices; use a scene with more free space or fewer devices");
         }
@@ -610,7 +610,7 @@ int runDevices(const DevicesArgs& args) {
     }
     md += "\nFiles: " + (out / "devices.csv").string() + ", " +
           (out / "devices-per-device.csv").string() + ", " + (out / "cursor.csv").string() + ", " +
-          (out / "devices.json").string();
+          (out / "devices.json").string() + ", " + (out / "devices.md").string();
     for (const auto& p : plots) {
         md += ", " + p.string();
     }

@@ -35,7 +35,7 @@ TEST_CASE("soak: a soak that would end before its first fault is refused, naming
     // Faults stop a quiet tail before the end (3 watchdogs + 1 s + a reopen), so the last can
     // recover: long enough for one fault and its tail, it is accepted.
     o.durationS = 60.0;
-    CHECK(soakQuietTailS(o) == Approx(3 * 0.05 + 1.0 + 0.2));
+    CHECK(soakQuietTailS(o) == Approx(3 * 0.05 + 1.0 + 1.0));
     CHECK_NOTHROW(checkSoakOptions(o));
     o.faultEveryS = 60.0 - soakQuietTailS(o);
     CHECK_THROWS_AS(checkSoakOptions(o), InputError);

@@ -62,7 +62,7 @@ struct MeshesArgs {
 /// Runs the mesh experiment; returns the process exit code. [control]
 int runMeshes(const MeshesArgs& args);
 
-/// `hapto experiment devices`: load against device count, and cursor steps against N.
+/// `hapto experiment scaling`: load against device count, and cursor steps against N.
 struct DevicesArgs {
     CommonArgs common;
     int maxDevices = 8;                          ///< Largest device count (1, 2, 4, ... up to it).

@@ -1,6 +1,6 @@
 #pragma once
 /// A seeded hand-speed random walk: one pointer position per servo tick, for benchmarks and
-/// experiments (hapto_bench, `hapto bench query`, the cursor part of `hapto experiment devices`).
+/// experiments (hapto_bench, `hapto bench query`, the cursor part of `hapto experiment scaling`).
 ///
 /// The idea: drive every index and every baseline with the same motion a hand makes at a
 /// haptic device, so cursor caching is exercised the way a servo thread exercises it. The

@@ -3,6 +3,7 @@
 /// injected on a schedule; drift, misses, memory and fault handling, with a verdict.
 
 #include "hapto/index/IndexSpec.h"
+#include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Scene.h"
 
 #include <cstdint>
@@ -10,10 +11,6 @@
 #include <memory>
 #include <string>
 #include <vector>
-
-namespace hapto {
-class Runtime;
-}
 
 namespace hapto::experiments {
 
@@ -25,10 +22,11 @@ struct SoakOptions {
     double rateHz = 1000.0;                    ///< Servo rate of every hand (Hz).
     std::string index = "octree:2:0.005";      ///< Spatial index specification.
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes; ///< Index memory limit (MB).
-    double faultEveryS = 15.0;       ///< A fault every this many seconds, hands in turn.
-    double windowS = 60.0;           ///< Report window (s).
-    double watchdogMs = 50.0;        ///< Watchdog timeout (ms); stalls are sized by it.
-    double reopenMs = 200.0;         ///< Reopen period after a fault (ms).
+    double faultEveryS = 15.0; ///< A fault every this many seconds, hands in turn.
+    double windowS = 60.0;     ///< Report window (s).
+    double watchdogMs = 50.0;  ///< Watchdog timeout (ms); stalls are sized by it.
+    /// Reopen period after a fault (ms): the runtime's, as `hapto run` has it.
+    double reopenMs = static_cast<double>(RuntimeOptions{}.reopenAfterNs) / 1e6;
     double memoryToleranceMiB = 2.0; ///< Allowed resident-memory growth (MiB).
     std::string report;              ///< JSON report path; empty: none.
     bool realtime = true;            ///< Ask for SCHED_FIFO and pinning.
