@@ -1,4 +1,4 @@
-// `hapto experiment paper1|paper2|meshes|devices --quick`: the files, their columns and the sanity
+// `hapto experiment paper1|paper2|meshes|scaling --quick`: the files, their columns and the sanity
 // of their values. The experiments run real servo threads for their load figures (wall clock),
 // so the cases that run one are tagged [realtime] and run alone; they check the files and the
 // invariants between columns (a row that measured nothing is marked skipped by the experiment
@@ -319,15 +319,20 @@ TEST_CASE("hapto experiment paper2 --quick writes Table 2 for the 200-object sce
     CHECK(j["limits"].size() == 4);
 }
 
-TEST_CASE("hapto experiment devices --quick: load against devices and cursor steps against N",
+TEST_CASE("hapto experiment scaling --quick: load against devices and cursor steps against N",
           "[realtime]") {
     test::TempDir dir;
-    const auto r = test::runHapto("experiment devices --quick --out " + dir.path().string());
+    const auto r = test::runHapto("experiment scaling --quick --out " + dir.path().string());
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
+    // Every file it writes is there, and listed on the results' "Files:" line.
+    const std::size_t files = r.output.find("\nFiles: ");
+    REQUIRE(files != std::string::npos);
+    const std::string listed = r.output.substr(files, r.output.find('\n', files + 1) - files);
     for (const char* f :
          {"devices.csv", "devices-per-device.csv", "cursor.csv", "devices.json", "devices.md"}) {
         CHECK(std::filesystem::exists(dir / f));
+        CHECK_THAT(listed, Catch::Contains((dir / f).string()));
     }
     if (gnuplotOnPath()) {
         CHECK(std::filesystem::file_size(dir / "devices-load.png") > 0);
@@ -419,11 +424,11 @@ TEST_CASE("hapto experiment: bad arguments exit 2 with a message") {
              "experiment meshes --quick --max-triangles 99",
              "experiment meshes --quick --max-triangles 2e7",
              "experiment meshes --quick --size nan",
-             "experiment devices --quick --script run",
-             "experiment devices --quick --index bogus",
-             "experiment devices --quick --rates 1000,x",
-             "experiment devices --quick --walk-steps 0",
-             "experiment devices --quick --scene /nonexistent/scene.json",
+             "experiment scaling --quick --script run",
+             "experiment scaling --quick --index bogus",
+             "experiment scaling --quick --rates 1000,x",
+             "experiment scaling --quick --walk-steps 0",
+             "experiment scaling --quick --scene /nonexistent/scene.json",
              "experiment nothing",
          }) {
         const auto r = test::runHapto(args + out);

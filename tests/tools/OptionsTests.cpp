@@ -95,12 +95,167 @@ TEST_CASE("wholeNumber reads counts as numbers, with or without an exponent") {
     CHECK_THAT(parseWhole({"--list", "10,x"}, n, list), Catch::Contains("not a number"));
 }
 
+TEST_CASE("positiveRange refuses 0 and says so in its range, which reads (0, hi]") {
+    const auto parsePositive = [](const std::string& value) -> std::string {
+        CLI::App app;
+        double x = 1.0;
+        app.add_option("--x", x)->check(positiveRange(10));
+        std::vector<std::string> args{value, "--x"}; // CLI11 takes them in reverse
+        try {
+            app.parse(args);
+        } catch (const CLI::ParseError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    CHECK_THAT(parsePositive("0"),
+               Catch::Contains("out of range") && Catch::Contains("above 0 and at most 10"));
+    CHECK_THAT(parsePositive("-1"), Catch::Contains("out of range"));
+    CHECK_THAT(parsePositive("nan"), Catch::Contains("not a finite number"));
+    CHECK_THAT(parsePositive("11"), Catch::Contains("out of range"));
+    CHECK(parsePositive("1e-9").empty());
+    CHECK(parsePositive("10").empty());
+    CHECK(positiveRange(10).get_description() == "in (0, 10]");
+    CHECK(finiteRange(0, 10).get_description() == "in [0, 10]");
+}
+
+TEST_CASE("wrapText breaks at spaces within the width and indents the lines after the first") {
+    CHECK(wrapText("one two three four", 9, 2) == "one two\n  three\n  four");
+    CHECK(wrapText("short", 80, 4) == "short");
+    // A word longer than the width stands alone; a newline is kept, with the indent.
+    CHECK(wrapText("a verylongword b", 5, 0) == "a\nverylongword\nb");
+    CHECK(wrapText("first\nsecond line", 80, 3) == "first\n   second line");
+    // A line's own leading spaces (an example's indent) start each of its pieces.
+    CHECK(wrapText("  aa bb cc", 7, 0) == "  aa bb\n  cc");
+}
+
+namespace {
+
+/// The help of `app` laid out by HelpFormatter, as `--help` (or, with `all`, `--help-all`)
+/// prints it.
+std::string helpOf(CLI::App& app, bool all = false) {
+    return app.help("", all ? CLI::AppFormatMode::All : CLI::AppFormatMode::Normal);
+}
+
+/// The lines of `text`.
+std::vector<std::string> linesOf(const std::string& text) {
+    std::vector<std::string> lines;
+    std::size_t start = 0;
+    while (start < text.size()) {
+        const std::size_t end = std::min(text.find('\n', start), text.size());
+        lines.push_back(text.substr(start, end - start));
+        start = end + 1;
+    }
+    return lines;
+}
+
+} // namespace
+
+TEST_CASE("HelpFormatter: --help-all gives every command at every depth, wrapped, with examples") {
+    CLI::App app("A tool.", "tool");
+    app.formatter(std::make_shared<HelpFormatter>());
+    app.set_help_all_flag("--help-all", "Everything");
+    CLI::App* group = app.add_subcommand("group", "A group of commands");
+    CLI::App* leaf = group->add_subcommand("leaf", "A command two levels down");
+    double depth = 1.0;
+    leaf->add_option("--deep-option", depth,
+                     std::string(40, 'a') + " " + std::string(40, 'b') + " " +
+                         std::string(40, 'c') + " " + std::string(40, 'd'));
+    setExamples(leaf, {"tool group leaf --deep-option 2"});
+    const std::string all = helpOf(app, true);
+    INFO(all);
+    // CLI11 by itself lists `leaf` under `group` by name only.
+    CHECK_THAT(all, Catch::Contains("\ntool group leaf\n"));
+    CHECK_THAT(all, Catch::Contains("--deep-option FLOAT"));
+    CHECK_THAT(all, Catch::Contains("Examples:\n  tool group leaf --deep-option 2"));
+    for (const std::string& line : linesOf(all)) {
+        INFO(line);
+        CHECK(line.size() <= kTextWidth);
+    }
+    // A command's own help wraps the same way.
+    for (const std::string& line : linesOf(helpOf(*leaf))) {
+        CHECK(line.size() <= kTextWidth);
+    }
+}
+
+TEST_CASE("the realtime flag's help names its default, not CLI11's {false}") {
+    for (const bool asks : {true, false}) {
+        CLI::App app;
+        app.formatter(std::make_shared<HelpFormatter>());
+        bool realtime = asks;
+        addRealtimeFlag(&app, realtime, "");
+        const std::string help = helpOf(app);
+        INFO(help);
+        CHECK_THAT(help, Catch::Contains("--realtime,--no-realtime") && !Catch::Contains("{"));
+        CHECK_THAT(help, Catch::Contains(asks ? "Default: ask" : "Default: do not"));
+    }
+}
+
+TEST_CASE("a renamed option is refused naming its new spelling, whatever it is given") {
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"hands.json", "--devices"}, {"3", "--devices"}, {"--devices"}}) {
+        CLI::App app;
+        int hands = 2;
+        app.add_option("--hands", hands);
+        addRenamedOption(&app, "--devices", "--hands N", "a device file elsewhere");
+        std::vector<std::string> reversed = args;
+        std::string error;
+        try {
+            app.parse(reversed);
+        } catch (const CLI::ParseError& e) {
+            error = e.what();
+        }
+        CHECK_THAT(error, Catch::Contains("--devices") && Catch::Contains("use --hands N"));
+    }
+}
+
+TEST_CASE("the view's options: --view serves it, --view-port and --view-bind need --view") {
+    const auto parseView = [](std::vector<std::string> args, ViewArgs& view) -> std::string {
+        CLI::App app;
+        addViewOptions(&app, view);
+        std::reverse(args.begin(), args.end()); // CLI11 takes them in reverse
+        try {
+            app.parse(args);
+        } catch (const CLI::ParseError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    ViewArgs off;
+    CHECK(parseView({}, off).empty());
+    CHECK_FALSE(off.enabled);
+    ViewArgs on;
+    CHECK(parseView({"--view"}, on).empty());
+    CHECK(on.enabled);
+    CHECK(on.port == kDefaultViewPort);
+    ViewArgs any;
+    CHECK(parseView({"--view", "--view-port", "0"}, any).empty());
+    CHECK((any.enabled && any.port == 0));
+    ViewArgs old; // the old spelling still works
+    CHECK(parseView({"--view", "0"}, old).empty());
+    CHECK((old.enabled && old.port == 0));
+    ViewArgs alone;
+    CHECK_THAT(parseView({"--view-port", "0"}, alone), Catch::Contains("--view"));
+    CHECK_THAT(parseView({"--view", "--view-port", "70000"}, alone),
+               Catch::Contains("--view-port"));
+    CHECK_THAT(parseView({"--view", "nan"}, alone), Catch::Contains("--view"));
+    // Its help does not read as if the view were on by default.
+    CLI::App app;
+    app.formatter(std::make_shared<HelpFormatter>());
+    ViewArgs shown;
+    addViewOptions(&app, shown);
+    const std::string help = helpOf(app);
+    INFO(help);
+    CHECK_THAT(help, Catch::Contains("--view-port PORT") && Catch::Contains("=8340") &&
+                         !Catch::Contains("--view INT") && !Catch::Contains("--view :"));
+}
+
 TEST_CASE("the realtime flag takes --realtime and --no-realtime") {
     for (const auto& [args, expected] : std::vector<std::pair<std::vector<std::string>, bool>>{
              {{}, true}, {{"--no-realtime"}, false}, {{"--realtime"}, true}}) {
         CLI::App app;
         bool realtime = true;
-        addRealtimeFlag(&app, realtime, "default: ask");
+        addRealtimeFlag(&app, realtime, "");
         std::vector<std::string> reversed(args.rbegin(), args.rend());
         app.parse(reversed);
         CHECK(realtime == expected);

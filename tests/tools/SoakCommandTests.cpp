@@ -28,7 +28,7 @@ TEST_CASE("hapto soak injects every kind of fault, each device comes back, and t
     // 12 s, a fault every 0.5 s: the five kinds each at least once over three hands. The
     // watchdog is generous so a slow (sanitizer) build does not trip it by itself.
     const CommandResult r =
-        runHapto("soak --minutes 0.2 --devices 3 --fault-every 0.5 --window 2 --watchdog-ms 200 "
+        runHapto("soak --minutes 0.2 --hands 3 --fault-every 0.5 --window 2 --watchdog-ms 200 "
                  "--reopen-ms 50 --no-realtime --memory-tolerance 64 --report " +
                  (dir / "soak.json").string());
     INFO(r.output);
@@ -75,8 +75,8 @@ TEST_CASE("hapto soak injects every kind of fault, each device comes back, and t
 }
 
 TEST_CASE("hapto soak rejects bad arguments with exit 2") {
-    for (const char* args : {"soak --minutes -1", "soak --devices 0", "soak --fault-every 0",
-                             "soak --index octree:x"}) {
+    for (const char* args : {"soak --minutes -1", "soak --hands 0", "soak --hands 33",
+                             "soak --fault-every 0", "soak --index octree:x"}) {
         INFO(args);
         const CommandResult r = runHapto(args);
         CHECK(r.exitCode == 2);

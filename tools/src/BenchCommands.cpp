@@ -717,6 +717,7 @@ void addBenchCommands(CLI::App& app) {
     CLI::App* bench =
         app.add_subcommand("bench", "Measure the speed of the spatial indices and the servo tick");
     bench->require_subcommand(1);
+    setExamples(bench, {"hapto bench query --steps 1e5", "hapto bench tick --ticks 5000"});
 
     auto args = std::make_shared<QueryArgs>();
     auto* cmd = bench->add_subcommand(
@@ -750,6 +751,9 @@ void addBenchCommands(CLI::App& app) {
     cmd->add_flag("--json", args->json,
                   "Print only a JSON array of {index, objects, steps, ns_p50, ns_p999, ns_mean, "
                   "locate_steps_mean, candidates_mean}");
+    setExamples(cmd, {"hapto bench query --steps 1e5",
+                      "hapto bench query --scene million.hsb --index octree:2:0.005@climb "
+                      "--index grid:20 --json"});
     cmd->callback([args] { runQuery(*args); });
 
     auto targs = std::make_shared<TickArgs>();
@@ -813,6 +817,8 @@ void addBenchCommands(CLI::App& app) {
                      "device, walk_min, walk_max, stages: {read, ...: {ns_p50, ns_p99, ns_p999, "
                      "ns_mean}}, tick: "
                      "{...}, locate_steps_mean, candidates_mean, contact_fraction} to this file");
+    setExamples(tick, {"hapto bench tick --ticks 5000",
+                       "hapto bench tick --scene mesh.json --device sim --json tick.json"});
     tick->callback([targs] { runTick(*targs); });
 }
 

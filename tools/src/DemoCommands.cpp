@@ -219,7 +219,7 @@ int runDemo(const DemoArgs& a) {
                     felt[i].maxForceN, 100 * d.loadFraction.p50, 100 * d.loadFraction.p999,
                     d.fault.empty() ? (d.stable ? "stable" : "UNSTABLE") : d.fault.c_str());
         if (const std::string note = lateWakeupNote(d); !note.empty()) {
-            std::printf("         %s\n", note.c_str());
+            std::printf("         %s\n", wrapText(note, kTextWidth - 9, 9).c_str());
         }
         devicesJson.push_back({{"name", d.name},
                                {"ticks", d.ticks},
@@ -266,6 +266,7 @@ int runDemo(const DemoArgs& a) {
 void addDemoCommands(CLI::App& app) {
     auto* demo = app.add_subcommand("demo", "Scripted demonstrations");
     demo->require_subcommand(1);
+    setExamples(demo, {"hapto demo grasp --view"});
     auto* cmd = demo->add_subcommand(
         "grasp", "Two simulated hands approach an object from both sides, squeeze, lift it 5 cm, "
                  "carry it 10 cm sideways, put it down and let go (about 9 s)");
@@ -280,8 +281,10 @@ void addDemoCommands(CLI::App& app) {
     addIndexOption(cmd, a->index);
     addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--report", a->report, "Write a JSON report here");
-    addRealtimeFlag(cmd, a->realtime, "default: do not, the demo shares the machine");
+    addRealtimeFlag(cmd, a->realtime, "the demo shares the machine");
     addViewOptions(cmd, a->view);
+    setExamples(cmd, {"hapto demo grasp --view",
+                      "hapto demo grasp --scene grasp.json --object 3 --report grasp.json"});
     cmd->callback([a] { runDemo(*a); });
 }
 

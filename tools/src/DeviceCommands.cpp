@@ -1,6 +1,7 @@
 // `hapto devices`: what hardware this machine can reach, and why not when it cannot.
 
 #include "Commands.h"
+#include "Options.h"
 
 #include "hapto/devices/FalconDevice.h"
 #include "hapto/devices/PhantomDevice.h"
@@ -17,6 +18,7 @@ void addDeviceCommands(CLI::App& app) {
     auto library = std::make_shared<std::string>("libHD.so");
     cmd->add_option("--hd-library", *library, "OpenHaptics HD library to probe")
         ->capture_default_str();
+    setExamples(cmd, {"hapto devices", "hapto devices --hd-library /opt/OpenHaptics/lib/libHD.so"});
     cmd->callback([library] {
         std::string why;
         const std::vector<FalconInfo> falcons = listFalcons(why);

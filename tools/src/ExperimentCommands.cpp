@@ -1,4 +1,4 @@
-// `hapto experiment paper1|paper2|meshes|devices`: the paper's experiments and load scaling,
+// `hapto experiment paper1|paper2|meshes|scaling`: the paper's experiments and load scaling,
 // measured by the real Runtime, written as CSV, JSON, markdown and gnuplot figures.
 
 #include "Commands.h"
@@ -42,7 +42,7 @@ void addCommon(CLI::App* cmd, CommonArgs& a, CommonOptions& o, const std::string
                                 "--quick: 1")
                     ->capture_default_str()
                     ->check(finiteRange(1, 99));
-    addRealtimeFlag(cmd, a.realtime, "default: ask");
+    addRealtimeFlag(cmd, a.realtime, "");
 }
 
 void applyQuick(CommonArgs& a, const CommonOptions& o) {
@@ -86,6 +86,7 @@ void addExperimentCommands(CLI::App& app) {
         "(servo threads, absolute deadlines); write CSV, JSON, markdown tables and gnuplot "
         "figures");
     exp->require_subcommand(1);
+    setExamples(exp, {"hapto experiment paper1 --quick", "hapto experiment scaling --quick"});
 
     // paper1
     {
@@ -99,6 +100,8 @@ void addExperimentCommands(CLI::App& app) {
             "outside the lattice's +z face. A renderer stops growing after its first unstable "
             "K. Prints the analogue of the paper's Table 1 and the max stable objects");
         addCommon(cmd, a->common, *o, "paper1");
+        setExamples(cmd, {"hapto experiment paper1 --quick",
+                          "hapto experiment paper1 --rates 1000 --max-per-side 20 --out out/p1"});
         auto verdict = std::make_shared<std::string>("design");
         addVerdict(cmd, *verdict);
         addRates(cmd, a->ratesHz, "e.g. 1000,10000");
@@ -137,6 +140,8 @@ void addExperimentCommands(CLI::App& app) {
             "2x2x2, grid 5x5x5 and octree M=2; conditions no touch / touch / sliding. Prints "
             "the analogue of the paper's Table 2 (200-object scenes) and the max stable objects");
         addCommon(cmd, a->common, *o, "paper2");
+        setExamples(cmd, {"hapto experiment paper2 --quick",
+                          "hapto experiment paper2 --counts 100,200,500 --decades"});
         auto verdict = std::make_shared<std::string>("design");
         addVerdict(cmd, *verdict);
         auto* countsOpt = cmd->add_option("--counts", a->counts,
@@ -197,6 +202,8 @@ void addExperimentCommands(CLI::App& app) {
             "side. A renderer stops growing after its first unstable size (brute force does "
             "long before 1e6)");
         addCommon(cmd, a->common, *o, "meshes");
+        setExamples(cmd, {"hapto experiment meshes --quick",
+                          "hapto experiment meshes --shape torus --max-triangles 1e6"});
         auto verdict = std::make_shared<std::string>("design");
         addVerdict(cmd, *verdict);
         addRates(cmd, a->ratesHz, "e.g. 1000,4000");
@@ -247,13 +254,16 @@ void addExperimentCommands(CLI::App& app) {
         auto o = std::make_shared<CommonOptions>();
         auto noCursor = std::make_shared<bool>(false);
         auto* cmd = exp->add_subcommand(
-            "devices",
+            "scaling",
             "Load scaling: 1, 2, 4, ... simulated hands (distinct seeds, clear start points) "
             "over one scene and one World, one servo thread each, at several rates: per-device "
             "and total load, misses, verdict. Then the three octree cursor strategies (root, "
             "climb, neighbour links) along one hand-speed walk over K^3 lattices: mean steps "
             "per locate against N (the paper's section 2.2.4)");
-        addCommon(cmd, a->common, *o, "devices");
+        addCommon(cmd, a->common, *o, "scaling");
+        setExamples(cmd,
+                    {"hapto experiment scaling --quick",
+                     "hapto experiment scaling --max-devices 8 --rates 1000,4000 --no-cursor"});
         auto* maxDevices = cmd->add_option("--max-devices", a->maxDevices,
                                            "Largest device count; counts 1, 2, 4, ... up to it; "
                                            "--quick: 2")
@@ -309,6 +319,8 @@ void addExperimentCommands(CLI::App& app) {
             }
         });
     }
+    // `devices` is the command that lists hardware; the experiment is named for what it does.
+    addRenamedCommand(exp, "devices", "hapto experiment scaling");
 }
 
 } // namespace hapto::cli

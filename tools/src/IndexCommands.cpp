@@ -87,7 +87,9 @@ namespace {
 
 void runQuery(const std::string& scenePath, const std::string& specText,
               const std::string& pointsPath, const std::string& outPath, std::uint64_t maxIndexMb) {
-    const IndexSpec spec = IndexSpec::parse(specText).withMaxMegabytes(maxIndexMb);
+    if (!specText.empty()) {
+        IndexSpec::parse(specText); // a bad --index is refused before any file is read
+    }
     if (!outPath.empty()) {
         refuseSameFile(outPath, "-o", scenePath, "--scene");
         refuseSameFile(outPath, "-o", pointsPath, "--points");
@@ -95,7 +97,8 @@ void runQuery(const std::string& scenePath, const std::string& specText,
     }
     const std::vector<Vec3> points = readPoints(pointsPath, "points file");
     const Scene scene = loadSceneOrDefault(scenePath);
-    const std::unique_ptr<SpatialIndex> index = buildIndex(scene, spec);
+    const std::unique_ptr<SpatialIndex> index =
+        buildIndex(scene, sessionIndexSpec(specText, scene, maxIndexMb));
 
     TextOutput out(outPath);
     std::string& text = out.text();
@@ -195,8 +198,6 @@ void printStats(const IndexStats& s, const std::string& source) {
 } // namespace
 
 void addIndexCommands(CLI::App& app) {
-    const std::string specHelp = "Index: brute, grid:N (e.g. grid:5) or octree:M:MIN (e.g. "
-                                 "octree:2:0.005, MIN in metres), each optionally + :aabb";
     // query
     {
         auto* cmd = app.add_subcommand(
@@ -207,13 +208,16 @@ void addIndexCommands(CLI::App& app) {
         auto points = std::make_shared<std::string>();
         auto out = std::make_shared<std::string>();
         cmd->add_option("--scene", *scene, "Scene file")->required();
-        cmd->add_option("--index", *spec, specHelp)->required();
+        addIndexOption(cmd, *spec);
         cmd->add_option("--points", *points,
                         "CSV file, one point x,y,z (m) per line, optional header x,y,z")
             ->required();
         cmd->add_option("-o,--output", *out, "Output CSV file (default: standard output)");
         auto maxIndexMb = std::make_shared<std::uint64_t>(IndexSpec::kDefaultMaxMegabytes);
         addMaxIndexMbOption(cmd, *maxIndexMb);
+        setExamples(cmd, {"hapto query --scene scene.json --points points.csv",
+                          "hapto query --scene scene.json --index grid:5 --points points.csv -o "
+                          "candidates.csv"});
         cmd->callback([=] { runQuery(*scene, *spec, *points, *out, *maxIndexMb); });
     }
     // index-stats
@@ -226,14 +230,19 @@ void addIndexCommands(CLI::App& app) {
         auto spec = std::make_shared<std::string>();
         auto json = std::make_shared<bool>(false);
         cmd->add_option("--scene", *scene, "Scene file (default: the embedded default scene)");
-        cmd->add_option("--index", *spec, specHelp)->required();
+        addIndexOption(cmd, *spec);
         cmd->add_flag("--json", *json, "Print the statistics as one JSON object");
         auto maxIndexMb = std::make_shared<std::uint64_t>(IndexSpec::kDefaultMaxMegabytes);
         addMaxIndexMbOption(cmd, *maxIndexMb);
+        setExamples(cmd, {"hapto index-stats --scene scene.json",
+                          "hapto index-stats --scene scene.json --index octree:5:0.002 --json"});
         cmd->callback([=] {
-            const IndexSpec parsed = IndexSpec::parse(*spec).withMaxMegabytes(*maxIndexMb);
+            if (!spec->empty()) {
+                IndexSpec::parse(*spec); // a bad --index is refused before the scene is read
+            }
             const Scene s = loadSceneOrDefault(*scene);
-            const std::unique_ptr<SpatialIndex> index = buildIndex(s, parsed);
+            const std::unique_ptr<SpatialIndex> index =
+                buildIndex(s, sessionIndexSpec(*spec, s, *maxIndexMb));
             if (*json) {
                 std::cout << statsJson(index->stats()).dump(2) << "\n";
             } else {

@@ -118,6 +118,8 @@ void addRenderCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(100, 100000));
     cmd->add_option("-o,--output", a->output, "Output CSV file (default: standard output)");
+    setExamples(cmd, {"hapto render --scene scene.json --path path.csv -o forces.csv",
+                      "hapto render --scene mesh.json --path path.csv --rate 4000 --index grid:8"});
     cmd->callback([a] { runRender(*a); });
 }
 

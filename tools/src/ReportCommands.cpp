@@ -3,6 +3,7 @@
 // line per statistic.
 
 #include "Commands.h"
+#include "Options.h"
 
 #include "hapto/experiments/Plot.h"
 #include "hapto/scenes/InputError.h"
@@ -145,6 +146,7 @@ void addReportCommands(CLI::App& app) {
     CLI::App* report =
         app.add_subcommand("report", "Look at the JSON reports written by `hapto run --report`");
     report->require_subcommand(1);
+    setExamples(report, {"hapto report plot run.json -o run.png"});
     auto* cmd = report->add_subcommand(
         "plot", "Draw a run report as PNG or SVG with gnuplot: tick time (% of the period), "
                 "wake-up lateness and contact and missed ticks, per device");
@@ -152,6 +154,8 @@ void addReportCommands(CLI::App& app) {
     auto outputs = std::make_shared<PlotOutputs>();
     cmd->add_option("report", *path, "The report (hapto run --report FILE.json)")->required();
     addPlotOutputOptions(cmd, *outputs);
+    setExamples(cmd, {"hapto report plot run.json -o run.png   # after hapto run --report run.json",
+                      "hapto report plot run.json -o run.svg --script run.gp"});
     cmd->callback([path, outputs] { plotReport(*path, *outputs); });
 }
 

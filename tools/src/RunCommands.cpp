@@ -45,7 +45,7 @@ struct RunArgs {
     int missLimit = 3;
     std::size_t devicesPerThread = 1;
     std::int32_t wakeLatencyUs = -1;
-    double reopenMs = 1000;
+    double reopenMs = static_cast<double>(RuntimeOptions{}.reopenAfterNs) / 1e6;
     bool quiet = false;
     ViewArgs view;
 };
@@ -65,7 +65,7 @@ void printSummary(const RunReport& r) {
             std::printf("  %s: %s\n", d.name.c_str(), e.c_str());
         }
         if (const std::string note = lateWakeupNote(d); !note.empty()) {
-            std::printf("  %s: %s\n", d.name.c_str(), note.c_str());
+            std::printf("%s\n", wrapText("  " + d.name + ": " + note, kTextWidth - 4, 4).c_str());
         }
     }
     std::printf(
@@ -269,16 +269,15 @@ void addRunCommands(CLI::App& app) {
     cmd->add_option("--report", a->report, "Write the JSON report here");
     cmd->add_option("--record", a->record,
                     "Record every device's ticks into DIR/<name>.trace (see `hapto trace export`)");
-    addRealtimeFlag(cmd, a->realtime, "default: ask");
+    addRealtimeFlag(cmd, a->realtime, "");
     cmd->add_option("--spin-us", a->spinUs, "Spin this long before each deadline (us)")
         ->capture_default_str()
         ->check(finiteRange(0, 1000));
     cmd->add_option("--warm-us", a->warmUs,
-                    "Wake this long before each deadline, touch the tick's working set (snapshot, "
-                    "index path, candidate objects, renderer) and spin to the deadline, so the "
-                    "tick starts warm; 0 = off (us; less than half the period; default: 5 when "
-                    "each servo thread has a core of its own (devices <= cores), else off, as "
-                    "measured with `hapto bench tick` and in docs/results/many-devices.md)")
+                    "Wake this long before each deadline, touch the tick's working set and spin "
+                    "to the deadline, so the tick starts warm; 0 = off (us; less than half the "
+                    "period; default: 5 when each servo thread has a core of its own, else off; "
+                    "docs/results/many-devices.md)")
         ->check(finiteRange(0, static_cast<double>(kMaxWarmUpNs) / 1000.0));
     cmd->add_option("--miss-limit", a->missLimit,
                     "K: after K missed deadlines in a row, command zero force until caught up")
@@ -290,14 +289,17 @@ void addRunCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(0, 3600000));
     cmd->add_option("--devices-per-thread", a->devicesPerThread,
-                    "Simulated devices only: run K devices on one servo thread, each at its own "
-                    "deadline with its own load record and safety (one sleep per wake-up for all "
-                    "those due); 1 = one servo thread per device")
+                    "Simulated devices only: run K devices on one servo thread, each with its own "
+                    "deadline, load record and safety; 1 = one servo thread per device")
         ->capture_default_str()
         ->check(finiteRange(1, static_cast<double>(kMaxSessionDevices)));
     addWakeLatencyOption(cmd, a->wakeLatencyUs, "the devices run (unset: no request)");
     cmd->add_flag("--quiet", a->quiet, "No live lines on the terminal");
     addViewOptions(cmd, a->view);
+    setExamples(cmd,
+                {"hapto run --duration 10 --view",
+                 "hapto run --scene scene.json --devices hands.json --report run.json",
+                 "hapto run --record traces --duration 5   # then: hapto view --trace traces"});
     cmd->callback([a] {
         const int rc = runSession(*a);
         if (rc != 0) {

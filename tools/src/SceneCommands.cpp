@@ -325,6 +325,8 @@ void addSceneCommands(CLI::App& app) {
             ->capture_default_str()
             ->check(finiteRange(0, 1e3));
         addGeneratedSceneOutput(cmd, [opt] { return makeLatticeScene(*opt); });
+        setExamples(cmd, {"hapto scene grid --per-side 10 -o grid10.json",
+                          "hapto scene grid --per-side 100 --size 0.01 --gap 0.002 -o big.hsb"});
     }
     // random
     {
@@ -342,6 +344,8 @@ void addSceneCommands(CLI::App& app) {
             ->capture_default_str()
             ->check(finiteRange(0, 1e4));
         addGeneratedSceneOutput(cmd, [opt] { return makeRandomScene(*opt); });
+        setExamples(cmd, {"hapto scene random --count 200 --seed 7 -o random200.json",
+                          "hapto scene random --count 1e6 --rotate -o million.hsb"});
     }
     // cluster
     {
@@ -361,6 +365,7 @@ void addSceneCommands(CLI::App& app) {
             ->check(finiteRange(0, 1e4));
         cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
         addGeneratedSceneOutput(cmd, [opt] { return makeClusterScene(*opt); });
+        setExamples(cmd, {"hapto scene cluster --count 1e5 --clusters 20 -o clusters.hsb"});
     }
     // default
     {
@@ -368,6 +373,7 @@ void addSceneCommands(CLI::App& app) {
             "default", "Write the embedded default scene (200 random 5 cm cubes, seed 2004, 4 cm "
                        "clear around the centre)");
         addGeneratedSceneOutput(cmd, [] { return makeDefaultScene(); });
+        setExamples(cmd, {"hapto scene default -o default.json"});
     }
     // mesh
     {
@@ -394,6 +400,9 @@ void addSceneCommands(CLI::App& app) {
             ->check(finiteRange(0, kMaxSeed));
         cmd->add_option("-o,--output", args->out, "Output scene file (the mesh goes to F.ply)")
             ->required();
+        setExamples(cmd, {"hapto scene mesh --triangles 1e5 -o sphere.json   # and sphere.ply",
+                          "hapto scene mesh --shape terrain --triangles 2e6 --size 0.5 -o "
+                          "terrain.json"});
         cmd->callback([args] { writeMeshScene(*args); });
     }
     // import
@@ -404,21 +413,24 @@ void addSceneCommands(CLI::App& app) {
         auto opt = std::make_shared<ImportOptions>();
         cmd->add_option("model", opt->model, "The model file (.obj, .stl or .ply)")->required();
         cmd->add_option("--scale", opt->scale,
-                        "Uniform scale: the model's units times it give metres (> 0)")
+                        "Uniform scale: the model's units times it give metres")
             ->capture_default_str()
-            ->check(finiteRange(0, 1e6));
+            ->check(positiveRange(1e6));
         addNumberListOption(cmd, "--center", opt->center, 3, -1e6, 1e6,
                             "Where the model's origin goes, x,y,z (m); default 0,0,0");
         addNumberListOption(cmd, "--rotation", opt->rotation, 4, -1, 1,
                             "Orientation, a unit quaternion w,x,y,z; default 1,0,0,0");
-        cmd->add_option("--stiffness", opt->stiffness, "Surface stiffness (N/m), > 0")
+        cmd->add_option("--stiffness", opt->stiffness, "Surface stiffness (N/m)")
             ->capture_default_str()
-            ->check(finiteRange(0, Material::kMaxStiffness));
+            ->check(positiveRange(Material::kMaxStiffness));
         addNumberListOption(cmd, "--friction", opt->friction, 2, 0, Material::kMaxFriction,
                             "Coulomb coefficients static,dynamic (dynamic <= static); "
                             "default 0,0");
         cmd->add_option("-o,--output", opt->out, "Output scene file ('-' for standard output)")
             ->required();
+        setExamples(cmd, {"hapto scene import bunny.stl --scale 0.001 -o bunny.json   # mm to m",
+                          "hapto scene import part.obj --center 0,0.1,0 --stiffness 500 -o "
+                          "part.json"});
         cmd->callback([opt] { importModel(*opt); });
     }
     // convert
@@ -434,6 +446,8 @@ void addSceneCommands(CLI::App& app) {
             ->required();
         cmd->add_option("--format", opt->format, "json or binary (default: from -o's extension)")
             ->check(CLI::IsMember({"json", "binary"}));
+        setExamples(cmd, {"hapto scene convert million.json -o million.hsb",
+                          "hapto scene convert million.hsb -o - --format json | head"});
         cmd->callback([opt] { convertScene(*opt); });
     }
     // info
@@ -441,6 +455,7 @@ void addSceneCommands(CLI::App& app) {
         auto* cmd = scene->add_subcommand("info", "Load a scene (or the default) and describe it");
         auto path = std::make_shared<std::string>();
         cmd->add_option("--scene", *path, "Scene file (default: the embedded default scene)");
+        setExamples(cmd, {"hapto scene info", "hapto scene info --scene grid10.json"});
         cmd->callback([path] {
             const auto t0 = std::chrono::steady_clock::now();
             const Scene s = loadSceneOrDefault(*path);
@@ -449,6 +464,8 @@ void addSceneCommands(CLI::App& app) {
             printInfo(s, path->empty() ? "(embedded default scene)" : *path, secs);
         });
     }
+    // Set last: a command inherits the footer its group has when it is added.
+    setExamples(scene, {"hapto scene grid --per-side 10 -o grid10.json", "hapto scene info"});
 }
 
 } // namespace hapto::cli

@@ -48,6 +48,8 @@ void addSoakCommands(CLI::App& app) {
                 "every fault was handled and memory stayed flat, 1 otherwise (and when "
                 "interrupted: no verdict); 2 for bad arguments, such as a soak too short to "
                 "reach its first fault");
+    setExamples(cmd, {"hapto soak --duration 600 --report soak.json",
+                      "hapto soak --duration 20 --hands 3 --fault-every 1"});
     auto a = std::make_shared<SoakArgs>();
     auto* duration = cmd->add_option("--duration", a->durationS, "How long to run (s)")
                          ->capture_default_str()
@@ -58,9 +60,12 @@ void addSoakCommands(CLI::App& app) {
                         "Deprecated: how long to run in minutes (use --duration, in seconds)")
             ->check(finiteRange(0.02, 100000))
             ->excludes(duration);
-    cmd->add_option("--devices", a->devices, "Simulated hands (D)")
+    cmd->add_option("--hands", a->devices, "How many simulated hands")
+        ->type_name("N")
         ->capture_default_str()
         ->check(finiteRange(1, 32));
+    addRenamedOption(cmd, "--devices", "--hands N",
+                     "--devices names a device file in run, demo grasp and view");
     cmd->add_option("--rate", a->rateHz, "Servo rate of every hand (Hz)")
         ->capture_default_str()
         ->check(finiteRange(100, 100000));
@@ -69,9 +74,9 @@ void addSoakCommands(CLI::App& app) {
     addIndexOption(cmd, a->index);
     addMaxIndexMbOption(cmd, a->maxIndexMb);
     cmd->add_option("--fault-every", a->faultEveryS,
-                    "Inject a fault every this many seconds, into the hands in turn: disconnect "
-                    "(0.5 s), stall of 0.4 watchdog timeouts (a miss, not a fault), non-finite "
-                    "sample, stall of 3 watchdog timeouts, read error (s)")
+                    "Inject a fault every this many seconds (s), into the hands in turn: "
+                    "disconnect (0.5 s), stall of 0.4 watchdog timeouts (a miss, not a fault), "
+                    "non-finite sample, stall of 3 watchdog timeouts, read error")
         ->capture_default_str()
         ->check(finiteRange(0.1, 1e6));
     cmd->add_option("--window", a->windowS, "Report rate, drift, misses and memory per window (s)")
@@ -81,7 +86,8 @@ void addSoakCommands(CLI::App& app) {
                     "No tick for this long faults a device (ms); stalls are sized from it")
         ->capture_default_str()
         ->check(finiteRange(5, 10000));
-    cmd->add_option("--reopen-ms", a->reopenMs, "Retry opening a faulted device this often (ms)")
+    cmd->add_option("--reopen-ms", a->reopenMs,
+                    "Retry opening a faulted device this often (ms; hapto run's default)")
         ->capture_default_str()
         ->check(finiteRange(1, 60000));
     cmd->add_option("--memory-tolerance", a->memoryToleranceMiB,
@@ -90,7 +96,7 @@ void addSoakCommands(CLI::App& app) {
         ->capture_default_str()
         ->check(finiteRange(0, 1e6));
     cmd->add_option("--report", a->report, "Write the JSON soak report here");
-    addRealtimeFlag(cmd, a->realtime, "default: ask");
+    addRealtimeFlag(cmd, a->realtime, "");
     cmd->callback([a, minutes, minutesOpt] {
         if (minutesOpt->count() > 0) {
             a->durationS = *minutes * 60.0;

@@ -1,6 +1,7 @@
 // `hapto trace export|info|plot`: look inside trace files written by `hapto run --record`.
 
 #include "Commands.h"
+#include "Options.h"
 
 #include "hapto/devices/TraceReader.h"
 #include "hapto/experiments/Plot.h"
@@ -265,6 +266,8 @@ void addTraceCommands(CLI::App& app) {
     CLI::App* trace =
         app.add_subcommand("trace", "Look inside trace files written by `hapto run --record`");
     trace->require_subcommand(1);
+    setExamples(trace, {"hapto trace info traces/left.trace",
+                        "hapto trace plot traces/*.trace -o traces.png"});
     {
         auto* cmd = trace->add_subcommand(
             "export", "Write a trace as CSV: tick, time_ns, position (m, device frame), force "
@@ -273,12 +276,14 @@ void addTraceCommands(CLI::App& app) {
         auto out = std::make_shared<std::string>();
         cmd->add_option("trace", *path, "The trace file")->required();
         cmd->add_option("-o,--output", *out, "CSV file to write (default: standard output)");
+        setExamples(cmd, {"hapto trace export traces/left.trace -o left.csv"});
         cmd->callback([path, out] { exportCsv(*path, *out); });
     }
     {
         auto* cmd = trace->add_subcommand("info", "Describe a trace: device, rate, samples");
         auto path = std::make_shared<std::string>();
         cmd->add_option("trace", *path, "The trace file")->required();
+        setExamples(cmd, {"hapto trace info traces/left.trace"});
         cmd->callback([path] { printInfo(*path); });
     }
     {
@@ -289,6 +294,7 @@ void addTraceCommands(CLI::App& app) {
         auto outputs = std::make_shared<PlotOutputs>();
         cmd->add_option("traces", *paths, "The trace files (one line colour each)")->required();
         addPlotOutputOptions(cmd, *outputs);
+        setExamples(cmd, {"hapto trace plot traces/left.trace traces/right.trace -o hands.png"});
         cmd->callback([paths, outputs] { plotTraces(*paths, *outputs); });
     }
 }

@@ -74,8 +74,7 @@ void runView(const ViewCommandArgs& a) {
     ViewServerOptions options;
     options.bindAddress = a.view.bindAddress;
     options.port = a.view.port;
-    options.liveStream = false; // the page plays the recording: no stream to hold a place
-    signals.endStartUp();       // a signal from now on stops the server in order
+    signals.endStartUp(); // a signal from now on stops the server in order
     ViewServer server(options);
     server.setDocument("/scene.json", viewSceneJson(scene, devices, ViewMode::Trace));
     server.setDocument("/trace.json", viewTraceJson(scene, traces));
@@ -103,7 +102,9 @@ void runView(const ViewCommandArgs& a) {
 void addViewCommands(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "view", "Serve the 3-D view over a recorded session (traces from `hapto run --record`) "
-                "with play, pause and a time slider, on http://127.0.0.1:PORT/");
+                "with play, pause and a time slider, in the browser at the address it prints");
+    setExamples(cmd, {"hapto view --trace traces   # after hapto run --record traces",
+                      "hapto view --trace traces/left.trace --scene scene.json --view-port 0"});
     auto a = std::make_shared<ViewCommandArgs>();
     cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
     cmd->add_option("--trace", a->traces, "Trace folder (its *.trace files) or trace files")
@@ -112,9 +113,8 @@ void addViewCommands(CLI::App& app) {
     cmd->add_option("--devices", a->devices,
                     "Device configuration placing each trace's device in the world, by name "
                     "(default: the default two hands)");
-    cmd->add_option("--port", a->view.port, "TCP port (0 takes any free one)")
-        ->capture_default_str()
-        ->check(finiteRange(0, 65535));
+    addViewPortOption(cmd, a->view);
+    addRenamedOption(cmd, "--port", "--view-port PORT", "as in run and demo grasp");
     addViewBindOption(cmd, a->view);
     cmd->add_option("--duration", a->durationS, "Serve this long (s); 0 serves until Ctrl-C")
         ->capture_default_str()

@@ -1,6 +1,7 @@
 // The `hapto` command: one executable, one subcommand per task.
 
 #include "Commands.h"
+#include "Options.h"
 
 #include "hapto/Version.h"
 #include "hapto/scenes/InputError.h"
@@ -10,14 +11,16 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <memory>
 #include <string>
 
 int main(int argc, char** argv) {
     CLI::App app{"hapto: a multi-device haptic runtime over one shared spatial index.\n"
                  "Units are SI throughout: metres, seconds, newtons, N/m.",
                  "hapto"};
+    app.formatter(std::make_shared<hapto::cli::HelpFormatter>()); // inherited by every command
     app.require_subcommand(1);
-    app.set_help_all_flag("--help-all", "Print help for every subcommand and exit");
+    app.set_help_all_flag("--help-all", "Print help for every command, at every depth, and exit");
     app.set_version_flag("--version", std::string("hapto ") + hapto::kVersion,
                          "Print hapto's version and exit");
 
@@ -33,6 +36,10 @@ int main(int argc, char** argv) {
     hapto::cli::addExperimentCommands(app);
     hapto::cli::addSoakCommands(app);
     hapto::cli::addViewCommands(app);
+    // After the commands: a footer set earlier would be inherited by each of them.
+    hapto::cli::setExamples(
+        &app, {"hapto run --duration 10 --view", "hapto demo grasp --view", "hapto scene info",
+               "hapto scene grid --help   # one command; hapto --help-all: every command"});
 
     // A first word that is no option and no command is named as an unknown command (CLI11
     // would only say that an argument was not expected).
