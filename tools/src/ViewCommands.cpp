@@ -74,7 +74,8 @@ void runView(const ViewCommandArgs& a) {
     ViewServerOptions options;
     options.bindAddress = a.view.bindAddress;
     options.port = a.view.port;
-    signals.endStartUp(); // a signal from now on stops the server in order
+    options.liveStream = false; // the page plays the recording: no stream to hold a place
+    signals.endStartUp();       // a signal from now on stops the server in order
     ViewServer server(options);
     server.setDocument("/scene.json", viewSceneJson(scene, devices, ViewMode::Trace));
     server.setDocument("/trace.json", viewTraceJson(scene, traces));
