@@ -824,10 +824,16 @@ private:
     const std::string& mName;
 };
 
-} // namespace
+/// A PLY header as read: its elements in order, its format, and where its body starts.
+struct PlyHeader {
+    std::vector<PlyElement> elements;
+    PlyFormat format = PlyFormat::Ascii;
+    std::size_t bodyStart = 0; ///< The byte after end_header's newline.
+    std::size_t bodyLine = 0;  ///< The line the body starts on.
+};
 
-void checkPly(std::string_view bytes, const std::string& name, double scale) {
-    // The header: lines up to end_header.
+/// Reads the header: lines up to end_header, each one the specification's.
+PlyHeader readPlyHeader(std::string_view bytes, const std::string& name) {
     std::vector<PlyElement> elements;
     std::optional<PlyFormat> format;
     std::vector<std::string_view> tok;
@@ -910,10 +916,24 @@ void checkPly(std::string_view bytes, const std::string& name, double scale) {
     if (!format) {
         fail(name + ": the PLY header has no format line");
     }
+    return {std::move(elements), *format, at, lineNo + 1};
+}
 
-    // The elements hapto needs: vertex (x, y, z) and face (vertex_indices).
+/// Where hapto's values are in a PLY file's elements: the vertex element and its x, y, z
+/// properties, the face element and its vertex_indices list.
+struct PlyLayout {
     const PlyElement* vertex = nullptr;
     const PlyElement* face = nullptr;
+    int xyz[3] = {-1, -1, -1};
+    int indices = -1;
+};
+
+/// Finds the elements and properties hapto needs, and checks their counts against the limits.
+PlyLayout plyLayout(const std::vector<PlyElement>& elements, const std::string& name) {
+    const PlyElement* vertex = nullptr;
+    const PlyElement* face = nullptr;
+    int xyz[3] = {-1, -1, -1};
+    int indices = -1;
     for (const PlyElement& e : elements) {
         vertex = e.name == "vertex" ? &e : vertex;
         face = e.name == "face" ? &e : face;
@@ -924,7 +944,6 @@ void checkPly(std::string_view bytes, const std::string& name, double scale) {
     if (!face) {
         fail(name + ": no triangles (the PLY header declares no 'face' element)");
     }
-    int xyz[3] = {-1, -1, -1};
     for (std::size_t i = 0; i < vertex->properties.size(); ++i) {
         for (int c = 0; c < 3; ++c) {
             if (vertex->properties[i].name == kAxis[c] && !vertex->properties[i].list) {
@@ -937,7 +956,6 @@ void checkPly(std::string_view bytes, const std::string& name, double scale) {
             fail(name + ": the PLY vertex element has no property " + kAxis[c]);
         }
     }
-    int indices = -1;
     for (std::size_t i = 0; i < face->properties.size(); ++i) {
         const PlyProperty& p = face->properties[i];
         if (p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
@@ -958,9 +976,22 @@ void checkPly(std::string_view bytes, const std::string& name, double scale) {
     if (face->count == 0) {
         fail(name + ": no triangles (the PLY header declares 0 faces)");
     }
+    return {vertex, face, {xyz[0], xyz[1], xyz[2]}, indices};
+}
+
+} // namespace
+
+void checkPly(std::string_view bytes, const std::string& name, double scale) {
+    const PlyHeader header = readPlyHeader(bytes, name);
+    const std::vector<PlyElement>& elements = header.elements;
+    const PlyLayout layout = plyLayout(elements, name);
+    const PlyElement* vertex = layout.vertex;
+    const PlyElement* face = layout.face;
+    const int(&xyz)[3] = layout.xyz;
+    const int indices = layout.indices;
 
     // The body, element by element.
-    PlyReader r(bytes, at, lineNo + 1, *format, name);
+    PlyReader r(bytes, header.bodyStart, header.bodyLine, header.format, name);
     std::uint64_t triangles = 0;
     for (const PlyElement& e : elements) {
         for (std::uint64_t i = 0; i < e.count; ++i) {

@@ -386,6 +386,11 @@ TEST_CASE("a NUL byte in a JSON scene is named with its line, column and byte") 
                              "\"version\": 1, \"objects\": []}";
     CHECK(errorOf(text) == "bad.json:2:3: not valid JSON: a NUL byte (byte 28); a scene file is "
                            "JSON text or a binary hapto scene (HAPTOSCN)");
+    // A whole scene before the NUL: the parser took the NUL for the end and ignored the rest.
+    CHECK(errorOf(std::string(R"({"format": "hapto-scene", "version": 1, "objects": []})") + '\0' +
+                  "anything") ==
+          "bad.json:1:55: not valid JSON: a NUL byte (byte 54); a scene file is JSON text or a "
+          "binary hapto scene (HAPTOSCN)");
 }
 
 TEST_CASE("a 2 GB scene file of zeros is refused from its first bytes, not read whole") {
