@@ -51,7 +51,7 @@ SimConfig parseSim(const Source& w, const Json& j, const Path& path) {
         const std::string script = string(w, *v, path / "script");
         const std::optional<HandScript> parsed = parseHandScript(script);
         if (!parsed) {
-            w.fail(path / "script", "unknown script '" + script +
+            w.fail(path / "script", "unknown script '" + printable(script) +
                                         "' (expected free, touch, slide, walk, grasp-left or "
                                         "grasp-right)");
         }
@@ -297,8 +297,8 @@ ForceEffect parseEffect(const Source& w, const Json& j, const Path& path) {
         e.type = EffectType::Constant;
         e.forceN = vec3(w, required(w, j, path, "force_n"), path / "force_n");
     } else {
-        w.fail(path / "type",
-               "unknown effect type '" + type + "' (expected spring, damper or constant)");
+        w.fail(path / "type", "unknown effect type '" + printable(type) +
+                                  "' (expected spring, damper or constant)");
     }
     if (const Json* v = optional(j, "enabled")) {
         e.enabled = boolean(w, *v, path / "enabled");
@@ -360,7 +360,7 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
     const std::optional<DeviceKind> parsedKind = parseDeviceKind(kind);
     if (!parsedKind) {
         w.fail(path / "kind",
-               "unknown kind '" + kind + "' (expected sim, replay, falcon or phantom)");
+               "unknown kind '" + printable(kind) + "' (expected sim, replay, falcon or phantom)");
     }
     d.kind = *parsedKind;
     for (const DeviceKind otherKind : kFileKinds) {

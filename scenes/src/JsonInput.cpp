@@ -138,7 +138,8 @@ private:
                                   : "[" + std::to_string(up.index) + "]";
             }
             throw InputError(std::string(mSource.name()) + ": " +
-                             (path.empty() ? "(top level)" : path) + ": duplicate field '" + key +
+                             (path.empty() ? "(top level)" : path) + ": duplicate field '" +
+                             printable(key) +
                              "' (each field may appear once; JSON readers differ on which copy "
                              "they keep)");
         }
@@ -379,7 +380,8 @@ void checkKeys(const Source& s, const Json& obj, const Path& path,
             for (const auto a : allowed) {
                 list += (list.empty() ? "" : ", ") + std::string(a);
             }
-            s.fail(path, "unknown field '" + it.key() + "' (expected one of: " + list + ")");
+            s.fail(path,
+                   "unknown field '" + printable(it.key()) + "' (expected one of: " + list + ")");
         }
     }
 }

@@ -587,4 +587,14 @@ TEST_CASE("a device name with control characters is shown escaped in its message
     CHECK_THAT(e, Catch::Contains("bad.json: devices[0].name: a device name is 1 to 63 letters"));
     CHECK_THAT(e, Catch::Contains(R"((got "a\nb\u0000c\u001b[2J"))"));
     CHECK(std::none_of(e.begin(), e.end(), [](char c) { return c >= 0 && c < 0x20; }));
+    // So are an unknown field, kind, script and effect type.
+    CHECK_THAT(errorOf(withDevice(R"("\u001b[2J": 1)")),
+               Catch::Contains(R"(bad.json: devices[0]: unknown field '\x1B[2J')"));
+    CHECK_THAT(errorOf(withDevice(R"("sim": {"script": "a\nb"})")),
+               Catch::Contains(R"(devices[0].sim.script: unknown script 'a\nb')"));
+    CHECK_THAT(errorOf(withDevice(R"("effects": [{"type": "\r"}])")),
+               Catch::Contains(R"(devices[0].effects[0].type: unknown effect type '\r')"));
+    std::string badKind = withDevice("");
+    badKind.replace(badKind.find(R"("sim")"), 5, R"("s\u0000m")");
+    CHECK_THAT(errorOf(badKind), Catch::Contains(R"(devices[0].kind: unknown kind 's\x00m')"));
 }
