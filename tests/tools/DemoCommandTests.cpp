@@ -1,6 +1,8 @@
 // `hapto demo grasp` end to end on a mesh: two simulated hands lift, carry and put down a closed
 // mesh object read from a scene file (a cube from an OBJ file beside it), and the command says
-// the rebuilt index finds it at its new place. A wall-clock session (about 9 s).
+// the rebuilt index finds it at its new place. What the grasp does is checked on the step
+// mode's clock (--stepped: the same every run, however busy the machine); the wall-clock
+// session (about 9 s) is checked only for ending with every device at zero force.
 
 #include "TestSupport.h"
 
@@ -48,13 +50,15 @@ std::string graspScene(const std::string& meshFields, double y = -0.075) {
 )";
 }
 
-/// Runs the grasp demo on the scene in `dir`, checks it grasped once and the index found the
-/// object at its new place, and returns the JSON report.
+/// Runs the grasp demo with --stepped on the scene in `dir`, checks it grasped once and the
+/// index found the object at its new place, and returns the JSON report.
 nlohmann::json runGraspDemo(const TempDir& dir) {
-    const CommandResult r = runHapto("demo grasp --scene " + (dir / "scene.json").string() +
-                                     " --object 0 --report " + (dir / "report.json").string());
+    const CommandResult r =
+        runHapto("demo grasp --stepped --scene " + (dir / "scene.json").string() +
+                 " --object 0 --report " + (dir / "report.json").string());
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
+    CHECK(r.output.find("force at the end: left 0.000 N, right 0.000 N") != std::string::npos);
     CHECK(r.output.find("grasped 1 time(s)") != std::string::npos);
     CHECK(r.output.find("the index finds it at its new place: yes, at its old place: no") !=
           std::string::npos);
@@ -70,14 +74,22 @@ nlohmann::json runGraspDemo(const TempDir& dir) {
           Approx(start[0].get<double>() + 0.10).margin(0.008));
     CHECK(report["back_in_index"] == true);
     CHECK(report["index_finds_it_at_end"] == true);
+    CHECK(report["clock"] == "stepped");
+    // Each hand squeezes with press_n (2 N) while it holds the object: the mean from the
+    // grasp's start (the squeeze still rising then) through the lift and carry is within 10 %
+    // (issue 35 item 2: the hand's spring in series with the surface gave 1.4 N).
+    for (const auto& d : report["devices"]) {
+        INFO(d["name"]);
+        CHECK(d["squeeze_mean_n"].get<double>() == Approx(2.0).margin(0.2));
+        CHECK(d["end_force_n"] == 0.0);
+    }
     return report;
 }
 
 } // namespace
 
-TEST_CASE("hapto demo grasp --object on a closed mesh lifts, carries and puts it down, and the "
-          "index finds it at its new place",
-          "[realtime]") {
+TEST_CASE("hapto demo grasp --stepped --object on a closed mesh lifts, carries and puts it down, "
+          "and the index finds it at its new place") {
     TempDir dir;
     writeFile(dir / "cube.obj", kCubeObj);
     writeFile(dir / "scene.json", graspScene(R"("file": "cube.obj")"));
@@ -91,9 +103,9 @@ TEST_CASE("hapto demo grasp --object on a closed mesh lifts, carries and puts it
     CHECK(report["mass_kg"].get<double>() > 0);
 }
 
-TEST_CASE("hapto demo grasp --object on a generated torus lying flat on the floor, 1.5 cm from a "
-          "ridge, lifts, carries and puts it down",
-          "[realtime]") {
+TEST_CASE(
+    "hapto demo grasp --stepped --object on a generated torus lying flat on the floor, 1.5 cm "
+    "from a ridge, lifts, carries and puts it down") {
     TempDir dir;
     // A 6 cm torus, axis along y (lying flat), 2016 triangles, written beside its own scene.
     const CommandResult made =
@@ -107,4 +119,31 @@ TEST_CASE("hapto demo grasp --object on a generated torus lying flat on the floo
     // Put back on the floor, 10 cm along +x.
     CHECK(report["end_position"][1].get<double>() ==
           Approx(report["start_position"][1].get<double>()).margin(0.003));
+}
+
+TEST_CASE("hapto demo grasp --stepped: the same session gives the same report, path and forces") {
+    TempDir dir;
+    writeFile(dir / "cube.obj", kCubeObj);
+    writeFile(dir / "scene.json", graspScene(R"("file": "cube.obj")"));
+    const nlohmann::json first = runGraspDemo(dir);
+    const nlohmann::json second = runGraspDemo(dir);
+    CHECK(second == first);
+}
+
+TEST_CASE("hapto demo grasp on the wall clock ends with every device at zero force", "[realtime]") {
+    // What the grasp does on the wall clock depends on the control loop keeping pace with the
+    // servo threads (a busy machine can leave the cube where it was): only the session's end is
+    // checked here; the grasp itself, on the step clock, above.
+    TempDir dir;
+    const CommandResult r = runHapto("demo grasp --report " + (dir / "report.json").string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(r.output.find("force at the end: left 0.000 N, right 0.000 N") != std::string::npos);
+    const nlohmann::json report = nlohmann::json::parse(readFile(dir / "report.json"));
+    CHECK(report["clock"] == "wall");
+    REQUIRE(report["devices"].size() == 2);
+    for (const auto& d : report["devices"]) {
+        CHECK(d["end_force_n"] == 0.0);
+        CHECK(d["fault"] == "");
+    }
 }

@@ -1,4 +1,5 @@
-// `hapto demo grasp`: two simulated hands pick up, carry and put down an object.
+// `hapto demo grasp`: two simulated hands pick up, carry and put down an object, on the wall
+// clock or (--stepped) on the step mode's.
 
 #include "Commands.h"
 #include "LiveView.h"
@@ -13,6 +14,7 @@
 #include "hapto/index/Cursor.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/runtime/GraspController.h"
+#include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/InputError.h"
@@ -37,6 +39,7 @@ struct DemoArgs {
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
     ObjectId object = 0;
     bool realtime = false;
+    bool stepped = false; ///< --stepped: the session runs on the step mode's clock.
     ViewArgs view;
 };
 
@@ -61,6 +64,45 @@ std::vector<DeviceConfig> graspHands(ObjectId object) {
     return hands;
 }
 
+// --stepped runs only devices whose time the session gives them: simulated hands and replays
+// (a Falcon or PHANToM would be read as fast as the machine goes, not at its rate).
+void checkSteppable(const std::vector<DeviceConfig>& configs) {
+    for (const DeviceConfig& c : configs) {
+        if (c.kind != DeviceKind::Sim && c.kind != DeviceKind::Replay) {
+            throw InputError("--stepped: device '" + c.name + "' is a " +
+                             std::string(name(c.kind)) +
+                             "; only simulated hands (sim) and replays run on the step clock");
+        }
+    }
+}
+
+// The control loop's milliseconds. On the wall clock a step sleeps until its millisecond
+// while the servo threads run on their own; stepped (--stepped), it first runs the servo ticks
+// due in its millisecond on this thread (Runtime::runUntil), so the session's outcome is the
+// same every run however busy the machine is.
+class ControlClock {
+public:
+    ControlClock(Runtime& runtime, ManualClock* stepped)
+        : mRuntime(runtime), mStepped(stepped), mT0Ns(stepped ? stepped->nowNs() : 0) {}
+    /// Runs or waits for the next millisecond; returns the session's time then (s).
+    double next() {
+        if (mStepped) {
+            mRuntime.runUntil(mStepped->nowNs() + 1'000'000);
+            return 1e-9 * static_cast<double>(mStepped->nowNs() - mT0Ns);
+        }
+        mNext += std::chrono::milliseconds(1);
+        std::this_thread::sleep_until(mNext);
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - mWallT0).count();
+    }
+
+private:
+    Runtime& mRuntime;
+    ManualClock* mStepped;
+    std::uint64_t mT0Ns;
+    std::chrono::steady_clock::time_point mWallT0 = std::chrono::steady_clock::now();
+    std::chrono::steady_clock::time_point mNext = mWallT0;
+};
+
 // Per device: what the hand felt while the object was held.
 struct Felt {
     double maxForceN = 0;
@@ -69,102 +111,10 @@ struct Felt {
     std::uint64_t samples = 0;
 };
 
-int runDemo(const DemoArgs& a) {
-    StopSignals signals; // before any thread starts; see `hapto run`
-    std::vector<DeviceConfig> configs =
-        a.devices.empty() ? graspHands(a.object) : loadDeviceConfigFile(a.devices);
-    if (configs.size() != 2) {
-        throw InputError(a.devices +
-                         ": the grasp demo takes exactly two devices (left, right), got " +
-                         std::to_string(configs.size()));
-    }
-    useTraceSettings(configs);
-    checkSessionFiles({a.scene, a.devices, a.report, ""}, configs); // before the scene loads
-    // One copy of the scene: the world's first snapshot shares it with the hands and the view.
-    const auto shared = std::make_shared<const Scene>(
-        a.scene.empty() ? makeGraspScene() : loadSceneOrDefault(a.scene));
-    const Scene& scene = *shared;
-    if (!scene.slotOf(a.object)) {
-        throw InputError("--object: the scene has no object with id " + std::to_string(a.object));
-    }
-    World world(shared, sessionIndexSpec(a.index, scene, a.maxIndexMb));
-    signals.endStartUp(); // a signal from now on stops the demo in order
-    std::vector<RuntimeDevice> devices;
-    std::vector<SimDevice*> sims;
-    for (const DeviceConfig& c : configs) {
-        RuntimeDevice rd{makeDevice(c, scene), c, nullptr};
-        sims.push_back(dynamic_cast<SimDevice*>(rd.device.get()));
-        devices.push_back(std::move(rd));
-    }
-    RuntimeOptions options;
-    options.realtime = a.realtime;
-    Runtime runtime(world, std::move(devices), options);
-    GraspController grasp(world, runtime, 0, 1);
-    signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
-    LiveView view(a.view, "hapto demo grasp", scene, runtime);
-
-    const Vec3 startPosition = scene.object(*scene.slotOf(a.object)).center;
-    std::printf(
-        "hapto demo grasp: object %u at (%.3f, %.3f, %.3f) m, %u objects, devices %s + %s\n",
-        a.object, startPosition.x, startPosition.y, startPosition.z, scene.size(),
-        configs[0].name.c_str(), configs[1].name.c_str());
-    if (runtime.start() != 2) {
-        runtime.stop();
-        throw std::runtime_error(
-            "a device could not be opened: " + runtime.report().devices[0].fault + " " +
-            runtime.report().devices[1].fault);
-    }
-
-    view.start();
-    // Until both scripts are done (simulated hands) or 12 s, plus a second to settle.
-    Felt felt[2];
-    const auto t0 = std::chrono::steady_clock::now();
-    auto next = t0;
-    GraspState last = GraspState::Idle;
-    for (;;) {
-        next += std::chrono::milliseconds(1);
-        std::this_thread::sleep_until(next);
-        const double t =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        runtime.maintain();
-        grasp.step(0.001);
-        view.update(world);
-        if (grasp.state() != last) {
-            const auto& p = grasp.path().back();
-            std::printf("  %6.3f s  %-8s object at (%.3f, %.3f, %.3f) m\n", p.timeS,
-                        grasp.state() == GraspState::Grasped   ? "grasped"
-                        : grasp.state() == GraspState::Falling ? "released"
-                                                               : "at rest",
-                        p.position.x, p.position.y, p.position.z);
-            last = grasp.state();
-        }
-        if (grasp.state() == GraspState::Grasped) {
-            ContactReport c[2];
-            if (runtime.lastTick(0, c[0]) && runtime.lastTick(1, c[1])) {
-                const Vec3 axis = glm::normalize(c[1].devicePoint - c[0].devicePoint);
-                for (int i = 0; i < 2; ++i) {
-                    const double sign = i == 0 ? -1.0 : 1.0; // left is pushed to -axis
-                    felt[i].maxForceN = std::max(felt[i].maxForceN, glm::length(c[i].force));
-                    felt[i].squeezeSumN += sign * glm::dot(c[i].force, axis);
-                    felt[i].verticalSumN += c[i].force.y;
-                    ++felt[i].samples;
-                }
-            }
-        }
-        // The servo threads own the scripts: read the phase they publish.
-        const bool scriptsDone = sims[0] && sims[1] &&
-                                 sims[0]->publishedPhase() == ScriptPhase::Done &&
-                                 sims[1]->publishedPhase() == ScriptPhase::Done;
-        if ((scriptsDone && grasp.state() == GraspState::Idle && t > 1.0) || t > 12.0 ||
-            !runtime.anyRunning() || signals.requested()) {
-            break;
-        }
-    }
-    runtime.stop();
-    view.stop();
-    world.setRestDelay(std::chrono::nanoseconds(0));
-    world.settle();
-
+// After the session: where the object ended, whether the rebuilt index finds it there, what
+// each hand felt, the force each device was left with; the JSON report when asked for.
+void reportDemo(const DemoArgs& a, const Scene& scene, const World& world, const Runtime& runtime,
+                const GraspController& grasp, const Felt (&felt)[2], const Vec3& startPosition) {
     const Vec3 endPosition =
         world.current().scene->object(*world.current().scene->slotOf(a.object)).center;
     const RunReport r = runtime.report();
@@ -209,6 +159,16 @@ int runDemo(const DemoArgs& a) {
         std::printf("weight %.3f N (%.1f g); it did not move; the index finds it there: %s\n",
                     grasp.massKg() * 9.81, grasp.massKg() * 1000, foundNew ? "yes" : "no");
     }
+    // The force each device was last sent (N): runtime.stop() commands zero to every one.
+    double endForceN[2] = {0.0, 0.0};
+    for (int i = 0; i < 2; ++i) {
+        ContactReport last;
+        if (runtime.lastTick(i, last)) {
+            endForceN[i] = glm::length(last.force);
+        }
+    }
+    std::printf("force at the end: %s %.3f N, %s %.3f N\n", r.devices[0].name.c_str(), endForceN[0],
+                r.devices[1].name.c_str(), endForceN[1]);
     nlohmann::json devicesJson = nlohmann::json::array();
     for (int i = 0; i < 2; ++i) {
         const DeviceReport& d = r.devices[i];
@@ -231,7 +191,8 @@ int runDemo(const DemoArgs& a) {
                                  {"p999", d.loadFraction.p999},
                                  {"max", d.loadFraction.max}}},
                                {"stable", d.stable},
-                               {"fault", d.fault}});
+                               {"fault", d.fault},
+                               {"end_force_n", endForceN[i]}});
     }
     if (!a.report.empty()) {
         nlohmann::json path = nlohmann::json::array();
@@ -244,6 +205,7 @@ int runDemo(const DemoArgs& a) {
         }
         const nlohmann::json report{
             {"object_id", a.object},
+            {"clock", a.stepped ? "stepped" : "wall"},
             {"grasped_ticks", grasp.graspedSteps()},
             {"grasp_starts_s", grasp.graspStarts()},
             {"grasp_ends_s", grasp.graspEnds()},
@@ -258,6 +220,111 @@ int runDemo(const DemoArgs& a) {
         writeFileAtomically(a.report, report.dump(2) + "\n");
         std::printf("report written to %s\n", a.report.c_str());
     }
+}
+
+int runDemo(const DemoArgs& a) {
+    StopSignals signals; // before any thread starts; see `hapto run`
+    std::vector<DeviceConfig> configs =
+        a.devices.empty() ? graspHands(a.object) : loadDeviceConfigFile(a.devices);
+    if (configs.size() != 2) {
+        throw InputError(a.devices +
+                         ": the grasp demo takes exactly two devices (left, right), got " +
+                         std::to_string(configs.size()));
+    }
+    useTraceSettings(configs);
+    if (a.stepped) {
+        checkSteppable(configs);
+    }
+    checkSessionFiles({a.scene, a.devices, a.report, ""}, configs); // before the scene loads
+    // One copy of the scene: the world's first snapshot shares it with the hands and the view.
+    const auto shared = std::make_shared<const Scene>(
+        a.scene.empty() ? makeGraspScene() : loadSceneOrDefault(a.scene));
+    const Scene& scene = *shared;
+    if (!scene.slotOf(a.object)) {
+        throw InputError("--object: the scene has no object with id " + std::to_string(a.object));
+    }
+    ManualClock clock; // --stepped: the session's time, for the world and the runtime
+    World world(shared, sessionIndexSpec(a.index, scene, a.maxIndexMb));
+    if (a.stepped) {
+        world.useClock(clock);
+    }
+    signals.endStartUp(); // a signal from now on stops the demo in order
+    std::vector<RuntimeDevice> devices;
+    std::vector<SimDevice*> sims;
+    for (const DeviceConfig& c : configs) {
+        RuntimeDevice rd{makeDevice(c, scene), c, nullptr};
+        sims.push_back(dynamic_cast<SimDevice*>(rd.device.get()));
+        devices.push_back(std::move(rd));
+    }
+    RuntimeOptions options;
+    options.realtime = a.realtime;
+    Runtime runtime(world, std::move(devices), options);
+    GraspController grasp(world, runtime, 0, 1);
+    if (!a.stepped) { // stepped, this thread never blocks: it sees the first signal
+        signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
+    }
+    LiveView view(a.view, "hapto demo grasp", scene, runtime);
+
+    const Vec3 startPosition = scene.object(*scene.slotOf(a.object)).center;
+    std::printf(
+        "hapto demo grasp: object %u at (%.3f, %.3f, %.3f) m, %u objects, devices %s + %s\n",
+        a.object, startPosition.x, startPosition.y, startPosition.z, scene.size(),
+        configs[0].name.c_str(), configs[1].name.c_str());
+    if ((a.stepped ? runtime.startStepped(clock) : runtime.start()) != 2) {
+        runtime.stop();
+        throw std::runtime_error(
+            "a device could not be opened: " + runtime.report().devices[0].fault + " " +
+            runtime.report().devices[1].fault);
+    }
+
+    view.start();
+    // Until both scripts are done (simulated hands) or 12 s of session time, plus a second to
+    // settle.
+    Felt felt[2];
+    ControlClock control(runtime, a.stepped ? &clock : nullptr);
+    GraspState last = GraspState::Idle;
+    for (;;) {
+        const double t = control.next();
+        runtime.maintain();
+        grasp.step(0.001);
+        view.update(world);
+        if (grasp.state() != last) {
+            const auto& p = grasp.path().back();
+            std::printf("  %6.3f s  %-8s object at (%.3f, %.3f, %.3f) m\n", p.timeS,
+                        grasp.state() == GraspState::Grasped   ? "grasped"
+                        : grasp.state() == GraspState::Falling ? "released"
+                                                               : "at rest",
+                        p.position.x, p.position.y, p.position.z);
+            last = grasp.state();
+        }
+        if (grasp.state() == GraspState::Grasped) {
+            ContactReport c[2];
+            if (runtime.lastTick(0, c[0]) && runtime.lastTick(1, c[1])) {
+                const Vec3 axis = glm::normalize(c[1].devicePoint - c[0].devicePoint);
+                for (int i = 0; i < 2; ++i) {
+                    const double sign = i == 0 ? -1.0 : 1.0; // left is pushed to -axis
+                    felt[i].maxForceN = std::max(felt[i].maxForceN, glm::length(c[i].force));
+                    felt[i].squeezeSumN += sign * glm::dot(c[i].force, axis);
+                    felt[i].verticalSumN += c[i].force.y;
+                    ++felt[i].samples;
+                }
+            }
+        }
+        // The servo threads own the scripts: read the phase they publish.
+        const bool scriptsDone = sims[0] && sims[1] &&
+                                 sims[0]->publishedPhase() == ScriptPhase::Done &&
+                                 sims[1]->publishedPhase() == ScriptPhase::Done;
+        if ((scriptsDone && grasp.state() == GraspState::Idle && t > 1.0) || t > 12.0 ||
+            !runtime.anyRunning() || signals.requested()) {
+            break;
+        }
+    }
+    runtime.stop();
+    view.stop();
+    world.setRestDelay(std::chrono::nanoseconds(0));
+    world.settle();
+
+    reportDemo(a, scene, world, runtime, grasp, felt, startPosition);
     return 0;
 }
 
@@ -283,9 +350,22 @@ void addDemoCommands(CLI::App& app) {
     cmd->add_option("--report", a->report, "Write a JSON report here");
     addRealtimeFlag(cmd, a->realtime, "the demo shares the machine");
     addViewOptions(cmd, a->view);
+    cmd->add_flag("--stepped", a->stepped,
+                  "Run the session on the step mode's clock, not the wall clock: the servo ticks "
+                  "and the control loop take turns on one thread, a millisecond of session time "
+                  "at a time, as fast as the machine goes, so every run gives the same result "
+                  "however busy the machine is (simulated hands and replays only; not with "
+                  "--realtime)");
     setExamples(cmd, {"hapto demo grasp --view",
-                      "hapto demo grasp --scene grasp.json --object 3 --report grasp.json"});
-    cmd->callback([a] { runDemo(*a); });
+                      "hapto demo grasp --scene grasp.json --object 3 --report grasp.json",
+                      "hapto demo grasp --stepped --report grasp.json"});
+    cmd->callback([a] {
+        if (a->stepped && a->realtime) {
+            throw InputError("--stepped runs the session on this thread, not on real-time servo "
+                             "threads: give --stepped or --realtime, not both");
+        }
+        runDemo(*a);
+    });
 }
 
 } // namespace hapto::cli

@@ -3,12 +3,20 @@
 // put it down, while hapto measures every servo tick. Each hand also feels the other through a
 // virtual spring: a per-tick hook, called on each hand's servo thread.
 //
-//   two_hands [DEVICES.json]
+//   two_hands [--stepped] [DEVICES.json]
+//
+// --stepped runs the same objects on the runtime's step mode: the servo ticks and the control
+// loop take turns on this thread, one millisecond of a clock the program moves at a time, so
+// every run gives the same result however busy the machine is (simulated hands and replays
+// only). Stepped, the program checks the carry; on the wall clock, where the carry depends on
+// the control loop keeping pace with the servo threads, it checks only that the session ran to
+// its end and left every device at zero force.
 
 #include <hapto/devices/DeviceConfig.h>
 #include <hapto/devices/DeviceFactory.h>
 #include <hapto/index/IndexSpec.h>
 #include <hapto/runtime/GraspController.h>
+#include <hapto/runtime/ManualClock.h>
 #include <hapto/runtime/Realtime.h>
 #include <hapto/runtime/Runtime.h>
 #include <hapto/runtime/World.h>
@@ -17,6 +25,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <string_view>
 #include <thread>
 
 using namespace hapto;
@@ -64,27 +73,48 @@ static std::vector<DeviceConfig> simulatedHands() {
 }
 
 int main(int argc, char** argv) try {
+    bool stepped = false;
+    const char* deviceFile = nullptr;
+    for (int i = 1; i < argc; ++i) {
+        if (std::string_view(argv[i]) == "--stepped") {
+            stepped = true;
+        } else {
+            deviceFile = argv[i];
+        }
+    }
+
     // 1. The scene (metres, y up) and the world: one index, shared by every servo thread.
+    //    Stepped, the world's time is the program's clock too.
     const Scene scene = makeGraspScene();
+    ManualClock clock;
     World world(scene, IndexSpec::parse("octree:2:0.005"));
+    if (stepped) {
+        world.useClock(clock);
+    }
 
     // 2. The devices, from a file or in code.
     const std::vector<DeviceConfig> configs =
-        argc > 1 ? loadDeviceConfigFile(argv[1]) : simulatedHands();
+        deviceFile ? loadDeviceConfigFile(deviceFile) : simulatedHands();
     if (configs.size() != 2) {
-        throw InputError(std::string(argv[1]) + ": two devices, please (left and right hands)");
+        throw InputError(std::string(deviceFile) + ": two devices, please (left and right hands)");
     }
     std::vector<RuntimeDevice> devices;
     for (const DeviceConfig& config : configs) {
+        if (stepped && config.kind != DeviceKind::Sim && config.kind != DeviceKind::Replay) {
+            throw InputError("--stepped: device '" + config.name + "' keeps real time");
+        }
         devices.push_back({makeDevice(config, scene), config, nullptr});
     }
 
     // 3. One servo thread per device; grasping runs here, on the control thread, which must
     //    keep pace with the hands: give it real-time priority too (below the servo threads'
-    //    80) when the process may; it runs anyway when it may not.
-    const rt::RealtimeGrant grant = rt::makeCurrentThreadRealtime(70, -1);
-    if (!grant.note.empty()) {
-        std::fprintf(stderr, "two_hands: %s\n", grant.note.c_str());
+    //    80) when the process may; it runs anyway when it may not. Stepped, there is no
+    //    thread but this one and nothing to keep pace with.
+    if (!stepped) {
+        const rt::RealtimeGrant grant = rt::makeCurrentThreadRealtime(70, -1);
+        if (!grant.note.empty()) {
+            std::fprintf(stderr, "two_hands: %s\n", grant.note.c_str());
+        }
     }
     Runtime runtime(world, std::move(devices));
     // The hooks are registered before start(); their contexts outlive the runtime's threads.
@@ -92,17 +122,24 @@ int main(int argc, char** argv) try {
     runtime.setTickHook(0, {&feelTheOtherHand, &leftFeelsRight});
     runtime.setTickHook(1, {&feelTheOtherHand, &rightFeelsLeft});
     GraspController grasp(world, runtime, 0, 1);
-    if (runtime.start() != configs.size()) {
+    if ((stepped ? runtime.startStepped(clock) : runtime.start()) != configs.size()) {
         std::fprintf(stderr, "two_hands: a device did not open\n");
         return 1;
     }
     const Vec3 start = scene.object(0).center;
-    // The grasp scripts take about 9 s of device time: 9500 ticks of the first device.
+    // The grasp scripts take about 9 s of device time: 9500 ticks of the first device. Each
+    // control step is a millisecond: on the wall clock it sleeps while the servo threads run;
+    // stepped, it first runs the servo ticks due in its millisecond.
     while (runtime.metrics(0).ticks.load() < 9500 && runtime.anyRunning()) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        runtime.maintain(); // watchdog and world upkeep
+        if (stepped) {
+            runtime.runUntil(clock.nowNs() + 1'000'000);
+        } else {
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        runtime.maintain(); // world upkeep (the watchdog runs on the runtime's own thread)
         grasp.step(0.001);  // grasp, carry, release, fall
     }
+    const bool ranToTheEnd = runtime.metrics(0).ticks.load() >= 9500;
     runtime.stop(); // every device at zero force
 
     // 4. What happened.
@@ -116,8 +153,15 @@ int main(int argc, char** argv) try {
                     static_cast<unsigned long long>(d.ticks), 100 * d.loadFraction.p50,
                     100 * d.loadFraction.p999);
     }
+    bool zeroForce = true; // the force each device was last sent
+    for (std::size_t i = 0; i < runtime.deviceCount(); ++i) {
+        ContactReport last;
+        zeroForce = zeroForce && (!runtime.lastTick(i, last) || last.force == Vec3(0.0));
+    }
     const bool carried = grasp.graspStarts().size() == 1 && std::abs(end.x - start.x - 0.10) < 0.01;
-    return carried ? 0 : 1;
+    std::printf("%s, %s\n", ranToTheEnd ? "ran to the end" : "STOPPED EARLY",
+                zeroForce ? "every device at zero force" : "A DEVICE STILL HAS FORCE");
+    return ranToTheEnd && zeroForce && (carried || !stepped) ? 0 : 1;
 } catch (const InputError& e) {
     std::fprintf(stderr, "two_hands: %s\n", e.what());
     return 2;
