@@ -52,6 +52,7 @@
 
 #include "hapto/core/Finite.h"
 #include "hapto/core/ShapeGeometry.h"
+#include "hapto/core/SweptShapes.h"
 
 #include <algorithm>
 #include <cmath>
@@ -81,92 +82,6 @@ double length2(const Vec3& v) {
     return glm::dot(v, v);
 }
 
-/// The swept test of one object: where the path enters its shrunk skin, and where it reaches
-/// the skin itself (the stop point), as fractions of the path.
-struct Entry {
-    bool found = false;
-    double t = kInf;  ///< Entry into the shrunk skin, in [0, 1).
-    double tStop = 0; ///< Arrival at the skin, in [0, t].
-    int axis = -1;    ///< Box: the entered face's axis; -1 for a sphere.
-    double sign = 0;  ///< Box: the entered face's side (+1 or -1 along the axis).
-};
-
-/// The slab test of a box (in its own frame; an axis-aligned box's frame is a translation).
-Entry sweepBox(const RenderBody& box, const Vec3& from, const Vec3& to) {
-    const Vec3 a = box.toLocal(from);
-    const Vec3 d = box.toLocal(to) - a;
-    double tIn = -kInf;
-    double tOut = kInf;
-    double sIn = -kInf;
-    Entry e;
-    for (int i = 0; i < 3; ++i) {
-        const double h = box.halfExtents[i] + kSkinM - kShrinkM;
-        const double hs = box.halfExtents[i] + kSkinM;
-        if (std::abs(d[i]) < 1e-18) {
-            if (std::abs(a[i]) >= h) {
-                return {};
-            }
-            continue;
-        }
-        const double inv = 1.0 / d[i];
-        double t1 = (-h - a[i]) * inv;
-        double t2 = (h - a[i]) * inv;
-        double s1 = (-hs - a[i]) * inv;
-        if (t1 > t2) {
-            std::swap(t1, t2);
-            s1 = (hs - a[i]) * inv;
-        }
-        if (t1 > tIn) {
-            tIn = t1;
-            e.axis = i;
-            e.sign = d[i] > 0 ? -1.0 : 1.0;
-        }
-        tOut = std::min(tOut, t2);
-        sIn = std::max(sIn, s1);
-    }
-    // tIn < 0: the start is already inside (passed through); tIn >= tOut: no interior chord.
-    if (e.axis < 0 || tIn < 0.0 || tIn >= 1.0 || tIn >= tOut) {
-        return {};
-    }
-    e.found = true;
-    e.t = tIn;
-    e.tStop = std::clamp(sIn, 0.0, tIn);
-    return e;
-}
-
-Entry sweepSphere(const Vec3& center, double radius, const Vec3& from, const Vec3& to) {
-    const Vec3 f = from - center;
-    const Vec3 d = to - from;
-    const double a = glm::dot(d, d);
-    if (a < 1e-36) {
-        return {};
-    }
-    const double b = glm::dot(f, d); // half the linear coefficient
-    const double r = radius + kSkinM - kShrinkM;
-    const double c = glm::dot(f, f) - r * r;
-    if (c <= 0.0 || b >= 0.0) { // inside already, or moving away
-        return {};
-    }
-    const double disc = b * b - a * c;
-    if (disc <= 0.0) {
-        return {};
-    }
-    const double t = c / (-b + std::sqrt(disc)); // the smaller root, in a stable form
-    if (t < 0.0 || t >= 1.0) {
-        return {};
-    }
-    Entry e;
-    e.found = true;
-    e.t = t;
-    const double rs = radius + kSkinM;
-    const double cs = glm::dot(f, f) - rs * rs;
-    if (cs > 0.0) {
-        const double discS = b * b - a * cs;
-        e.tStop = discS > 0.0 ? std::clamp(cs / (-b + std::sqrt(discS)), 0.0, t) : t;
-    }
-    return e;
-}
-
 /// True when p is inside the object's shrunk skin (strictly).
 bool insideSkin(const RenderBody& o, const Vec3& p) {
     return o.shape == Shape::Sphere
@@ -184,175 +99,16 @@ double distanceToSkin(const RenderBody& o, const Vec3& p) {
 /// The nearest point on the object's skin to an inside point p.
 Vec3 pushOut(const RenderBody& o, const Vec3& p) {
     if (o.shape == Shape::Sphere) {
-        const Vec3 d = p - o.center;
-        const double len = glm::length(d);
-        const Vec3 n = len > 0.0 ? d / len : Vec3(0, 0, 1);
-        return o.center + (o.halfExtents.x + kSkinM) * n;
+        return sphereSurfacePointNearest(o.center, o.halfExtents.x + kSkinM, p);
     }
-    Vec3 l = o.toLocal(p);
-    const int best = dominantFaceAxis(l, o.halfExtents + Vec3(kSkinM)); // the nearest face
-    l[best] = (l[best] < 0.0 ? -1.0 : 1.0) * (o.halfExtents[best] + kSkinM);
-    return o.toWorld(l);
-}
-
-/// The point of triangle v closest to p (Ericson, Real-Time Collision Detection, 5.1.5).
-Vec3 closestOnTriangle(const Vec3& p, const std::array<Vec3, 3>& v) {
-    const Vec3& a = v[0];
-    const Vec3& b = v[1];
-    const Vec3& c = v[2];
-    const Vec3 ab = b - a;
-    const Vec3 ac = c - a;
-    const Vec3 ap = p - a;
-    const double d1 = glm::dot(ab, ap);
-    const double d2 = glm::dot(ac, ap);
-    if (d1 <= 0.0 && d2 <= 0.0) {
-        return a;
-    }
-    const Vec3 bp = p - b;
-    const double d3 = glm::dot(ab, bp);
-    const double d4 = glm::dot(ac, bp);
-    if (d3 >= 0.0 && d4 <= d3) {
-        return b;
-    }
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-        return a + (d1 / (d1 - d3)) * ab;
-    }
-    const Vec3 cp = p - c;
-    const double d5 = glm::dot(ab, cp);
-    const double d6 = glm::dot(ac, cp);
-    if (d6 >= 0.0 && d5 <= d6) {
-        return c;
-    }
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-        return a + (d2 / (d2 - d6)) * ac;
-    }
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
-        return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-    }
-    const double denom = 1.0 / (va + vb + vc);
-    return a + (vb * denom) * ab + (vc * denom) * ac;
-}
-
-double triangleDistance2(const Vec3& p, const std::array<Vec3, 3>& v) {
-    return length2(p - closestOnTriangle(p, v));
-}
-
-/// A triangle's edges in its plane: inward[i] is perpendicular to the edge v[i] -> v[i+1]
-/// (v's unit normal n crossed with it), points into the triangle and is as long as the edge;
-/// length2[i] is its squared length. Made once per near triangle per tick, or on the spot.
-struct EdgeNormals {
-    std::array<Vec3, 3> inward{};
-    std::array<double, 3> length2{};
-};
-
-EdgeNormals edgeNormals(const std::array<Vec3, 3>& v, const Vec3& n) {
-    EdgeNormals e;
-    for (int i = 0; i < 3; ++i) {
-        e.inward[i] = glm::cross(n, v[(i + 1) % 3] - v[i]);
-        e.length2[i] = glm::dot(e.inward[i], e.inward[i]);
-    }
-    return e;
-}
-
-/// How far (m) p's projection onto the plane of triangle v (edges e: an EdgeNormals, or the
-/// near list's copy of one) lies outside the farthest of its three edge lines; <= 0 over the
-/// triangle.
-double outsideEdges(const Vec3& p, const std::array<Vec3, 3>& v, const auto& e) {
-    double worst = -kInf;
-    for (int i = 0; i < 3; ++i) {
-        worst = std::max(worst, -glm::dot(e.inward[i], p - v[i]) / std::sqrt(e.length2[i]));
-    }
-    return worst;
-}
-
-/// True when p projects into triangle v (unit normal n, edges e) grown by `margin` (m) across
-/// each edge, as a box face's skin grows across its edges (square corners), with a sliver's
-/// sharp corners cut at 1.5 x margin from the triangle.
-/// outsideEdges without its square roots: each edge compares squares.
-bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n, const auto& e,
-                       double margin) {
-    bool over = true; // p projects into the triangle itself
-    for (int i = 0; i < 3; ++i) {
-        const double out = -glm::dot(e.inward[i], p - v[i]); // distance outside x |inward|
-        if (out > 0.0) {
-            if (out * out > margin * margin * e.length2[i]) {
-                return false;
-            }
-            over = false;
-        }
-    }
-    if (over) {
-        return true;
-    }
-    const Vec3 onPlane = p - glm::dot(n, p - v[0]) * n;
-    return triangleDistance2(onPlane, v) <= 2.25 * margin * margin;
-}
-
-bool overGrownTriangle(const Vec3& p, const std::array<Vec3, 3>& v, const Vec3& n, double margin) {
-    return overGrownTriangle(p, v, n, edgeNormals(v, n), margin);
+    return o.toWorld(boxSurfacePointNearestLocal(o.toLocal(p), o.halfExtents + Vec3(kSkinM)));
 }
 
 /// A triangle's corners and edges read from the scene (m, world), for one not in the near
 /// list's copy.
-struct FetchedTriangle {
-    std::array<Vec3, 3> corners;
-    EdgeNormals edges;
-};
-
-FetchedTriangle fetchTriangle(const Scene& scene, std::uint32_t item, const Vec3& normal) {
+TriangleGeometry fetchTriangle(const Scene& scene, std::uint32_t item, const Vec3& normal) {
     const std::array<Vec3, 3> v = scene.triangleCorners(item);
-    return {v, edgeNormals(v, normal)};
-}
-
-/// The swept test of one triangle, entered only from its front (outward) side. The path is
-/// stopped where it would enter the triangle's skin slab (the plane kSkinM in front, shrunk by
-/// kShrinkM) at a point over the triangle grown by kSkinM across its edges (so the skins of
-/// the triangles around a convex edge meet like a box's, and a flat mesh's skin is the box
-/// face's), or wherever it really crosses the triangle (so no path reaches behind a closed
-/// mesh, whatever its dihedral angles). A path that starts behind the triangle's plane, or
-/// does not go deeper, passes.
-///
-/// The plane comes first (two dot products reject most triangles); the corners and edges
-/// (`geometry()`: the near list's copy, or a FetchedTriangle) are read only for a path that
-/// reaches the skin slab.
-template <class GeometryFn>
-Entry sweepTriangle(const WorldFace& tp, GeometryFn&& geometry, const Vec3& from, const Vec3& to) {
-    if (tp.normal == Vec3(0.0)) {
-        return {};
-    }
-    const double sf = glm::dot(tp.normal, from) - tp.offset; // heights over the plane (m)
-    const double st = glm::dot(tp.normal, to) - tp.offset;
-    if (!(sf >= 0.0) || !(st < sf)) {
-        return {}; // behind (one-sided), or not going deeper
-    }
-    const double h = kSkinM - kShrinkM;
-    double t = 0.0;
-    if (sf > h) {
-        if (st >= h) {
-            return {};
-        }
-        t = (sf - h) / (sf - st);
-    }
-    if (t >= 1.0) {
-        return {};
-    }
-    const Vec3 d = to - from;
-    const auto& g = geometry();
-    bool over = overGrownTriangle(from + t * d, g.corners, tp.normal, g.edges, kSkinM);
-    if (!over && st < 0.0) {
-        over = overGrownTriangle(from + (sf / (sf - st)) * d, g.corners, tp.normal, g.edges, kOnM);
-    }
-    if (!over) {
-        return {};
-    }
-    Entry e;
-    e.found = true;
-    e.t = t;
-    e.tStop = sf > kSkinM ? std::clamp((sf - kSkinM) / (sf - st), 0.0, t) : 0.0;
-    return e;
+    return {v, triangleEdges(v, normal)};
 }
 
 /// A valid item of this scene: a box or sphere slot, or a triangle item.
@@ -386,24 +142,11 @@ void visitMeshTrianglesNear(const TriangleMesh& mesh, const Aabb& localBox, Fn&&
     mesh.forEachTriangleNear(localBox, std::forward<Fn>(fn));
 }
 
-/// Distance (m) from p to an item's skin, 0 inside. A triangle's skin, like a box face's: the
-/// points within kSkinM of its plane over the triangle grown by kSkinM across its edges.
-template <class GeometryFn>
-double triangleDistanceToSkin(const WorldFace& tp, GeometryFn&& geometry, const Vec3& p) {
-    if (tp.normal == Vec3(0.0)) {
-        return kInf;
-    }
-    const double up = std::max(0.0, std::abs(glm::dot(tp.normal, p) - tp.offset) - kSkinM);
-    const auto& g = geometry();
-    const double out = std::max(0.0, outsideEdges(p, g.corners, g.edges) - kSkinM);
-    return std::sqrt(up * up + out * out);
-}
-
 double itemDistanceToSkin(const Scene& scene, std::uint32_t item, const Vec3& p) {
     if (isTriangleItem(item)) {
         const WorldFace tp = scene.triangleFace(item);
-        return triangleDistanceToSkin(
-            tp, [&] { return fetchTriangle(scene, item, tp.normal); }, p);
+        return triangleSkinDistance(
+            tp.normal, tp.offset, [&] { return fetchTriangle(scene, item, tp.normal); }, p, kSkinM);
     }
     return distanceToSkin(scene.body(item), p);
 }
@@ -420,69 +163,6 @@ struct GodObjectRenderer::Hit {
     double sign = 0.0;
     std::uint32_t near = kNotCached; ///< A triangle's place in mTriangleData, if there.
 };
-
-namespace {
-
-/// Closest point to goal in {x : n_i . x >= offset_i, i < count} (count <= 3): the best
-/// feasible equality-constrained projection over all subsets of the planes. Returns fallback
-/// (a point known to be feasible) if no subset gives a feasible point (degenerate input).
-template <class PlaneT>
-Vec3 closestInHalfSpaces(const PlaneT* planes, std::uint32_t count, const Vec3& goal,
-                         const Vec3& fallback) {
-    Vec3 best = fallback;
-    double bestD = kInf;
-    for (std::uint32_t mask = 0; mask < (1u << count); ++mask) {
-        std::uint32_t idx[3];
-        std::uint32_t k = 0;
-        for (std::uint32_t i = 0; i < count; ++i) {
-            if (mask & (1u << i)) {
-                idx[k++] = i;
-            }
-        }
-        Vec3 c = goal;
-        if (k == 1) {
-            const PlaneT& p = planes[idx[0]];
-            c = goal - (glm::dot(p.normal, goal) - p.offset) * p.normal;
-        } else if (k == 2) {
-            const PlaneT& p1 = planes[idx[0]];
-            const PlaneT& p2 = planes[idx[1]];
-            const double a = glm::dot(p1.normal, p2.normal);
-            const double det = 1.0 - a * a;
-            if (det < 1e-10) {
-                continue; // (anti)parallel: a single-plane subset covers it
-            }
-            const double r1 = glm::dot(p1.normal, goal) - p1.offset;
-            const double r2 = glm::dot(p2.normal, goal) - p2.offset;
-            const double l1 = (r1 - a * r2) / det;
-            const double l2 = (r2 - a * r1) / det;
-            c = goal - l1 * p1.normal - l2 * p2.normal;
-        } else if (k == 3) {
-            const PlaneT& p1 = planes[idx[0]];
-            const PlaneT& p2 = planes[idx[1]];
-            const PlaneT& p3 = planes[idx[2]];
-            const Vec3 c23 = glm::cross(p2.normal, p3.normal);
-            const double det = glm::dot(p1.normal, c23);
-            if (std::abs(det) < 1e-8) {
-                continue;
-            }
-            c = (p1.offset * c23 + p2.offset * glm::cross(p3.normal, p1.normal) +
-                 p3.offset * glm::cross(p1.normal, p2.normal)) /
-                det;
-        }
-        bool feasible = true;
-        for (std::uint32_t i = 0; i < count && feasible; ++i) {
-            feasible = glm::dot(planes[i].normal, c) >= planes[i].offset - kFeasibleM;
-        }
-        const double d = length2(c - goal);
-        if (feasible && d < bestD) {
-            bestD = d;
-            best = c;
-        }
-    }
-    return best;
-}
-
-} // namespace
 
 GodObjectRenderer::GodObjectRenderer(const RendererConfig& config) : mConfig(config) {
     if (!(config.damping >= 0.0) || !std::isfinite(config.damping)) {
@@ -568,8 +248,8 @@ double GodObjectRenderer::distanceToSkinOf(const Scene& scene, std::uint32_t ite
         return itemDistanceToSkin(scene, item, p);
     }
     const NearTriangle& t = mTriangleData[near];
-    return triangleDistanceToSkin(
-        t.face, [&]() -> const NearTriangle& { return t; }, p);
+    return triangleSkinDistance(
+        t.face.normal, t.face.offset, [&]() -> const NearTriangle& { return t; }, p, kSkinM);
 }
 
 bool GodObjectRenderer::addNear(std::uint32_t item) noexcept {
@@ -655,8 +335,7 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
                         continue;
                     }
                     if (t && !t->hasEdges) {
-                        const EdgeNormals e = edgeNormals(v, f.normal);
-                        t->edges = {e.inward, e.length2};
+                        t->edges = triangleEdges(v, f.normal);
                         t->mesh = scene.objectSlotOf(item);
                         t->hasEdges = true;
                     }
@@ -695,19 +374,25 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
                                                 const Vec3& from, const Vec3& to) const noexcept {
     Hit best;
     forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t near) {
-        Entry e;
+        SweptEntry e;
         if (near != kNotCached) {
             const NearTriangle& t = mTriangleData[near];
-            e = sweepTriangle(
-                t.face, [&]() -> const NearTriangle& { return t; }, from, to);
+            e = sweepTriangleFront(
+                t.face.normal, t.face.offset, [&]() -> const NearTriangle& { return t; }, from, to,
+                kSkinM, kShrinkM, kOnM);
         } else if (isTriangleItem(item)) {
             const WorldFace tp = scene.triangleFace(item);
-            e = sweepTriangle(
-                tp, [&] { return fetchTriangle(scene, item, tp.normal); }, from, to);
+            e = sweepTriangleFront(
+                tp.normal, tp.offset, [&] { return fetchTriangle(scene, item, tp.normal); }, from,
+                to, kSkinM, kShrinkM, kOnM);
         } else {
             const RenderBody& o = scene.body(item);
-            e = o.shape == Shape::Sphere ? sweepSphere(o.center, o.halfExtents.x, from, to)
-                                         : sweepBox(o, from, to);
+            if (o.shape == Shape::Sphere) {
+                e = sweepSphere(o.center, o.halfExtents.x, from, to, kSkinM, kShrinkM);
+            } else {
+                const Vec3 a = o.toLocal(from);
+                e = sweepBoxLocal(o.halfExtents, a, o.toLocal(to) - a, kSkinM, kShrinkM);
+            }
         }
         if (e.found && e.t < best.t) {
             best = {true, e.t, e.tStop, item, e.axis, e.sign, near};
@@ -763,7 +448,8 @@ GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
 
     for (std::uint32_t it = 0; it < mConfig.maxIterations; ++it) {
         s.iterations = it + 1;
-        const Vec3 target = closestInHalfSpaces(s.planes.data(), s.planeCount, goal, p);
+        const Vec3 target =
+            closestPointInHalfSpaces(s.planes.data(), s.planeCount, goal, p, kFeasibleM);
         const Hit hit = sweep(scene, candidates, p, target);
         if (hit.found) {
             p += hit.tStop * (target - p);

@@ -2,6 +2,7 @@
 /// God-object (proxy) haptic rendering of a point tool against oriented boxes, spheres and
 /// triangle meshes.
 
+#include "hapto/core/ClosestPoint.h"
 #include "hapto/runtime/CandidateSet.h"
 #include "hapto/scenes/Scene.h"
 
@@ -192,12 +193,7 @@ private:
         bool hasEdges = false;
         WorldFace face;
         std::array<Vec3, 3> corners{};
-        /// Its edges in its plane: inward[i] = normal x (corner i+1 - corner i), length2[i] its
-        /// squared length.
-        struct Edges {
-            std::array<Vec3, 3> inward{};
-            std::array<double, 3> length2{};
-        } edges;
+        TriangleEdges edges; ///< Its edges in its plane.
     };
     static constexpr std::uint32_t kNotCached = 0xffffffffu;
     /// Where a solve ended.
