@@ -272,6 +272,39 @@ TEST_CASE("sim touch: the press never overshoots press_n, and does not wind up w
     }
 }
 
+TEST_CASE("sim grasp: the squeeze settles at press_n, and the press's extra depth is gone once "
+          "the hand has let go") {
+    // One hand of the grasp on the grasp scene's cube (800 N/m), which stays where it is here:
+    // the hand presses its -x face until the lift takes it off, then releases.
+    const Scene scene = makeGraspScene();
+    const SceneObject& cube = scene.object(*scene.slotOf(0));
+    DeviceConfig c = simConfig("grasp-left", 1, Vec3(-0.12, -0.04, 0));
+    sim(c).object = 0;
+    sim(c).pressForceN = 2.0;
+    sim(c).noiseM = 0.0;
+    sim(c).resolutionM = 0.0;
+    SimDevice d(c, scene);
+    REQUIRE(d.open() == DeviceStatus::Ok);
+    const Vec3 n(-1.0, 0.0, 0.0);
+    DeviceState s;
+    Vec3 force(0.0);
+    double squeezeN = 0.0, extraWhileSqueezing = 0.0;
+    for (int i = 0; i < 9000; ++i) {
+        REQUIRE(d.write(force) == DeviceStatus::Ok);
+        REQUIRE(d.read(s) == DeviceStatus::Ok);
+        force =
+            penaltyForce(cube, n, c.transform.positionToWorld(s.position), cube.material.stiffness);
+        if (std::abs(d.timeS() - 4.45) < 1e-9) {
+            squeezeN = glm::dot(force, n);
+            extraWhileSqueezing = d.pressExtraM();
+        }
+    }
+    CHECK(squeezeN == Approx(2.0).epsilon(0.01));
+    CHECK(extraWhileSqueezing == Approx(2.0 / cube.material.stiffness).epsilon(0.02));
+    CHECK(d.phase() == ScriptPhase::Done);
+    CHECK(d.pressExtraM() < 1e-9);
+}
+
 TEST_CASE("sim slide: moves along the surface while pressing on it") {
     const Scene scene = makeDefaultScene();
     DeviceConfig c = simConfig("slide", 1, Vec3(-0.01, 0.0, 0.0));
