@@ -129,8 +129,8 @@ TEST_CASE("options follow one convention, the old spellings still work") {
     CHECK(tooShortMinutes.output.find("--minutes 0.02") != std::string::npos);
 }
 
-TEST_CASE("--help-all gives every command's options at every depth; every command has examples "
-          "and no help line is wider than 100 columns") {
+TEST_CASE("hapto --help-all gives every command's options at every depth, each command has "
+          "examples, and no help line is wider than 100 columns") {
     const auto all = test::runHapto("--help-all");
     REQUIRE(all.exitCode == 0);
     std::deque<std::string> todo;
