@@ -1,5 +1,6 @@
-// The checks numeric options go through (finiteRange, wholeNumber) and the realtime flag
-// (tools/src/Options.h), in process.
+// The command line's conventions (tools/src/Options.h), in process: the checks numeric options
+// go through (finiteRange, positiveRange, wholeNumber), the shared options (realtime, the view,
+// renamed ones), the default index, and the help layout (wrapText, HelpFormatter, examples).
 
 #include "Options.h"
 #include "hapto/scenes/InputError.h"
