@@ -96,7 +96,7 @@ TEST_CASE("wholeNumber reads counts as numbers, with or without an exponent") {
     CHECK_THAT(parseWhole({"--list", "10,x"}, n, list), Catch::Contains("not a number"));
 }
 
-TEST_CASE("positiveRange refuses 0 and says so in its range, which reads (0, hi]") {
+TEST_CASE("positiveRange refuses 0 and says so in the range it shows") {
     const auto parsePositive = [](const std::string& value) -> std::string {
         CLI::App app;
         double x = 1.0;
@@ -179,7 +179,7 @@ TEST_CASE("HelpFormatter: --help-all gives every command at every depth, wrapped
     }
 }
 
-TEST_CASE("the realtime flag's help names its default, not CLI11's {false}") {
+TEST_CASE("the realtime flag's help names its default in words, not as CLI11's flag value") {
     for (const bool asks : {true, false}) {
         CLI::App app;
         app.formatter(std::make_shared<HelpFormatter>());
