@@ -102,12 +102,14 @@ TEST_CASE("scene import refuses bad models and options with exit code 2 and writ
         {q(dir / "missing.stl"), "missing.stl: cannot open the model file"},
         {q(dir.path()), "is a directory"},
         {q(dir / "model.json"), "unknown model format '.json'"},
-        {q(dir / "cube.obj") + " --scale 0", "--scale: must be > 0"},
+        {q(dir / "cube.obj") + " --scale 0",
+         "--scale: 0 is out of range; expected a number above 0"},
         {q(dir / "cube.obj") + " --scale nan", "--scale"},
         {q(dir / "cube.obj") + " --center 1,2", "--center"},
         {q(dir / "cube.obj") + " --center 0,nan,0", "--center"},
         {q(dir / "cube.obj") + " --rotation 1,1,0,0", "--rotation: expected a unit quaternion"},
-        {q(dir / "cube.obj") + " --stiffness 0", "--stiffness: must be > 0"},
+        {q(dir / "cube.obj") + " --stiffness 0",
+         "--stiffness: 0 is out of range; expected a number above 0"},
         {q(dir / "cube.obj") + " --friction 0.1,0.2", "--friction: the dynamic coefficient"},
     };
     for (const Case& c : cases) {
