@@ -204,11 +204,62 @@ private:
         bool touched = false; ///< The proxy reached a surface this solve.
         Vec3 firstTouch{0.0}; ///< Where it first did.
         std::uint32_t iterations = 0;
+
+        /// Drops the planes the proxy at `at` is not on (within the on-plane tolerance).
+        void keepPlanesOn(const Vec3& at) noexcept;
+        /// Adds a plane unless the same plane is there; false when there is no room.
+        bool addPlane(const Plane& plane) noexcept;
+    };
+    /// What the friction step decided: the final solve, the passes of both solves, and
+    /// whether the proxy held its anchor.
+    struct Friction {
+        Solve solve;
+        std::uint32_t iterations = 0;
+        bool stuck = false;
     };
     struct Hit;
 
+    // The tick (GodObjectRenderer.cpp).
+    /// The device velocity (m/s): the given one, or estimated from the last position.
+    Vec3 velocityAt(const Vec3& devicePosition, const Vec3& deviceVelocity,
+                    double dtSeconds) const noexcept;
+    /// The proxy's start: carried by a touched object that moved, pushed out of one that moved
+    /// into it.
+    Vec3 startOfTick(const Scene& scene, const CandidateSet& candidates, const Vec3& goal,
+                     std::uint32_t& tested) noexcept;
+    /// Fills out.contacts from the final planes; returns the smallest stiffness among them.
+    double takeContacts(const Scene& scene, const Solve& fin, bool stuck,
+                        const Vec3& devicePosition, RenderOutput& out) const noexcept;
+    /// k (proxy - device) with the contact damping; zero (and no slipping) without contact.
+    Vec3 contactForce(const RenderOutput& out, double stiffness, const Vec3& devicePosition,
+                      const Vec3& velocity) noexcept;
+    /// The status and counters, a non-finite result zeroed, and the state the next tick
+    /// starts from.
+    void finishTick(const Scene& scene, const CandidateSet& candidates, const Vec3& start,
+                    const Vec3& goal, RenderOutput& out) noexcept;
+
+    // The candidate gathering (GodObjectNearList.cpp).
+    /// Builds the near list around `goal` unless the current one covers a reach of `need`.
+    void ensureNear(const Scene& scene, const CandidateSet& candidates, const Vec3& goal,
+                    double need, std::uint32_t& tested) noexcept;
     void buildNear(const Scene& scene, const CandidateSet& candidates, const Vec3& center,
                    double radius, std::uint32_t& tested) noexcept;
+    /// Lists a candidate triangle (the tick's k-th) if it is within the near ball.
+    void considerTriangle(const Scene& scene, std::uint32_t item, std::uint32_t k) noexcept;
+    /// Lists a box or sphere, or a mesh's triangles, within the ball of `radius` (m).
+    void considerObject(const Scene& scene, std::uint32_t item, double radius) noexcept;
+    bool addNear(std::uint32_t item) noexcept;
+    /// Distance (m) from p to an item's skin, 0 inside; a cached triangle's (`near` <
+    /// kCachedTriangles) from its copy.
+    double distanceToSkinOf(const Scene& scene, std::uint32_t item, std::uint32_t near,
+                            const Vec3& p) const noexcept;
+    template <class Fn>
+    void forEachNear(const Scene& scene, const CandidateSet& candidates, Fn&& fn) const noexcept;
+    template <class Fn>
+    void forEachMeshTriangleNear(const Scene& scene, std::uint32_t slot, const Vec3& center,
+                                 double radius, Fn&& fn) const noexcept;
+
+    // The proxy solve (GodObjectSolver.cpp).
     /// Solves toward `goal` from `start`, adding start and each pass's end to the visited
     /// points.
     Solve solve(const Scene& scene, const CandidateSet& candidates, const Vec3& start,
@@ -220,18 +271,22 @@ private:
     }
     Hit sweep(const Scene& scene, const CandidateSet& candidates, const Vec3& from,
               const Vec3& to) const noexcept;
+    /// Adds the plane the hit entered and, on an edge or corner, those beside it that the goal
+    /// is behind; false when the entered plane found no room.
+    bool addHitPlanes(const Scene& scene, const CandidateSet& candidates, Solve& s, const Hit& hit,
+                      const Vec3& p, const Vec3& target, const Vec3& goal) noexcept;
+    void addTriangleNeighbourPlanes(const Scene& scene, const CandidateSet& candidates, Solve& s,
+                                    const Hit& hit, const Vec3& p, const Vec3& goal) noexcept;
+    void addBoxEdgePlanes(const Scene& scene, const CandidateSet& candidates, Solve& s,
+                          const Hit& hit, const Vec3& p, const Vec3& goal) noexcept;
     bool covered(const Scene& scene, const CandidateSet& candidates, const Vec3& probe,
                  std::uint32_t self) const noexcept;
-    template <class Fn>
-    void forEachNear(const Scene& scene, const CandidateSet& candidates, Fn&& fn) const noexcept;
-    template <class Fn>
-    void forEachMeshTriangleNear(const Scene& scene, std::uint32_t slot, const Vec3& center,
-                                 double radius, Fn&& fn) const noexcept;
-    /// Distance (m) from p to an item's skin, 0 inside; a cached triangle's (`near` <
-    /// kCachedTriangles) from its copy.
-    double distanceToSkinOf(const Scene& scene, std::uint32_t item, std::uint32_t near,
-                            const Vec3& p) const noexcept;
-    bool addNear(std::uint32_t item) noexcept;
+    /// Drops the planes whose item the proxy at p has slid off; true when one was dropped.
+    bool dropSlidOff(const Scene& scene, Solve& s, const Vec3& p) const noexcept;
+
+    // Friction (GodObjectFriction.cpp).
+    Friction friction(const Scene& scene, const CandidateSet& candidates, const Vec3& start,
+                      const Vec3& goal, const Solve& free, std::uint32_t& tested) noexcept;
 
     RendererConfig mConfig;
     State mState;

@@ -1,0 +1,221 @@
+/// The god-object renderer's candidate gathering: the near list and the mesh walk.
+///
+/// Design note
+/// -----------
+/// Idea. The candidate spans (leaves of the index, the moving objects) name every item the
+/// proxy may meet this tick, many of them far away and many named twice (neighbouring leaves
+/// share the triangles that straddle them). One pass over the spans keeps the items that can
+/// matter in a deduplicated list (kMaxNearObjects): every point the proxy visits while solving
+/// toward a goal g from a start s lies within |s - g| of g, so an item farther than that from
+/// g cannot be touched. Boxes and spheres enter when their bounding sphere meets a generous
+/// ball (twice the reach, room for a friction lag up to mu_d = 1, plus 1 mm); triangles only
+/// when the triangle itself is within the reach plus 1 µm, so a fine mesh under a pressing
+/// tool adds a handful of triangles, not every one within a millimetre. A moving mesh's slot
+/// stands for its triangles near the ball, found through the mesh's own BVH in its frame.
+///
+/// Invariant. The list holds every valid item within the ball, once; when it would overflow
+/// the tick runs on the raw spans instead (forEachNear), which gives the same answers more
+/// slowly. The first kCachedTriangles candidate triangles are copied (plane, then corners,
+/// then edges, each when first needed) into mTriangleData, and a second list in the same tick
+/// (the friction solve's) meets them in the same order, so it reads nothing again.
+///
+/// Cost. One pass over the spans (an item an earlier span holds is skipped by a binary search
+/// of that sorted leaf list); two dot products reject most triangles by their plane; a corner
+/// well inside the ball spares the closest-point test. No allocation.
+
+#include "GodObjectParts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+namespace hapto {
+
+using namespace godobject;
+
+namespace {
+
+/// Distance (m) from p to the object's skin, 0 inside.
+double distanceToSkin(const RenderBody& o, const Vec3& p) {
+    return o.shape == Shape::Sphere
+               ? std::max(0.0, sphereSignedDistance(o.center, o.halfExtents.x + kSkinM, p))
+               : boxDistanceOutside(o.obb(), p, kSkinM);
+}
+
+/// Distance (m) from p to an item's skin, 0 inside, read from the scene.
+double itemDistanceToSkin(const Scene& scene, std::uint32_t item, const Vec3& p) {
+    if (isTriangleItem(item)) {
+        const WorldFace tp = scene.triangleFace(item);
+        return triangleSkinDistance(
+            tp.normal, tp.offset, [&] { return fetchTriangle(scene, item, tp.normal); }, p, kSkinM);
+    }
+    return distanceToSkin(scene.body(item), p);
+}
+
+/// True when a span before span s lists the item: it was decided there (the same test gives
+/// the same answer). Leaf lists are sorted; an unsorted span (the moving list) is only ever
+/// not found in.
+bool listedEarlier(const CandidateSet& candidates, std::size_t s, std::uint32_t item) {
+    return std::any_of(candidates.spans.begin(), candidates.spans.begin() + s,
+                       [&](const std::span<const std::uint32_t> earlier) {
+                           return std::binary_search(earlier.begin(), earlier.end(), item);
+                       });
+}
+
+} // namespace
+
+/// The scene numbers triangles mesh by mesh in slot order, so a binary search over the numbers
+/// finds a mesh's first. O(log triangles x log meshes).
+std::uint32_t godobject::firstTriangleItem(const Scene& scene, std::uint32_t slot) noexcept {
+    std::uint32_t lo = 0;
+    std::uint32_t hi = scene.triangleCount();
+    while (lo < hi) {
+        const std::uint32_t mid = lo + (hi - lo) / 2;
+        if (scene.triangle(kTriangleItemBit | mid).objectSlot < slot) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    return kTriangleItemBit | lo;
+}
+
+double GodObjectRenderer::distanceToSkinOf(const Scene& scene, std::uint32_t item,
+                                           std::uint32_t near, const Vec3& p) const noexcept {
+    if (near == kNotCached) {
+        return itemDistanceToSkin(scene, item, p);
+    }
+    const NearTriangle& t = mTriangleData[near];
+    return triangleSkinDistance(
+        t.face.normal, t.face.offset, [&]() -> const NearTriangle& { return t; }, p, kSkinM);
+}
+
+bool GodObjectRenderer::addNear(std::uint32_t item) noexcept {
+    if (mNearOverflow) {
+        return false;
+    }
+    for (std::uint32_t k = 0; k < mNearCount; ++k) {
+        if (mNear[k] == item) {
+            return false;
+        }
+    }
+    if (mNearCount == kMaxNearObjects) {
+        mNearOverflow = true;
+        return false;
+    }
+    mNear[mNearCount++] = item;
+    return true;
+}
+
+void GodObjectRenderer::ensureNear(const Scene& scene, const CandidateSet& candidates,
+                                   const Vec3& goal, double need, std::uint32_t& tested) noexcept {
+    const double covers =
+        mNearTriangles
+            ? mNearRadius
+            : (1.0 + kFrictionCover) * (mNearRadius - kTriangleNearMarginM) + kNearMarginM;
+    if (mNearRadius < 0.0 || glm::length(goal - mNearCenter) + need > covers) {
+        buildNear(scene, candidates, goal, need, tested);
+    }
+}
+
+void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candidates,
+                                  const Vec3& center, double reach,
+                                  std::uint32_t& tested) noexcept {
+    mNearCenter = center;
+    mNearRadius = reach + kTriangleNearMarginM;
+    mNearCount = 0;
+    mNearOverflow = false;
+    mNearTriangles = false;
+    // Triangles get a tight ball (the reach plus 1 µm) so that a fine mesh adds only the few
+    // triangles the proxy can touch this tick; boxes and spheres keep a generous one (room for
+    // a friction lag up to mu_d = 1, plus 1 mm), as cheap as it is few.
+    const double radius = (1.0 + kFrictionCover) * reach + kNearMarginM;
+    const std::uint32_t n = scene.size();
+    std::uint32_t triangles = 0; // valid triangle candidates so far (an item once)
+    for (std::size_t s = 0; s < candidates.count && s < CandidateSet::kMaxSpans; ++s) {
+        tested += static_cast<std::uint32_t>(candidates.spans[s].size());
+        for (const std::uint32_t item : candidates.spans[s]) {
+            if (mNearOverflow) {
+                break;
+            }
+            if (listedEarlier(candidates, s, item)) {
+                continue;
+            }
+            if (isTriangleItem(item)) {
+                if (validItem(scene, item)) {
+                    mNearTriangles = true;
+                    considerTriangle(scene, item, triangles++);
+                }
+            } else if (item < n) {
+                considerObject(scene, item, radius);
+            }
+        }
+    }
+}
+
+void GodObjectRenderer::considerTriangle(const Scene& scene, std::uint32_t item,
+                                         std::uint32_t k) noexcept {
+    const Vec3& center = mNearCenter;
+    const double triangleReach = mNearRadius + kSkinM;
+    // The k-th candidate triangle is the same in every list of the tick (the same spans, in the
+    // same order): what an earlier list read, it reuses.
+    NearTriangle* t = k < kCachedTriangles ? &mTriangleData[k] : nullptr;
+    if (t && (k >= mTriangleCount || t->item != item)) {
+        // Field by field: the corners and edges are written when first needed.
+        t->item = item;
+        t->hasCorners = false;
+        t->hasEdges = false;
+        t->face = scene.triangleFace(item);
+        mTriangleCount = k + 1;
+    }
+    // The distance to the plane bounds the distance to the triangle: most candidates end at
+    // one dot product.
+    const WorldFace f = t ? t->face : scene.triangleFace(item);
+    if (std::abs(glm::dot(f.normal, center) - f.offset) > triangleReach) {
+        return;
+    }
+    if (t && !t->hasCorners) {
+        t->corners = scene.triangleCorners(item);
+        t->hasCorners = true;
+    }
+    const std::array<Vec3, 3> v = t ? t->corners : scene.triangleCorners(item);
+    // A corner well inside the ball (by far more than rounding) makes the triangle near
+    // without the closest-point test.
+    const double r2 = triangleReach * triangleReach;
+    const bool cornerInside = std::min({length2(v[0] - center), length2(v[1] - center),
+                                        length2(v[2] - center)}) < r2 * (1.0 - 1e-9);
+    if ((!cornerInside && triangleDistance2(center, v) > r2) || !addNear(item)) {
+        return;
+    }
+    if (t && !t->hasEdges) {
+        t->edges = triangleEdges(v, f.normal);
+        t->mesh = scene.objectSlotOf(item);
+        t->hasEdges = true;
+    }
+    mNearCached[mNearCount - 1] = static_cast<std::uint8_t>(t ? k : kCachedTriangles);
+}
+
+void GodObjectRenderer::considerObject(const Scene& scene, std::uint32_t item,
+                                       double radius) noexcept {
+    const RenderBody& o = scene.body(item);
+    const double reach = radius + o.radius + kSkinM;
+    if (length2(o.center - mNearCenter) > reach * reach) {
+        return;
+    }
+    if (o.shape == Shape::Mesh) {
+        // A moving mesh (or an index that holds whole meshes): its triangles near the ball,
+        // from the mesh's own frame.
+        mNearTriangles = true;
+        forEachMeshTriangleNear(scene, item, mNearCenter, mNearRadius, [&](std::uint32_t t) {
+            if (addNear(t)) {
+                mNearCached[mNearCount - 1] = kCachedTriangles;
+            }
+        });
+        return;
+    }
+    if (addNear(item)) {
+        mNearCached[mNearCount - 1] = kCachedTriangles;
+    }
+}
+
+} // namespace hapto
