@@ -3,6 +3,7 @@
 
 #include "hapto/index/Cursor.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -54,6 +55,48 @@ LocateResult Cursor::locate(const Vec3& p) noexcept {
         mLeaf = r.leaf;
     }
     return r;
+}
+
+SegmentWalk Cursor::firstLeafNotIn(const Vec3& a, const Vec3& b,
+                                   std::span<const std::uint32_t> listed) const noexcept {
+    Cursor walker = *this;
+    const Vec3 d = b - a;
+    const double length = glm::length(d);
+    double t = 0.0;
+    for (int walked = 0; walked < kMaxWalkLeaves; ++walked) {
+        const LocateResult at = walker.locate(a + t * d);
+        if (at.outside) {
+            return {};
+        }
+        if (std::find(listed.begin(), listed.end(), at.leaf) == listed.end()) {
+            return {at, t};
+        }
+        if (!(length > 0.0)) {
+            return {};
+        }
+        // Where the segment leaves this leaf's box: the nearest exit over the three slabs.
+        const Aabb box = mIndex->leafBounds(at.leaf);
+        double exit = 1.0;
+        for (int i = 0; i < 3; ++i) {
+            if (d[i] > 0.0) {
+                exit = std::min(exit, (box.max[i] - a[i]) / d[i]);
+            } else if (d[i] < 0.0) {
+                exit = std::min(exit, (box.min[i] - a[i]) / d[i]);
+            }
+        }
+        if (exit >= 1.0) {
+            SegmentWalk reached;
+            reached.endBox = box; // b's leaf, listed
+            return reached;
+        }
+        t = std::max(exit, t) + 1e-9 / length; // a nanometre past the face
+        if (t > 1.0) {
+            return {};
+        }
+    }
+    SegmentWalk unknown;
+    unknown.unknown = true;
+    return unknown;
 }
 
 } // namespace hapto

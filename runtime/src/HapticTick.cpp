@@ -13,73 +13,10 @@ static_assert(alignof(HapticTick) == 64);
 
 namespace {
 
-/// What a walk along a path found: the first leaf no span lists, if any.
-struct Unlisted {
-    LocateResult at; ///< That leaf (at.leaf == kNoLeaf: every leaf on the way is listed).
-    /// Where on the segment that leaf begins (0 at its start, 1 at its end); 1 when none does.
-    double t = 1.0;
-    /// The walk stopped before the end without knowing (more than kMaxWalk leaves on one
-    /// segment, which only rounding that keeps finding the same face could make): the path
-    /// counts as not covered.
-    bool unknown = false;
-    bool covered() const noexcept { return at.leaf == kNoLeaf && !unknown; }
-};
-
-/// The most leaves one segment's walk visits (each listed but the last; at most 2 +
-/// HapticTick::kExtraLeaves are).
-constexpr int kMaxWalk = 64;
-
-/// The first leaf that the segment a -> b passes through and that is not in `listed`, walking
-/// from a leaf to the next at the point the segment leaves each box; none when there is none
-/// or the walk leaves the index's bounds (no item is indexed outside them), `unknown` after
-/// kMaxWalk leaves. `walker` is a copy of a cursor near a (the proxy's): each step crosses to
-/// the next leaf by its links, not from the root. [servo]
-Unlisted firstUnlistedLeaf(Cursor walker, const Vec3& a, const Vec3& b,
-                           std::span<const std::uint32_t> listed,
-                           Aabb* lastBox = nullptr) noexcept {
-    const SpatialIndex& index = *walker.index();
-    const Vec3 d = b - a;
-    const double length = glm::length(d);
-    double t = 0.0;
-    for (int walked = 0; walked < kMaxWalk; ++walked) {
-        const LocateResult at = walker.locate(a + t * d);
-        if (at.outside) {
-            return {};
-        }
-        if (std::find(listed.begin(), listed.end(), at.leaf) == listed.end()) {
-            return {at, t};
-        }
-        if (!(length > 0.0)) {
-            return {};
-        }
-        // Where the segment leaves this leaf's box: the nearest exit over the three slabs.
-        const Aabb box = index.leafBounds(at.leaf);
-        double exit = 1.0;
-        for (int i = 0; i < 3; ++i) {
-            if (d[i] > 0.0) {
-                exit = std::min(exit, (box.max[i] - a[i]) / d[i]);
-            } else if (d[i] < 0.0) {
-                exit = std::min(exit, (box.min[i] - a[i]) / d[i]);
-            }
-        }
-        if (exit >= 1.0) {
-            if (lastBox) {
-                *lastBox = box; // b's leaf, listed
-            }
-            return {};
-        }
-        t = std::max(exit, t) + 1e-9 / length; // a nanometre past the face
-        if (t > 1.0) {
-            return {};
-        }
-    }
-    return {{}, 1.0, true};
-}
-
 /// The first leaf not in `listed` along any segment of the renderer's visited paths (where the
-/// proxy went in its last update), if any. [servo]
-Unlisted firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& renderer,
-                              std::span<const std::uint32_t> listed) noexcept {
+/// proxy went in its last update), if any; `walker` is the proxy's cursor. [servo]
+SegmentWalk firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& renderer,
+                                 std::span<const std::uint32_t> listed) noexcept {
     for (int which = 0; which < 2; ++which) {
         const std::span<const Vec3> path = renderer.visitedPath(which);
         // The listed leaf box the last segment ended in: a segment inside it (a box is
@@ -89,8 +26,8 @@ Unlisted firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& ren
             if (path[i] == path[i - 1] || (box.contains(path[i - 1]) && box.contains(path[i]))) {
                 continue;
             }
-            box = Aabb{Vec3(1.0), Vec3(-1.0)};
-            const Unlisted missed = firstUnlistedLeaf(walker, path[i - 1], path[i], listed, &box);
+            const SegmentWalk missed = walker.firstLeafNotIn(path[i - 1], path[i], listed);
+            box = missed.endBox;
             if (!missed.covered()) {
                 return missed;
             }
@@ -124,21 +61,7 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
 TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& v, double dtS,
                             const Vec3& externalForceN, const DeviceState& sample) noexcept {
     TickOutput out;
-    // A new snapshot (or the first tick): the cursors re-bind to its index and forget their
-    // leaves; a snapshot that only moved objects shares the index, but re-binding is cheap
-    // and keeps "cursor leaf == fresh locate" without reasoning about which index it is.
-    const SpatialIndex* index = snapshot.index.get();
-    if (mFresh || snapshot.version != mBoundVersion || index != mBoundIndex) {
-        out.newSnapshot = !mFresh;
-        mDeviceCursor.reset(*index);
-        mProxyCursor.reset(*index);
-        mBoundIndex = index;
-        mBoundVersion = snapshot.version;
-    }
-    if (mFresh) {
-        mRenderer.reset(p);
-        mFresh = false;
-    }
+    bind(snapshot, p, out);
 
     // 1. Locate both cursors. 2. Candidates: the device's leaf, the proxy's when it is
     // another leaf (or one is outside the bounds), and every moving object.
@@ -155,83 +78,15 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     out.outside = atDevice.outside;
     out.deviceLeaf = atDevice.leaf;
 
-    // 3. Render. The candidates cover where the device and the proxy are, not every place the
-    // proxy visits this tick: a proxy sliding over fine triangles (a mesh whose leaves are
-    // smaller than one tick's motion, with the device in an empty leaf under the surface)
-    // can slide off the triangles it knows, over a leaf nobody listed, and through the
-    // surface. So the way the proxy went is walked leaf by leaf: every segment of the
-    // renderer's visited paths (its start, each solver pass's end); at the first leaf that was
-    // not a candidate the tick is solved again from the same start with that leaf's items
-    // too, up to kExtraLeaves times. The likely slide (from the start along last tick's
-    // contact plane to the device point's projection on it) is known before solving, so its
-    // leaves are listed first: a slide over small leaves usually solves once.
+    // 3. Render, over every leaf the proxy's way crosses (see render()).
+    ListedLeaves listed;
+    listed.leaves[0] = atDevice.leaf;
+    listed.leaves[1] = atProxy.leaf;
+    listed.count = 2;
     const Vec3 from = mRenderer.proxy();
-    const Vec3 slide =
-        mRenderer.inContact() ? p - glm::dot(p - from, mSlideNormal) * mSlideNormal : from;
-    std::array<std::uint32_t, 2 + kExtraLeaves> listed{atDevice.leaf, atProxy.leaf};
-    std::size_t listedCount = 2;
-    while (listedCount < listed.size() && mRenderer.inContact()) {
-        const Unlisted missed = firstUnlistedLeaf(
-            mProxyCursor, from, slide, std::span<const std::uint32_t>(listed.data(), listedCount));
-        if (missed.at.leaf == kNoLeaf || !mCandidates.add(missed.at.candidates)) {
-            break;
-        }
-        listed[listedCount++] = missed.at.leaf;
-        ++out.extraLeaves;
-    }
+    listSlide(p, from, listed, out);
     stamp(1);
-    const GodObjectRenderer::State start = mRenderer.state(); // a plain copy: no allocation
-    out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
-    out.solves = 1;
-    std::uint32_t tested = out.render.objectsTested;
-    bool covered = false; // every leaf of the proxy's path is listed
-    for (;;) {
-        const std::span<const std::uint32_t> known(listed.data(), listedCount);
-        const Unlisted missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, known);
-        covered = missed.covered();
-        if (covered || missed.unknown || listedCount == listed.size() ||
-            !mCandidates.add(missed.at.candidates)) {
-            break;
-        }
-        listed[listedCount++] = missed.at.leaf;
-        mRenderer.restore(start);
-        out.render = mRenderer.update(*snapshot.scene, mCandidates, p, v, dtS);
-        tested += out.render.objectsTested;
-        ++out.extraLeaves;
-        ++out.solves;
-    }
-    // Out of room while the path still crosses a leaf no span lists (a very fast hand over
-    // very small leaves, or a proxy trapped far behind a hand that pushed through), or a walk
-    // that could not finish: the proxy must not move through space whose items the renderer
-    // has not seen. Solve again with the proxy's motion held to a goal pulled back from the
-    // device point toward the start, halving, then a nudge of kNudgeM, until the path stays in
-    // listed leaves; the last try is the start itself (the proxy stays, no contact, no force).
-    // The contacts and the force are the device point's: the hand pushing in feels the surface
-    // as hard as ever, and the proxy never falls through it. The first goal is halfway to where
-    // the straight way from the start to the device point leaves the listed leaves (halfway to
-    // the device point when it does not): a proxy trapped centimetres behind then moves up to
-    // half a leaf in one more solve, where halving from the device point would try goals
-    // centimetres away, each crossing unlisted leaves again, and end on the nudge.
-    const double away = glm::length(p - from);
-    const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (p - from) : p;
-    Vec3 goal = p;
-    const std::span<const std::uint32_t> known(listed.data(), listedCount);
-    const double firstHalf =
-        covered ? 0.5 : 0.5 * firstUnlistedLeaf(mProxyCursor, from, p, known).t;
-    for (int k = 0; !covered && k < kPullBacks; ++k) {
-        const double keep = k == 0 ? firstHalf : 0.5;
-        goal = k + 2 < kPullBacks ? from + keep * (goal - from) : k + 1 < kPullBacks ? nudge : from;
-        mRenderer.restore(start);
-        out.render = mRenderer.update(*snapshot.scene, mCandidates, p, goal, v, dtS);
-        tested += out.render.objectsTested;
-        ++out.pullBacks;
-        ++out.solves;
-        covered = firstUnlistedOnPaths(mProxyCursor, mRenderer, known).covered();
-    }
-    out.render.objectsTested = tested;
-    if (out.render.contactCount > 0) {
-        mSlideNormal = out.render.contacts[0].normal;
-    }
+    render(*snapshot.scene, p, v, dtS, from, listed, out);
     stamp(2);
 
     // 4. Force effects at the device point, then the hook, and the external force. A hook
@@ -258,6 +113,111 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     out.forceN = mSafety.filter(requested);
     stamp(4);
     return out;
+}
+
+void HapticTick::bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& out) noexcept {
+    // A new snapshot (or the first tick): the cursors re-bind to its index and forget their
+    // leaves; a snapshot that only moved objects shares the index, but re-binding is cheap
+    // and keeps "cursor leaf == fresh locate" without reasoning about which index it is.
+    const SpatialIndex* index = snapshot.index.get();
+    if (mFresh || snapshot.version != mBoundVersion || index != mBoundIndex) {
+        out.newSnapshot = !mFresh;
+        mDeviceCursor.reset(*index);
+        mProxyCursor.reset(*index);
+        mBoundIndex = index;
+        mBoundVersion = snapshot.version;
+    }
+    if (mFresh) {
+        mRenderer.reset(p);
+        mFresh = false;
+    }
+}
+
+void HapticTick::listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed,
+                           TickOutput& out) noexcept {
+    // The likely slide (from the start along last tick's contact plane to the device point's
+    // projection on it) is known before solving, so its leaves are listed first: a slide over
+    // small leaves usually solves once.
+    const Vec3 slide =
+        mRenderer.inContact() ? p - glm::dot(p - from, mSlideNormal) * mSlideNormal : from;
+    while (listed.count < listed.leaves.size() && mRenderer.inContact()) {
+        const SegmentWalk missed = mProxyCursor.firstLeafNotIn(from, slide, listed.known());
+        if (missed.at.leaf == kNoLeaf || !mCandidates.add(missed.at.candidates)) {
+            break;
+        }
+        listed.leaves[listed.count++] = missed.at.leaf;
+        ++out.extraLeaves;
+    }
+}
+
+void HapticTick::render(const Scene& scene, const Vec3& p, const Vec3& v, double dtS,
+                        const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept {
+    // The candidates cover where the device and the proxy are, not every place the proxy
+    // visits this tick: a proxy sliding over fine triangles (a mesh whose leaves are smaller
+    // than one tick's motion, with the device in an empty leaf under the surface) can slide
+    // off the triangles it knows, over a leaf nobody listed, and through the surface. So the
+    // way the proxy went is walked leaf by leaf: every segment of the renderer's visited paths
+    // (its start, each solver pass's end); at the first leaf that was not a candidate the tick
+    // is solved again from the same start with that leaf's items too, up to kExtraLeaves
+    // times; then, if the way still leaves the listed leaves, the goal is pulled back.
+    const GodObjectRenderer::State start = mRenderer.state(); // a plain copy: no allocation
+    out.render = mRenderer.update(scene, mCandidates, p, v, dtS);
+    out.solves = 1;
+    std::uint32_t tested = out.render.objectsTested;
+    for (;;) {
+        const SegmentWalk missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, listed.known());
+        if (missed.covered()) {
+            break;
+        }
+        if (missed.unknown || listed.count == listed.leaves.size() ||
+            !mCandidates.add(missed.at.candidates)) {
+            pullBack(scene, p, v, dtS, from, start, listed.known(), tested, out);
+            break;
+        }
+        listed.leaves[listed.count++] = missed.at.leaf;
+        mRenderer.restore(start);
+        out.render = mRenderer.update(scene, mCandidates, p, v, dtS);
+        tested += out.render.objectsTested;
+        ++out.extraLeaves;
+        ++out.solves;
+    }
+    out.render.objectsTested = tested;
+    if (out.render.contactCount > 0) {
+        mSlideNormal = out.render.contacts[0].normal;
+    }
+}
+
+void HapticTick::pullBack(const Scene& scene, const Vec3& p, const Vec3& v, double dtS,
+                          const Vec3& from, const GodObjectRenderer::State& start,
+                          std::span<const std::uint32_t> known, std::uint32_t& tested,
+                          TickOutput& out) noexcept {
+    // Out of room while the path still crosses a leaf no span lists (a very fast hand over
+    // very small leaves, or a proxy trapped far behind a hand that pushed through), or a walk
+    // that could not finish: the proxy must not move through space whose items the renderer
+    // has not seen. Solve again with the proxy's motion held to a goal pulled back from the
+    // device point toward the start, halving, then a nudge of kNudgeM, until the path stays in
+    // listed leaves; the last try is the start itself (the proxy stays, no contact, no force).
+    // The contacts and the force are the device point's: the hand pushing in feels the surface
+    // as hard as ever, and the proxy never falls through it. The first goal is halfway to where
+    // the straight way from the start to the device point leaves the listed leaves (halfway to
+    // the device point when it does not): a proxy trapped centimetres behind then moves up to
+    // half a leaf in one more solve, where halving from the device point would try goals
+    // centimetres away, each crossing unlisted leaves again, and end on the nudge.
+    const double away = glm::length(p - from);
+    const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (p - from) : p;
+    Vec3 goal = p;
+    const double firstHalf = 0.5 * mProxyCursor.firstLeafNotIn(from, p, known).t;
+    bool covered = false;
+    for (int k = 0; !covered && k < kPullBacks; ++k) {
+        const double keep = k == 0 ? firstHalf : 0.5;
+        goal = k + 2 < kPullBacks ? from + keep * (goal - from) : k + 1 < kPullBacks ? nudge : from;
+        mRenderer.restore(start);
+        out.render = mRenderer.update(scene, mCandidates, p, goal, v, dtS);
+        tested += out.render.objectsTested;
+        ++out.pullBacks;
+        ++out.solves;
+        covered = firstUnlistedOnPaths(mProxyCursor, mRenderer, known).covered();
+    }
 }
 
 } // namespace hapto

@@ -128,3 +128,73 @@ TEST_CASE("cursor: unbound, outside and back, reset to another index, FromRoot s
     CHECK(cursor.locate({-0.125, -0.125, -0.125}).leaf ==
           grid->locate({-0.125, -0.125, -0.125}).leaf);
 }
+
+TEST_CASE("cursor walk: the first unlisted leaf along a segment, every leaf a sampled point is "
+          "in found, the cursor itself unmoved") {
+    for (const auto& [name, scene] : testScenes()) {
+        for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::grid(7)}) {
+            INFO(name << " " << spec.toString());
+            const auto index = buildIndex(scene, spec);
+            const Aabb b = scene.bounds();
+            Random rng(23);
+            for (int n = 0; n < 200; ++n) {
+                const Vec3 a = b.center() +
+                               0.45 * b.size() *
+                                   Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+                const Vec3 e = b.center() +
+                               0.45 * b.size() *
+                                   Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+                Cursor cursor(*index);
+                const std::uint32_t startLeaf = cursor.locate(a).leaf;
+                // List the leaves one walk at a time: each is found where the segment enters
+                // it, and the first is a's own.
+                std::vector<std::uint32_t> listed;
+                SegmentWalk walk;
+                for (int k = 0; k < 200; ++k) {
+                    walk = cursor.firstLeafNotIn(a, e, listed);
+                    if (walk.at.leaf == kNoLeaf || walk.unknown) {
+                        break;
+                    }
+                    INFO("segment " << n << ", walk " << k << " at t = " << walk.t);
+                    REQUIRE(walk.t >= 0.0);
+                    REQUIRE(walk.t <= 1.0);
+                    REQUIRE(index->locate(a + walk.t * (e - a)).leaf == walk.at.leaf);
+                    REQUIRE((k > 0 || (walk.t == 0.0 && walk.at.leaf == startLeaf)));
+                    listed.push_back(walk.at.leaf);
+                }
+                REQUIRE(walk.covered());
+                REQUIRE(cursor.leaf() == startLeaf);
+                // The walk saw every leaf a point of the segment lies in, and ended in e's.
+                for (int k = 0; k <= 400; ++k) {
+                    const std::uint32_t leaf = index->locate(a + (k / 400.0) * (e - a)).leaf;
+                    REQUIRE(std::find(listed.begin(), listed.end(), leaf) != listed.end());
+                }
+                REQUIRE((walk.endBox.isEmpty() || walk.endBox.contains(e)));
+            }
+        }
+    }
+}
+
+TEST_CASE("cursor walk: outside the bounds, zero length, and an unbound cursor find nothing") {
+    const Scene scene = makeDegenerateScene();
+    const auto tree = Octree::build(scene, IndexSpec::octree(2, 0.005));
+    const Cursor cursor(*tree);
+    const Vec3 top = tree->bounds().max;
+    // Entirely outside: no indexed item there, nothing to list.
+    const SegmentWalk out = cursor.firstLeafNotIn(top + Vec3(0.1), top + Vec3(0.2), {});
+    CHECK(out.at.leaf == kNoLeaf);
+    CHECK(out.covered());
+    // A point: its leaf, listed or not.
+    const Vec3 p(0.01, 0.01, 0.01);
+    const std::uint32_t leaf = tree->locate(p).leaf;
+    CHECK(cursor.firstLeafNotIn(p, p, {}).at.leaf == leaf);
+    const std::vector<std::uint32_t> listed{leaf};
+    CHECK(cursor.firstLeafNotIn(p, p, listed).covered());
+    // Inside one listed leaf: covered, and the walk gives that leaf's box.
+    const Aabb box = tree->leafBounds(leaf);
+    const SegmentWalk inside = cursor.firstLeafNotIn(box.center(), p, listed);
+    CHECK(inside.covered());
+    CHECK(inside.endBox.min == box.min);
+    CHECK(inside.endBox.max == box.max);
+    CHECK(Cursor().firstLeafNotIn(p, p, {}).covered());
+}

@@ -19,8 +19,27 @@
 #include "hapto/index/SpatialIndex.h"
 
 #include <cstdint>
+#include <span>
 
 namespace hapto {
+
+/// What a walk along a segment found (Cursor::firstLeafNotIn): the first leaf on the way that
+/// is not listed, if any.
+struct SegmentWalk {
+    LocateResult at; ///< That leaf (at.leaf == kNoLeaf: every leaf on the way is listed).
+    /// Where on the segment that leaf begins (0 at its start, 1 at its end); 1 when none does.
+    double t = 1.0;
+    /// The walk stopped before the end without knowing (more than Cursor::kMaxWalkLeaves
+    /// leaves on one segment, which only rounding that keeps finding the same face could
+    /// make): the segment counts as not covered.
+    bool unknown = false;
+    /// The listed leaf box the segment's end lies in, when the walk got there through the
+    /// leaves (empty otherwise: an unlisted leaf, outside the bounds, a zero-length segment or
+    /// an end on a leaf's face). A later segment inside it (a box is convex) needs no walk.
+    Aabb endBox{Vec3(1.0), Vec3(-1.0)};
+    /// Every leaf the segment passes through inside the bounds is listed. [any thread]
+    bool covered() const noexcept { return at.leaf == kNoLeaf && !unknown; }
+};
 
 /// A per-thread, heap-free cursor caching its current leaf (one 64-byte cache line).
 class alignas(64) Cursor {
@@ -47,6 +66,17 @@ public:
     std::uint32_t leaf() const noexcept { return mLeaf; }
     /// The index it is bound to, or nullptr. [servo]
     const SpatialIndex* index() const noexcept { return mIndex; }
+
+    /// The most leaves firstLeafNotIn visits on one segment before it gives up (`unknown`).
+    static constexpr int kMaxWalkLeaves = 64;
+    /// The first leaf that the segment a -> b (m) passes through and that is not in `listed`,
+    /// walking from a leaf to the next where the segment leaves each leaf's box (a nanometre
+    /// past that face); none when there is none or the walk leaves the index's bounds (no item
+    /// is indexed outside them), `unknown` after kMaxWalkLeaves leaves. The walk moves a copy of
+    /// this cursor (best placed near a), so each step crosses to the next leaf by its links,
+    /// not from the root; this cursor is unchanged. No allocation. [servo]
+    SegmentWalk firstLeafNotIn(const Vec3& a, const Vec3& b,
+                               std::span<const std::uint32_t> listed) const noexcept;
 
 private:
     void forget() noexcept;

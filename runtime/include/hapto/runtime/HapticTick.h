@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 namespace hapto {
 
@@ -133,8 +134,32 @@ public:
     const ForceSafety& safety() const noexcept { return mSafety; }
 
 private:
+    /// The leaves this tick's candidate spans list: the device's, the proxy's, then the extra
+    /// ones, in the order their spans were added.
+    struct ListedLeaves {
+        std::array<std::uint32_t, 2 + kExtraLeaves> leaves{};
+        std::size_t count = 0;
+        std::span<const std::uint32_t> known() const noexcept {
+            return std::span<const std::uint32_t>(leaves.data(), count);
+        }
+    };
+
     /// Writes the clock as stage `i`'s end when stages are timed. [servo]
     void stamp(std::size_t i) noexcept;
+    /// Binds the cursors to a new snapshot's index, and the proxy to `p` on a fresh start.
+    void bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& out) noexcept;
+    /// Lists the leaves of the likely slide (from `from` along the last contact plane toward
+    /// `p`) before solving.
+    void listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept;
+    /// Solves, and solves again with each leaf the proxy's way crosses that no span listed;
+    /// pulls the goal back when they run out.
+    void render(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
+                ListedLeaves& listed, TickOutput& out) noexcept;
+    /// Solves again toward goals pulled back from `p` toward `from` until the proxy's way stays
+    /// in the listed leaves (TickOutput::pullBacks).
+    void pullBack(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
+                  const GodObjectRenderer::State& start, std::span<const std::uint32_t> known,
+                  std::uint32_t& tested, TickOutput& out) noexcept;
 
     Cursor mDeviceCursor; ///< The device point's leaf.
     Cursor mProxyCursor;  ///< The proxy's leaf.
