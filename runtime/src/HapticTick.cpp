@@ -8,14 +8,12 @@
 
 namespace hapto {
 
-static_assert(sizeof(HapticTick) == 12032, "update the size in HapticTick.h");
-static_assert(alignof(HapticTick) == 64);
-
 namespace {
 
 /// The first leaf not in `listed` along any segment of the renderer's visited paths (where the
 /// proxy went in its last update), if any; `walker` is the proxy's cursor. [servo]
-SegmentWalk firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& renderer,
+template <ForceAlgorithm Algorithm>
+SegmentWalk firstUnlistedOnPaths(const Cursor& walker, const Algorithm& renderer,
                                  std::span<const std::uint32_t> listed) noexcept {
     for (int which = 0; which < 2; ++which) {
         const std::span<const Vec3> path = renderer.visitedPath(which);
@@ -38,28 +36,34 @@ SegmentWalk firstUnlistedOnPaths(const Cursor& walker, const GodObjectRenderer& 
 
 } // namespace
 
-HapticTick::HapticTick(const RendererConfig& renderer, const SafetyConfig& safety)
+template <ForceAlgorithm Algorithm>
+BasicHapticTick<Algorithm>::BasicHapticTick(const RendererConfig& renderer,
+                                            const SafetyConfig& safety)
     : mRenderer(renderer), mSafety(safety) {}
 
-void HapticTick::stamp(std::size_t i) noexcept {
+template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::stamp(std::size_t i) noexcept {
     if (mStamps != nullptr) {
         (*mStamps)[i] = rt::nowNs();
     }
 }
 
-void HapticTick::reset() noexcept {
+template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::reset() noexcept {
     mFresh = true;
     mSafety.reset();
 }
 
-TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& v, double dtS,
-                            const Vec3& externalForceN) noexcept {
+template <ForceAlgorithm Algorithm>
+TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const Vec3& p,
+                                            const Vec3& v, double dtS,
+                                            const Vec3& externalForceN) noexcept {
     static constexpr DeviceState kNoSample{};
     return tick(snapshot, p, v, dtS, externalForceN, kNoSample);
 }
 
-TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& v, double dtS,
-                            const Vec3& externalForceN, const DeviceState& sample) noexcept {
+template <ForceAlgorithm Algorithm>
+TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const Vec3& p,
+                                            const Vec3& v, double dtS, const Vec3& externalForceN,
+                                            const DeviceState& sample) noexcept {
     TickOutput out;
     bind(snapshot, p, out);
 
@@ -115,7 +119,9 @@ TickOutput HapticTick::tick(const WorldSnapshot& snapshot, const Vec3& p, const 
     return out;
 }
 
-void HapticTick::bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& out) noexcept {
+template <ForceAlgorithm Algorithm>
+void BasicHapticTick<Algorithm>::bind(const WorldSnapshot& snapshot, const Vec3& p,
+                                      TickOutput& out) noexcept {
     // A new snapshot (or the first tick): the cursors re-bind to its index and forget their
     // leaves; a snapshot that only moved objects shares the index, but re-binding is cheap
     // and keeps "cursor leaf == fresh locate" without reasoning about which index it is.
@@ -133,8 +139,9 @@ void HapticTick::bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& 
     }
 }
 
-void HapticTick::listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed,
-                           TickOutput& out) noexcept {
+template <ForceAlgorithm Algorithm>
+void BasicHapticTick<Algorithm>::listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed,
+                                           TickOutput& out) noexcept {
     // The likely slide (from the start along last tick's contact plane to the device point's
     // projection on it) is known before solving, so its leaves are listed first: a slide over
     // small leaves usually solves once.
@@ -150,8 +157,10 @@ void HapticTick::listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed
     }
 }
 
-void HapticTick::render(const Scene& scene, const Vec3& p, const Vec3& v, double dtS,
-                        const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept {
+template <ForceAlgorithm Algorithm>
+void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const Vec3& v,
+                                        double dtS, const Vec3& from, ListedLeaves& listed,
+                                        TickOutput& out) noexcept {
     // The candidates cover where the device and the proxy are, not every place the proxy
     // visits this tick: a proxy sliding over fine triangles (a mesh whose leaves are smaller
     // than one tick's motion, with the device in an empty leaf under the surface) can slide
@@ -160,7 +169,7 @@ void HapticTick::render(const Scene& scene, const Vec3& p, const Vec3& v, double
     // (its start, each solver pass's end); at the first leaf that was not a candidate the tick
     // is solved again from the same start with that leaf's items too, up to kExtraLeaves
     // times; then, if the way still leaves the listed leaves, the goal is pulled back.
-    const GodObjectRenderer::State start = mRenderer.state(); // a plain copy: no allocation
+    const typename Algorithm::State start = mRenderer.state(); // a plain copy: no allocation
     out.render = mRenderer.update(scene, mCandidates, p, v, dtS);
     out.solves = 1;
     std::uint32_t tested = out.render.objectsTested;
@@ -187,10 +196,12 @@ void HapticTick::render(const Scene& scene, const Vec3& p, const Vec3& v, double
     }
 }
 
-void HapticTick::pullBack(const Scene& scene, const Vec3& p, const Vec3& v, double dtS,
-                          const Vec3& from, const GodObjectRenderer::State& start,
-                          std::span<const std::uint32_t> known, std::uint32_t& tested,
-                          TickOutput& out) noexcept {
+template <ForceAlgorithm Algorithm>
+void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, const Vec3& v,
+                                          double dtS, const Vec3& from,
+                                          const typename Algorithm::State& start,
+                                          std::span<const std::uint32_t> known,
+                                          std::uint32_t& tested, TickOutput& out) noexcept {
     // Out of room while the path still crosses a leaf no span lists (a very fast hand over
     // very small leaves, or a proxy trapped far behind a hand that pushed through), or a walk
     // that could not finish: the proxy must not move through space whose items the renderer
@@ -219,5 +230,10 @@ void HapticTick::pullBack(const Scene& scene, const Vec3& p, const Vec3& v, doub
         covered = firstUnlistedOnPaths(mProxyCursor, mRenderer, known).covered();
     }
 }
+
+template class BasicHapticTick<GodObjectRenderer>;
+
+static_assert(sizeof(HapticTick) == 12032, "update the size in HapticTick.h");
+static_assert(alignof(HapticTick) == 64);
 
 } // namespace hapto

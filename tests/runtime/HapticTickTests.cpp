@@ -428,3 +428,45 @@ TEST_CASE("a proxy trapped far behind a hand that pushed through keeps its conta
     // halving and moved the proxy only by the 1 um nudge: a trapped proxy crawled.
     CHECK(nudged <= pulled / 10);
 }
+
+namespace {
+
+/// Every member the tick asks of a force algorithm but restore(): a tick over it could not
+/// solve a tick again with more leaves.
+struct NoRestore {
+    struct State {
+        Vec3 proxy{0.0};
+    };
+    explicit NoRestore(const RendererConfig&) {}
+    void reset(const Vec3&) noexcept {}
+    RenderOutput update(const Scene&, const CandidateSet&, const Vec3&, const Vec3&,
+                        double) noexcept {
+        return {};
+    }
+    RenderOutput update(const Scene&, const CandidateSet&, const Vec3&, const Vec3&, const Vec3&,
+                        double) noexcept {
+        return {};
+    }
+    Vec3 proxy() const noexcept { return mState.proxy; }
+    bool inContact() const noexcept { return false; }
+    const State& state() const noexcept { return mState; }
+    std::span<const Vec3> visitedPath(int) const noexcept { return {}; }
+    State mState;
+};
+
+/// The same with restore(): the smallest force algorithm.
+struct Minimal : NoRestore {
+    using NoRestore::NoRestore;
+    void restore(const State& state) noexcept { mState = state; }
+};
+
+} // namespace
+
+TEST_CASE("the force-algorithm seam: the god-object renderer is one, and the tick runs over it") {
+    STATIC_REQUIRE(ForceAlgorithm<GodObjectRenderer>);
+    STATIC_REQUIRE(ForceAlgorithm<Minimal>);
+    STATIC_REQUIRE_FALSE(ForceAlgorithm<NoRestore>);
+    STATIC_REQUIRE(std::is_same_v<HapticTick, BasicHapticTick<GodObjectRenderer>>);
+    STATIC_REQUIRE(std::is_same_v<decltype(std::declval<const HapticTick&>().renderer()),
+                                  const GodObjectRenderer&>);
+}

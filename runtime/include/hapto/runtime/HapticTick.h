@@ -6,6 +6,7 @@
 #include "hapto/index/Cursor.h"
 #include "hapto/runtime/CandidateSet.h"
 #include "hapto/runtime/Effects.h"
+#include "hapto/runtime/ForceAlgorithm.h"
 #include "hapto/runtime/ForceSafety.h"
 #include "hapto/runtime/GodObjectRenderer.h"
 #include "hapto/runtime/TickHook.h"
@@ -46,14 +47,16 @@ struct TickOutput {
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
 };
 
-/// One device's haptic tick. Design note: the sequence every caller runs (the servo threads,
-/// the runtime's step mode, `hapto render`, the experiments' warm-up and tick probe) lives
-/// here and nowhere else:
+/// One device's haptic tick around a force algorithm (the seam: ForceAlgorithm.h; HapticTick
+/// is the tick around the god-object renderer). Design note: the sequence every caller runs (the
+/// servo threads, the runtime's step mode, `hapto render`, the experiments' warm-up and tick probe)
+/// lives here and nowhere else:
 ///   1. locate: the device point's cursor and the proxy's cursor each find their leaf (they
 ///      differ while the tool presses into a surface, the proxy resting on it);
 ///   2. candidates: the two leaves' object slots (the proxy's only when its leaf differs) and
 ///      the snapshot's moving objects, as spans (no copy);
-///   3. render: the god-object renderer moves the proxy and computes k (proxy - device);
+///   3. render: the force algorithm (the god-object renderer) moves the proxy and computes
+///      k (proxy - device), solved again with each leaf the proxy's way crossed unlisted;
 ///   4. force effects and the hook: the device's EffectSet (springs, dampers, constant forces)
 ///      at the device point, then the application's per-tick hook, if any, are added to the
 ///      render force and the external force;
@@ -65,7 +68,10 @@ struct TickOutput {
 ///
 /// Size: 12032 bytes, 64-byte aligned (checked by a static_assert in the source file), of
 /// which 10176 are the renderer and 1288 the effect set (8 effects of 160 bytes).
-class alignas(64) HapticTick {
+///
+/// A template over the algorithm, instantiated in HapticTick.cpp for each one (today
+/// GodObjectRenderer); a new algorithm adds its line there.
+template <ForceAlgorithm Algorithm> class alignas(64) BasicHapticTick {
 public:
     /// Leaves the proxy may slide into in one tick, each solved again with its items
     /// (CandidateSet has a span for each: device, proxy, moving, and these).
@@ -83,7 +89,7 @@ public:
     static constexpr double kNudgeM = 1e-6;
 
     /// Checks both configurations; throws std::invalid_argument when one is invalid. [control]
-    explicit HapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
+    explicit BasicHapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
 
     /// The next tick starts afresh: the proxy is put on that tick's device point with no
     /// contact, the cursors are bound to its snapshot, and the force grows from zero at the
@@ -128,8 +134,8 @@ public:
 
     /// The proxy (m, world). [servo]
     const Vec3& proxy() const noexcept { return mRenderer.proxy(); }
-    /// The renderer (its counters, configuration). [servo]
-    const GodObjectRenderer& renderer() const noexcept { return mRenderer; }
+    /// The force algorithm (the renderer's counters, configuration). [servo]
+    const Algorithm& renderer() const noexcept { return mRenderer; }
     /// The safety filter; its counters() may be read from any thread. [any thread]
     const ForceSafety& safety() const noexcept { return mSafety; }
 
@@ -158,12 +164,12 @@ private:
     /// Solves again toward goals pulled back from `p` toward `from` until the proxy's way stays
     /// in the listed leaves (TickOutput::pullBacks).
     void pullBack(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
-                  const GodObjectRenderer::State& start, std::span<const std::uint32_t> known,
+                  const typename Algorithm::State& start, std::span<const std::uint32_t> known,
                   std::uint32_t& tested, TickOutput& out) noexcept;
 
     Cursor mDeviceCursor; ///< The device point's leaf.
     Cursor mProxyCursor;  ///< The proxy's leaf.
-    GodObjectRenderer mRenderer;
+    Algorithm mRenderer;  ///< The force algorithm.
     ForceSafety mSafety;
     CandidateSet mCandidates;                  ///< This tick's spans (views into the snapshot).
     EffectSet mEffects;                        ///< Springs, dampers, constant forces.
@@ -174,5 +180,9 @@ private:
     StageStamps* mStamps = nullptr;  ///< Where tick() writes its stage ends, or none.
     bool mFresh = true;              ///< The next tick starts afresh (reset()).
 };
+
+extern template class BasicHapticTick<GodObjectRenderer>;
+/// The haptic tick around the god-object renderer: the one every caller runs today.
+using HapticTick = BasicHapticTick<GodObjectRenderer>;
 
 } // namespace hapto
