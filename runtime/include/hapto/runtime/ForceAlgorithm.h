@@ -28,37 +28,33 @@
 ///     its start and end).
 
 #include "hapto/runtime/CandidateSet.h"
-#include "hapto/runtime/GodObjectRenderer.h"
+#include "hapto/runtime/RenderOutput.h"
 #include "hapto/scenes/Scene.h"
 
 #include <concepts>
 #include <span>
+#include <type_traits>
 
 namespace hapto {
 
 /// A force algorithm the haptic tick can run (see the design note above). [any thread]
+// (clang-format 14 breaks requires-expressions apart: this one is formatted by hand.)
+// clang-format off
 template <class A>
-concept ForceAlgorithm = std::constructible_from<A, const RendererConfig&> &&
+concept ForceAlgorithm =
+    std::constructible_from<A, const RendererConfig&> &&
+    std::is_trivially_copyable_v<typename A::State> &&
     requires(A& a, const A& c, const Scene& scene, const CandidateSet& candidates, const Vec3& p,
              const typename A::State& state) {
-    { a.reset(p) }
-    noexcept;
-    { a.update(scene, candidates, p, p, 0.001) }
-    noexcept->std::same_as<RenderOutput>;
-    { a.update(scene, candidates, p, p, p, 0.001) }
-    noexcept->std::same_as<RenderOutput>;
-    { c.proxy() }
-    noexcept->std::convertible_to<Vec3>;
-    { c.inContact() }
-    noexcept->std::same_as<bool>;
-    { c.state() }
-    noexcept->std::convertible_to<typename A::State>;
-    { a.restore(state) }
-    noexcept;
-    { c.visitedPath(0) }
-    noexcept->std::same_as<std::span<const Vec3>>;
-} && std::is_trivially_copyable_v<typename A::State>;
-
-static_assert(ForceAlgorithm<GodObjectRenderer>);
+        { a.reset(p) } noexcept;
+        { a.update(scene, candidates, p, p, 0.001) } noexcept -> std::same_as<RenderOutput>;
+        { a.update(scene, candidates, p, p, p, 0.001) } noexcept -> std::same_as<RenderOutput>;
+        { c.proxy() } noexcept -> std::convertible_to<Vec3>;
+        { c.inContact() } noexcept -> std::same_as<bool>;
+        { c.state() } noexcept -> std::convertible_to<typename A::State>;
+        { a.restore(state) } noexcept;
+        { c.visitedPath(0) } noexcept -> std::same_as<std::span<const Vec3>>;
+    };
+// clang-format on
 
 } // namespace hapto

@@ -4,6 +4,7 @@
 
 #include "hapto/core/ClosestPoint.h"
 #include "hapto/runtime/CandidateSet.h"
+#include "hapto/runtime/RenderOutput.h"
 #include "hapto/scenes/Scene.h"
 
 #include <array>
@@ -12,55 +13,6 @@
 #include <span>
 
 namespace hapto {
-
-/// How a renderer behaves; fixed at construction.
-struct RendererConfig {
-    /// Contact damping b (N·s/m), applied along the contact force direction only while in
-    /// contact, never pulling the tool into a surface. >= 0; 0 turns it off.
-    double damping = 0.0;
-    /// Proxy solver passes per tick (each pass: one small plane solve + one swept test over the
-    /// nearby objects), 1..GodObjectRenderer::kMaxIterations.
-    std::uint32_t maxIterations = 10;
-};
-
-/// What happened in a tick besides the force.
-enum class RenderStatus : std::uint8_t {
-    Ok,                ///< Normal tick.
-    NonFiniteInput,    ///< Device position was NaN/inf: zero force, proxy kept.
-    NonFiniteOutput,   ///< The computation produced NaN/inf (a broken scene?): zero force.
-    CandidatesDropped, ///< The CandidateSet overflowed (a span was dropped); tick still ran.
-    NearListFull,      ///< More nearby items than kMaxNearObjects: ran on the raw spans.
-};
-
-/// How often each fault happened in one renderer, as plain values.
-struct RenderCounters {
-    std::uint64_t ticks = 0;             ///< update() calls.
-    std::uint64_t nonFiniteInput = 0;    ///< Ticks with a NaN/inf device position.
-    std::uint64_t nonFiniteOutput = 0;   ///< Ticks whose result was NaN/inf (zeroed).
-    std::uint64_t candidatesDropped = 0; ///< Ticks whose CandidateSet had overflowed.
-    std::uint64_t nearListFull = 0;      ///< Ticks that fell back to the raw spans.
-};
-
-/// One active constraint plane of the proxy.
-struct Contact {
-    std::uint32_t slot = 0; ///< The touched item: a box's or sphere's slot in `scene.objects()`,
-                            ///< or a mesh triangle's item (isTriangleItem; Scene::triangle).
-    ObjectId id = 0;        ///< The touched object's id (a triangle's: its mesh's).
-    Vec3 normal{0.0};       ///< Outward unit normal of the constraint plane (world).
-    double depth = 0.0;     ///< How far the device point is behind that plane (m), > 0.
-};
-
-/// The result of one tick.
-struct RenderOutput {
-    Vec3 force{0.0};                   ///< Force to send (N, world frame), before ForceSafety.
-    Vec3 proxy{0.0};                   ///< Proxy (god-object) position after the tick (m, world).
-    std::array<Contact, 3> contacts{}; ///< Active constraints; the first `contactCount` are valid.
-    std::uint8_t contactCount = 0;     ///< 0 = free motion, 1 = face, 2 = edge/crease, 3 = corner.
-    bool sliding = false;              ///< In contact and the proxy moved along the surface.
-    RenderStatus status = RenderStatus::Ok; ///< Faults, as a value.
-    std::uint8_t iterations = 0;     ///< Solver passes used (both solves when friction slipped).
-    std::uint32_t objectsTested = 0; ///< Candidate slots examined (duplicates included).
-};
 
 /// Renders one point device against a scene with a god-object proxy (Zilles & Salisbury 1995,
 /// Ruspini et al. 1997) and Coulomb friction. One instance per device: it holds that device's

@@ -181,6 +181,7 @@ private:
     bool mFresh = true;              ///< The next tick starts afresh (reset()).
 };
 
+static_assert(ForceAlgorithm<GodObjectRenderer>);
 extern template class BasicHapticTick<GodObjectRenderer>;
 /// The haptic tick around the god-object renderer: the one every caller runs today.
 using HapticTick = BasicHapticTick<GodObjectRenderer>;
