@@ -66,7 +66,7 @@ void encodeTraceHeader(const TraceHeader& header, std::uint64_t sampleCount, uns
     putU32(out + 8, kTraceVersion);
     putU32(out + 12, static_cast<std::uint32_t>(kTraceHeaderBytes));
     putU32(out + 16, static_cast<std::uint32_t>(kTraceSampleBytes));
-    putU32(out + 20, 0);
+    putU32(out + 20, kTraceHeaderMarksMisses);
     putF64(out + 24, header.rateHz);
     putU64(out + 32, sampleCount);
     putU64(out + 40, header.startUnixNs);
@@ -123,7 +123,8 @@ void encodeTraceSample(const TraceSample& s, unsigned char* out) noexcept {
     putU32(out + 184, s.contactCount);
     putU32(out + 188, (s.hasVelocity ? kTraceSampleHasVelocity : 0u) |
                           (s.hasOrientation ? kTraceSampleHasOrientation : 0u) |
-                          (s.hasAngularVelocity ? kTraceSampleHasAngularVelocity : 0u));
+                          (s.hasAngularVelocity ? kTraceSampleHasAngularVelocity : 0u) |
+                          (s.missedDeadline ? kTraceSampleMissedDeadline : 0u));
 }
 
 TraceSample decodeTraceSample(const unsigned char* in, std::uint32_t version) noexcept {
@@ -149,6 +150,7 @@ TraceSample decodeTraceSample(const unsigned char* in, std::uint32_t version) no
         s.hasVelocity = (flags & kTraceSampleHasVelocity) != 0;
         s.hasOrientation = (flags & kTraceSampleHasOrientation) != 0;
         s.hasAngularVelocity = (flags & kTraceSampleHasAngularVelocity) != 0;
+        s.missedDeadline = (flags & kTraceSampleMissedDeadline) != 0;
     }
     return s;
 }

@@ -82,8 +82,9 @@ TraceReader::TraceReader(const std::filesystem::path& path) : mPath(path) {
             fail(16, "sample size " + std::to_string(h.sampleBytes) + ", expected " +
                          std::to_string(mSampleBytes) + " for version " + std::to_string(version));
         }
-        if (h.flags != 0) {
-            fail(20, "unknown flags " + std::to_string(h.flags) + " (expected 0)");
+        if ((h.flags & ~kTraceHeaderMarksMisses) != 0) {
+            fail(20, "unknown flags " + std::to_string(h.flags) + " (expected 0 or " +
+                         std::to_string(kTraceHeaderMarksMisses) + ")");
         }
         if (!(h.rateHz > 0.0 && h.rateHz <= 1e6)) {
             std::ostringstream s;
@@ -103,6 +104,7 @@ TraceReader::TraceReader(const std::filesystem::path& path) : mPath(path) {
         mHeader.version = h.version;
         mHeader.rateHz = h.rateHz;
         mHeader.startUnixNs = h.startUnixNs;
+        mHeader.marksMisses = (h.flags & kTraceHeaderMarksMisses) != 0;
         if (h.sampleCount == kTraceCountUnfinished) {
             mHeader.finished = false;
             mHeader.sampleCount = body / mSampleBytes;
@@ -188,9 +190,10 @@ void TraceReader::checkVersion2(const TraceSample& s, const unsigned char* bytes
     const std::uint32_t flags =
         static_cast<std::uint32_t>(bytes[188]) | static_cast<std::uint32_t>(bytes[189]) << 8 |
         static_cast<std::uint32_t>(bytes[190]) << 16 | static_cast<std::uint32_t>(bytes[191]) << 24;
-    constexpr std::uint32_t kKnown =
-        kTraceSampleHasVelocity | kTraceSampleHasOrientation | kTraceSampleHasAngularVelocity;
-    if ((flags & ~kKnown) != 0) {
+    const std::uint32_t known = kTraceSampleHasVelocity | kTraceSampleHasOrientation |
+                                kTraceSampleHasAngularVelocity |
+                                (mHeader.marksMisses ? kTraceSampleMissedDeadline : 0u);
+    if ((flags & ~known) != 0) {
         fail(offset + 188, which + "unknown sample flags " + std::to_string(flags));
     }
 }

@@ -189,7 +189,8 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
         return false;
     }
 
-    // Record.
+    // Record. A force written after the next deadline missed it (the rule at the end).
+    const bool missed = done > s.deadlineNs + s.periodNs;
     const std::uint64_t tickNs = done - wake;
     const std::uint64_t ioNs = (readDone - wake) + (done - writeStart);
     m.tickNs.record(tickNs);
@@ -239,6 +240,7 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
         sample.angularVelocity = s.sample.angularVelocity;
         sample.hasAngularVelocity = s.sample.hasAngularVelocity;
         sample.contactCount = out.render.contactCount;
+        sample.missedDeadline = missed;
         (void)s.recorder->push(sample);
     }
     ++s.tick;
@@ -248,7 +250,7 @@ bool Runtime::servoTick(Channel& ch, const std::uint64_t wake) noexcept {
     // The next deadline. A tick whose force came after the next deadline missed it; skip the
     // slots it overran instead of bursting to catch up, and tell the device they went by.
     s.deadlineNs += s.periodNs;
-    if (done > s.deadlineNs) {
+    if (missed) {
         DeviceMetrics::bump(m.missedDeadlines);
         s.consecutiveMisses = std::min(s.consecutiveMisses + 1, s.missLimit); // saturates
         const std::uint64_t skipped = (done - s.deadlineNs) / s.periodNs + 1;

@@ -61,6 +61,7 @@ std::vector<TraceSample> randomSamples(std::size_t n, std::uint64_t seed) {
             s.angularVelocity = Vec3(rng.normal(), rng.normal(), rng.normal());
         }
         s.contactCount = static_cast<std::uint32_t>(rng.below(4));
+        s.missedDeadline = rng.below(5) == 0;
     }
     return out;
 }
@@ -115,6 +116,7 @@ TEST_CASE("trace: write then read gives back every sample exactly") {
     CHECK(h.transform.scale == 1.5);
     CHECK(h.toolTipM == Vec3(0.0, 0.0, -0.04));
     CHECK(h.maxForceN == 3.3);
+    CHECK(h.marksMisses);
 }
 
 TEST_CASE("trace: a version 1 file still reads, its version 2 fields at their defaults") {
@@ -154,6 +156,7 @@ TEST_CASE("trace: the header layout is the documented one") {
     const std::string bytes = test::readFile(dir / "t.trace");
     CHECK(bytes.substr(0, 8) == "HAPTOTRC");
     CHECK(bytes[8] == 2);  // version, little-endian
+    CHECK(bytes[20] == 1); // flags: the samples mark missed deadlines
     CHECK(bytes[12] == 0); // header size 256
     CHECK(bytes[13] == 1);
     CHECK(bytes[16] == static_cast<char>(192));
@@ -181,7 +184,24 @@ TEST_CASE("trace: the header layout is the documented one") {
     CHECK(static_cast<unsigned char>(bytes[s0 + 184]) == s[0].contactCount);
     CHECK(static_cast<unsigned char>(bytes[s0 + 188]) ==
           ((s[0].hasVelocity ? 1 : 0) | (s[0].hasOrientation ? 2 : 0) |
-           (s[0].hasAngularVelocity ? 4 : 0)));
+           (s[0].hasAngularVelocity ? 4 : 0) | (s[0].missedDeadline ? 8 : 0)));
+}
+
+TEST_CASE("trace: a trace from before the miss marks says so, and a mark in it is refused") {
+    test::TempDir dir;
+    std::vector<TraceSample> samples = randomSamples(3, 3);
+    for (TraceSample& s : samples) {
+        s.missedDeadline = false;
+    }
+    writeTrace(dir / "t.trace", samples);
+    patch(dir / "t.trace", 20, std::string(1, '\0')); // header flags 0, as written before
+    TraceHeader h;
+    CHECK(TraceReader::load(dir / "t.trace", &h) == samples);
+    CHECK_FALSE(h.marksMisses);
+    patch(dir / "t.trace", kTraceHeaderBytes + 188, std::string(1, '\x08'));
+    CHECK_THAT(errorReading(dir / "t.trace"), Catch::Contains("unknown sample flags 8"));
+    patch(dir / "t.trace", 20, std::string(1, '\x02'));
+    CHECK_THAT(errorReading(dir / "t.trace"), Catch::Contains("unknown flags 2"));
 }
 
 TEST_CASE("trace: an empty recording is valid") {
@@ -246,8 +266,8 @@ TEST_CASE("trace: truncated and corrupt files are refused with the byte offset")
     patch(p, kTraceHeaderBytes + kTraceSampleBytes + 184, std::string("\x07", 1));
     CHECK_THAT(errorReading(p), Catch::Contains("byte 632: sample 1: contact count 7"));
     fresh();
-    patch(p, kTraceHeaderBytes + kTraceSampleBytes + 188, std::string("\x08", 1));
-    CHECK_THAT(errorReading(p), Catch::Contains("byte 636: sample 1: unknown sample flags 8"));
+    patch(p, kTraceHeaderBytes + kTraceSampleBytes + 188, std::string("\x10", 1));
+    CHECK_THAT(errorReading(p), Catch::Contains("byte 636: sample 1: unknown sample flags 16"));
     fresh();
     patch(p, 16, std::string("\x40", 1));
     CHECK_THAT(errorReading(p), Catch::Contains("byte 16: sample size 64"));

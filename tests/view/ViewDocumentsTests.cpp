@@ -51,6 +51,7 @@ TEST_CASE("the trace document: world-frame points and forces, contacts, frames a
         s.positionM = Vec3(0, 0, 0.0001 * static_cast<double>(i)); // device frame
         s.forceN = Vec3(0, 0, i >= 400 && i <= 600 ? -1.0 : 0.0);
         s.computeNs = i == 500 ? 1'500'000 : 100'000; // one tick overruns its period
+        s.missedDeadline = i == 500;                  // and the servo marked it
         t.samples.push_back(s);
     }
     const auto doc = nlohmann::json::parse(viewTraceJson(scene, {t}, 50.0));
@@ -274,21 +275,25 @@ struct ServoTick {
 
 /// The trace a 1 kHz servo records for `ticks` (ServoLoop.cpp): the first deadline
 /// `firstDeadlineNs` into the session, each next one a period on, or past every slot a late
-/// force overran.
-ViewTrace servoTrace(const std::vector<ServoTick>& ticks, std::uint64_t firstDeadlineNs) {
+/// force overran. As a trace from before the miss marks (the view rebuilds the deadlines) unless
+/// `marked`, when each missed tick carries its mark as the servo sets it.
+ViewTrace servoTrace(const std::vector<ServoTick>& ticks, std::uint64_t firstDeadlineNs,
+                     bool marked = false) {
     constexpr std::uint64_t kPeriodNs = 1'000'000;
     ViewTrace t;
     t.header.name = "left";
     t.header.rateHz = 1000;
+    t.header.marksMisses = marked;
     std::uint64_t deadlineNs = firstDeadlineNs;
     for (std::uint64_t i = 0; i < ticks.size(); ++i) {
         TraceSample s;
         s.tick = i;
         s.timeNs = deadlineNs + ticks[i].latenessNs;
         s.computeNs = static_cast<std::uint32_t>(ticks[i].computeNs);
-        t.samples.push_back(s);
         const std::uint64_t doneNs = s.timeNs + s.computeNs;
         deadlineNs += kPeriodNs;
+        s.missedDeadline = marked && doneNs > deadlineNs;
+        t.samples.push_back(s);
         while (doneNs > deadlineNs) {
             deadlineNs += kPeriodNs;
         }
@@ -360,4 +365,30 @@ TEST_CASE("the trace document's misses: after a miss whose force came just after
         CHECK(misses == expected);
     }
     CHECK(frames.back() == std::pair<std::uint64_t, std::uint64_t>{1000, 3});
+}
+
+TEST_CASE("the trace document counts a marked trace's misses as the servo marked them, whatever "
+          "the wake-ups would suggest") {
+    // Ticks whose deadlines the wake-ups cannot place: every one woke 1.5 periods late, two of
+    // them also overran; the servo marked exactly the ticks whose force came after the deadline.
+    std::vector<ServoTick> ticks(1000);
+    for (ServoTick& t : ticks) {
+        t.latenessNs = 1'500'000;
+    }
+    ticks[300].computeNs = 900'000;
+    ticks[700].computeNs = 2'000'000;
+    const ViewTrace marked = servoTrace(ticks, 2'000'000, true);
+    std::uint64_t marks = 0;
+    for (const TraceSample& s : marked.samples) {
+        marks += s.missedDeadline ? 1 : 0;
+    }
+    REQUIRE(marks == 1000); // each woke 1.5 periods late: each missed
+    CHECK(ticksAndMisses(marked).back() == std::pair<std::uint64_t, std::uint64_t>{1000, 1000});
+
+    // The same trace with only its last two ticks marked: the marks, not the times, decide.
+    ViewTrace few = marked;
+    for (TraceSample& s : few.samples) {
+        s.missedDeadline = s.tick >= 998;
+    }
+    CHECK(ticksAndMisses(few).back() == std::pair<std::uint64_t, std::uint64_t>{1000, 2});
 }

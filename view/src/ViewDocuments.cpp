@@ -136,14 +136,16 @@ PageMesh simplifiedMesh(const TriangleMesh& mesh, std::uint64_t budget) {
     return out;
 }
 
-// The runtime's missed-deadline rule (ServoLoop.cpp, the end of servoTick) replayed over a
-// trace. A trace records each tick's wake-up (timeNs, since the session started) and its
-// wake-up-to-force-written time (computeNs), not its deadline, so the deadlines are rebuilt the
-// way the servo moves them: one period on after each tick and, when the force came after that
-// (a miss), to the first slot after the force. The servo's first deadline is one period after
-// its thread started (about 2 ms into the session) and its slots keep that phase, which the
-// trace holds only through the wake-ups: each comes at or after its deadline, by the wake-up's
-// lateness. So the chain starts at the first tick's wake-up and moves back when the trace
+// The misses of a trace, as the runtime counted them. A trace whose header has
+// kTraceHeaderMarksMisses marks each tick that missed its deadline, and those marks are counted
+// as they are. Older traces do not: over them the runtime's missed-deadline rule (ServoLoop.cpp,
+// the end of servoTick) is replayed. Such a trace records each tick's wake-up (timeNs, since the
+// session started) and its wake-up-to-force-written time (computeNs), not its deadline, so the
+// deadlines are rebuilt the way the servo moves them: one period on after each tick and, when the
+// force came after that (a miss), to the first slot after the force. The servo's first deadline is
+// one period after its thread started (about 2 ms into the session) and its slots keep that phase,
+// which the trace holds only through the wake-ups: each comes at or after its deadline, by the
+// wake-up's lateness. So the chain starts at the first tick's wake-up and moves back when the trace
 // shows it is later than the servo's:
 //   - a tick that wakes before the deadline the chain gives it moves the chain back to its
 //     wake-up (the servo never ticks before its deadline);
@@ -161,10 +163,14 @@ PageMesh simplifiedMesh(const TriangleMesh& mesh, std::uint64_t budget) {
 // real-time scheduling (5-10 kHz, or 30 s with 4 % of the ticks missed), 0 to 2 % fewer.
 class MissCounter {
 public:
-    explicit MissCounter(std::uint64_t periodNs) : mPeriodNs(periodNs) {}
+    MissCounter(std::uint64_t periodNs, bool marked) : mPeriodNs(periodNs), mMarked(marked) {}
 
     // Counts the tick if its force was written after the deadline after its own.
     void tick(const TraceSample& s) {
+        if (mMarked) {
+            mMisses += s.missedDeadline ? 1 : 0;
+            return;
+        }
         const std::uint64_t wakeNs = s.timeNs;
         if (!mStarted || wakeNs < mDeadlineNs) {
             mDeadlineNs = wakeNs;
@@ -188,6 +194,7 @@ public:
 
 private:
     std::uint64_t mPeriodNs;
+    bool mMarked; // the trace marks its misses: count the marks
     bool mStarted = false;
     std::uint64_t mLastTick = 0;
     std::uint64_t mLastDoneNs = 0; // when the last tick wrote its force
@@ -285,7 +292,7 @@ std::string viewTraceJson(const Scene& scene, const std::vector<ViewTrace>& trac
         LoadHistogram compute;
         LoadWindow window(static_cast<double>(periodNs), 1'000'000'000,
                           static_cast<std::size_t>(frameHz) + 2);
-        MissCounter misses(periodNs);
+        MissCounter misses(periodNs, trace.header.marksMisses);
         const auto frameNs = static_cast<std::uint64_t>(1e9 / frameHz);
         std::uint64_t nextFrameNs = 0;
         nlohmann::json frames = nlohmann::json::array();

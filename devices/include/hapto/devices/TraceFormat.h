@@ -10,7 +10,8 @@
 ///        8    4  u32 version (kTraceVersion = 2; 1 in older files)
 ///       12    4  u32 header size in bytes (256; 128 in version 1)
 ///       16    4  u32 sample record size in bytes (192; 80 in version 1)
-///       20    4  u32 flags (0; reserved)
+///       20    4  u32 flags: bit 0 the samples mark missed deadlines (sample flag bit 3); the
+///                other bits zero (files from before the mark have 0)
 ///       24    8  f64 servo rate (Hz)
 ///       32    8  u64 sample count; kTraceCountUnfinished until the recorder is closed
 ///       40    8  u64 start of the recording, Unix time (ns); 0 = unknown
@@ -43,7 +44,8 @@
 ///      160   24  3 x f64 stylus angular velocity, device frame (rad/s); zero unless flag bit 2
 ///      184    4  u32 contact count (0..3)
 ///      188    4  u32 flags: bit 0 the device gave a velocity, bit 1 an orientation, bit 2 an
-///                angular velocity; the other bits zero
+///                angular velocity, bit 3 the tick missed its deadline (its force was written
+///                after the next deadline: the runtime counted a miss); the other bits zero
 ///
 /// 1 kHz for an hour is 691 MB (288 MB in version 1).
 
@@ -80,6 +82,13 @@ inline constexpr std::uint32_t kTraceSampleHasVelocity = 1u << 0;
 inline constexpr std::uint32_t kTraceSampleHasOrientation = 1u << 1;
 /// Sample flag: the angular velocity field is the device's.
 inline constexpr std::uint32_t kTraceSampleHasAngularVelocity = 1u << 2;
+/// Sample flag: the tick missed its deadline (meaningful when the header has
+/// kTraceHeaderMarksMisses).
+inline constexpr std::uint32_t kTraceSampleMissedDeadline = 1u << 3;
+/// Header flag: every sample says whether its tick missed its deadline
+/// (kTraceSampleMissedDeadline). Traces written before the mark existed have it clear; a reader
+/// then knows only the wake-ups.
+inline constexpr std::uint32_t kTraceHeaderMarksMisses = 1u << 0;
 /// The sample count of a trace whose recorder was never closed (a crash).
 inline constexpr std::uint64_t kTraceCountUnfinished = ~std::uint64_t{0};
 /// Longest device name a trace holds (bytes).
@@ -107,6 +116,7 @@ struct TraceSample {
     bool hasVelocity = false;        ///< The device gave the velocity.
     bool hasOrientation = false;     ///< The device gave the orientation.
     bool hasAngularVelocity = false; ///< The device gave the angular velocity.
+    bool missedDeadline = false;     ///< The tick's force came after its deadline (a miss).
 
     bool operator==(const TraceSample&) const = default;
 };
@@ -121,6 +131,8 @@ struct TraceHeader {
     std::uint64_t startUnixNs = 0;         ///< Recording start, Unix time (ns); 0 = unknown.
     std::string kind;                      ///< Device kind ("sim", ...).
     std::string name;                      ///< Device name ("left", ...).
+    bool marksMisses = true;               ///< Samples carry missedDeadline (false in traces
+                                           ///< written before the mark; this build writes it).
     // Version 2 only: the configuration the run used (a version 1 trace reads the defaults).
     WorkspaceTransform transform; ///< Device frame into the world.
     Vec3 toolTipM{0.0};           ///< Tool tip in the stylus frame (m).
@@ -136,7 +148,7 @@ struct TraceHeaderFields {
     std::uint32_t version = 0;     ///< Should be kTraceVersion.
     std::uint32_t headerBytes = 0; ///< Should be kTraceHeaderBytes.
     std::uint32_t sampleBytes = 0; ///< Should be kTraceSampleBytes.
-    std::uint32_t flags = 0;       ///< Should be 0.
+    std::uint32_t flags = 0;       ///< Only kTraceHeaderMarksMisses may be set.
     double rateHz = 0.0;           ///< Servo rate (Hz).
     std::uint64_t sampleCount = 0; ///< Or kTraceCountUnfinished.
     std::uint64_t startUnixNs = 0; ///< Recording start (ns, Unix time).
