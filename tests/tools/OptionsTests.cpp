@@ -232,9 +232,9 @@ TEST_CASE("the view's options: --view serves it, --view-port and --view-bind nee
     ViewArgs any;
     CHECK(parseView({"--view", "--view-port", "0"}, any).empty());
     CHECK((any.enabled && any.port == 0));
-    ViewArgs old; // the old spelling still works
-    CHECK(parseView({"--view", "0"}, old).empty());
-    CHECK((old.enabled && old.port == 0));
+    ViewArgs old; // the old spelling is refused, naming the new one
+    CHECK_THAT(parseView({"--view", "0"}, old), Catch::Contains("--view-port 0"));
+    CHECK_FALSE(old.enabled);
     ViewArgs alone;
     CHECK_THAT(parseView({"--view-port", "0"}, alone), Catch::Contains("--view"));
     CHECK_THAT(parseView({"--view", "--view-port", "70000"}, alone),

@@ -197,26 +197,23 @@ CLI::Option* addViewBindOption(CLI::App* cmd, ViewArgs& args) {
 }
 
 void addViewOptions(CLI::App* cmd, ViewArgs& args) {
-    // `--view PORT` is the old spelling of `--view --view-port PORT`: kept (scripts and the
-    // issue reports use `--view 0`), with a note naming the new one.
+    // `--view PORT` was the old spelling of `--view --view-port PORT`: one spelling now, so a
+    // value after --view is refused with the new spelling (exit 2), never taken silently.
     auto* view = cmd->add_option_function<std::string>(
                         "--view",
                         [&args](const std::string& port) {
-                            args.enabled = true;
                             if (!port.empty()) {
-                                args.port = std::stoi(port);
-                                std::cerr << "hapto: --view " << port
-                                          << " is the old spelling of --view --view-port " << port
-                                          << "\n";
+                                throw CLI::ValidationError(
+                                    "--view", "takes no value; the port is --view-port " + port);
                             }
+                            args.enabled = true;
                         },
                         "Serve a live 3-D view of the session in the browser (off unless given), "
                         "on http://127.0.0.1:" +
                             std::to_string(kDefaultViewPort) +
                             "/ unless --view-port or --view-bind say otherwise")
                      ->expected(0, 1)
-                     ->type_name("")
-                     ->check(wholeNumber(0, 65535).description("")); // the old PORT, unshown
+                     ->type_name("");
     addViewPortOption(cmd, args)->needs(view);
     addViewBindOption(cmd, args)->needs(view);
 }

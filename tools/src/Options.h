@@ -99,8 +99,8 @@ CLI::Option* addViewPortOption(CLI::App* cmd, ViewArgs& args);
 /// the view starts) to a command that serves the view. [control]
 CLI::Option* addViewBindOption(CLI::App* cmd, ViewArgs& args);
 /// Adds `--view` (serve a live 3-D view in the browser; off unless given), and `--view-port
-/// PORT` and `--view-bind ADDR`, which need it. `--view PORT`, the old spelling, still works
-/// and says to use `--view-port`. [control]
+/// PORT` and `--view-bind ADDR`, which need it. `--view PORT`, the old spelling, is refused
+/// naming `--view-port`. [control]
 void addViewOptions(CLI::App* cmd, ViewArgs& args);
 
 /// The width (columns) the command line wraps its text to: no line of `--help`, `--help-all`
