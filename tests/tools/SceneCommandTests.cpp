@@ -62,7 +62,8 @@ TEST_CASE("scene import wraps a model in a scene that refers to it relative to i
     }
 }
 
-TEST_CASE("scene info reports the triangles: total, per mesh, degenerate dropped, closed or not") {
+TEST_CASE("scene info reports the triangles: total, per mesh, degenerate and duplicate dropped, "
+          "closed or not") {
     TempDir dir;
     writeFile(dir / "cube.obj", kCubeObj);
     writeFile(dir / "open.obj", kOpenCubeObj);
@@ -70,7 +71,7 @@ TEST_CASE("scene info reports the triangles: total, per mesh, degenerate dropped
         {"id": 4, "shape": "mesh", "center": [0, 0, 0], "file": "cube.obj"},
         {"id": 8, "shape": "mesh", "center": [2, 0, 0], "file": "open.obj"},
         {"id": 9, "shape": "mesh", "center": [0, 2, 0],
-         "vertices": [[0,0,0],[1,0,0],[0,1,0],[2,0,0]], "triangles": [[0,1,2],[0,1,3]]},
+         "vertices": [[0,0,0],[1,0,0],[0,1,0],[2,0,0]], "triangles": [[0,1,2],[0,1,3],[2,1,0]]},
         {"id": 1, "shape": "box", "center": [0, 0, 3], "half_extents": [1, 1, 1]}]})");
     const auto r = runHapto("scene info --scene " + q(dir / "s.json"));
     INFO(r.output);
@@ -78,13 +79,13 @@ TEST_CASE("scene info reports the triangles: total, per mesh, degenerate dropped
     CHECK_THAT(r.output,
                Catch::Contains("objects:  4 (1 boxes, 0 of them rotated; 0 spheres; 3 meshes)"));
     CHECK_THAT(r.output, Catch::Contains("triangles: 23 in 3 meshes (1 closed, 2 open), 1 "
-                                         "degenerate dropped"));
-    CHECK_THAT(r.output, Catch::Contains("mesh 4: 12 triangles, 0 degenerate dropped, closed, "
-                                         "file cube.obj"));
-    CHECK_THAT(r.output, Catch::Contains("mesh 8: 10 triangles, 0 degenerate dropped, open, "
-                                         "file open.obj"));
-    CHECK_THAT(r.output,
-               Catch::Contains("mesh 9: 1 triangles, 1 degenerate dropped, open, inline"));
+                                         "degenerate and 1 duplicate dropped"));
+    CHECK_THAT(r.output, Catch::Contains("mesh 4: 12 triangles, 0 degenerate and 0 duplicate "
+                                         "dropped, closed, file cube.obj"));
+    CHECK_THAT(r.output, Catch::Contains("mesh 8: 10 triangles, 0 degenerate and 0 duplicate "
+                                         "dropped, open, file open.obj"));
+    CHECK_THAT(r.output, Catch::Contains("mesh 9: 1 triangles, 1 degenerate and 1 duplicate "
+                                         "dropped, open, inline"));
 }
 
 TEST_CASE("scene import refuses bad models and options with exit code 2 and writes nothing") {

@@ -47,17 +47,23 @@ void writeScene(const Scene& scene, const std::string& out) {
 /// The most meshes `scene info` lists one by one (the totals count them all).
 constexpr std::size_t kMeshesListed = 20;
 
+/// "D degenerate and U duplicate dropped": the triangles a mesh's loading left out.
+std::string droppedText(std::uint64_t degenerate, std::uint64_t duplicate) {
+    return std::to_string(degenerate) + " degenerate and " + std::to_string(duplicate) +
+           " duplicate dropped";
+}
+
 void printMeshLine(const SceneObject& o) {
     const TriangleMesh& m = *o.mesh;
-    std::printf("  mesh %u: %u triangles, %llu degenerate dropped, %s, %s\n", o.id,
-                m.triangleCount(), static_cast<unsigned long long>(m.droppedDegenerate()),
+    std::printf("  mesh %u: %u triangles, %s, %s, %s\n", o.id, m.triangleCount(),
+                droppedText(m.droppedDegenerate(), m.droppedDuplicate()).c_str(),
                 m.closed() ? "closed" : "open",
                 m.source().file.empty() ? "inline" : ("file " + m.source().file).c_str());
 }
 
 void printInfo(const Scene& scene, const std::string& source, double loadSeconds) {
     std::size_t boxes = 0, rotated = 0, meshes = 0, closed = 0;
-    std::uint64_t dropped = 0;
+    std::uint64_t degenerate = 0, duplicate = 0;
     ObjectId minId = kMaxObjectId, maxId = 0;
     for (const SceneObject& o : scene.objects()) {
         boxes += o.shape == Shape::Box;
@@ -65,7 +71,8 @@ void printInfo(const Scene& scene, const std::string& source, double loadSeconds
         if (o.shape == Shape::Mesh) {
             ++meshes;
             closed += o.mesh->closed();
-            dropped += o.mesh->droppedDegenerate();
+            degenerate += o.mesh->droppedDegenerate();
+            duplicate += o.mesh->droppedDuplicate();
         }
         minId = std::min(minId, o.id);
         maxId = std::max(maxId, o.id);
@@ -77,9 +84,8 @@ void printInfo(const Scene& scene, const std::string& source, double loadSeconds
     if (scene.size() > 0) {
         std::printf("ids:      %u .. %u\n", minId, maxId);
     }
-    std::printf("triangles: %u in %zu meshes (%zu closed, %zu open), %llu degenerate dropped\n",
-                scene.triangleCount(), meshes, closed, meshes - closed,
-                static_cast<unsigned long long>(dropped));
+    std::printf("triangles: %u in %zu meshes (%zu closed, %zu open), %s\n", scene.triangleCount(),
+                meshes, closed, meshes - closed, droppedText(degenerate, duplicate).c_str());
     std::size_t listed = 0;
     for (const SceneObject& o : scene.objects()) {
         if (o.shape == Shape::Mesh && listed++ < kMeshesListed) {
@@ -196,7 +202,7 @@ void importModel(const ImportOptions& o) {
         writeFileAtomically(o.out, sceneToJson(scene));
     }
     std::cerr << "wrote a scene with " << o.model << " (" << mesh->triangleCount() << " triangles, "
-              << mesh->droppedDegenerate() << " degenerate dropped, "
+              << droppedText(mesh->droppedDegenerate(), mesh->droppedDuplicate()) << ", "
               << (mesh->closed() ? "closed" : "open") << ") to " << o.out << "\n";
 }
 
