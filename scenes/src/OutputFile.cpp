@@ -3,6 +3,7 @@
 #include "hapto/scenes/OutputFile.h"
 
 #include "hapto/scenes/InputError.h"
+#include "hapto/scenes/InputFile.h"
 
 #include <cerrno>
 #include <cstring>
@@ -43,37 +44,17 @@ fs::path resolved(const fs::path& p) {
     return ec ? absolute : canonical;
 }
 
-/// What a file of mode `mode` is, for a message: "a FIFO", "a socket", ...
-std::string kindOf(mode_t mode) {
-    if (S_ISDIR(mode)) {
-        return "a folder";
-    }
-    if (S_ISFIFO(mode)) {
-        return "a FIFO";
-    }
-    if (S_ISSOCK(mode)) {
-        return "a socket";
-    }
-    if (S_ISCHR(mode)) {
-        return "a character device";
-    }
-    if (S_ISBLK(mode)) {
-        return "a block device";
-    }
-    return "not a regular file";
-}
-
 /// Throws InputError when `target` (symlinks resolved) exists and is not a regular file;
 /// `what` names the output ("-o 'x'" or "'x'").
 void refuseNonFile(const fs::path& target, const std::string& what) {
-    struct stat st {};
-    if (::stat(target.c_str(), &st) != 0 || S_ISREG(st.st_mode)) {
+    const std::string kind = nonRegularKind(target); // empty: a regular file, or nothing there
+    if (kind.empty()) {
         return;
     }
-    if (S_ISDIR(st.st_mode)) {
+    if (kind == "a directory") {
         throw InputError(what + ": this is a folder; give a file name to write");
     }
-    throw InputError(what + ": this is " + kindOf(st.st_mode) +
+    throw InputError(what + ": this is " + kind +
                      ", not a regular file; give the name of a file (an output is written "
                      "beside it and renamed into place)");
 }
