@@ -360,19 +360,7 @@ TEST_CASE("trace recorder: a servo thread and a draining thread lose nothing unc
     }
 }
 
-namespace {
-
-/// The names in a folder, sorted.
-std::vector<std::string> namesIn(const std::filesystem::path& dir) {
-    std::vector<std::string> names;
-    for (const auto& e : std::filesystem::directory_iterator(dir)) {
-        names.push_back(e.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
-} // namespace
+namespace {} // namespace
 
 TEST_CASE("trace recorder: the trace appears whole at close, until then the old file stays") {
     test::TempDir dir;
@@ -387,11 +375,11 @@ TEST_CASE("trace recorder: the trace appears whole at close, until then the old 
         }
         rec.drain();
         CHECK(test::readFile(p) == before); // the new samples go elsewhere until close()
-        CHECK(namesIn(dir.path()).size() == 2);
+        CHECK(test::namesIn(dir.path()).size() == 2);
         rec.close();
     }
     CHECK(TraceReader::load(p) == randomSamples(7, 7));
-    CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace"}); // no temporary left
+    CHECK(test::namesIn(dir.path()) == std::vector<std::string>{"t.trace"}); // no temporary left
 }
 
 TEST_CASE("trace recorder: an abandoned recording leaves the old trace and no temporary") {
@@ -406,7 +394,7 @@ TEST_CASE("trace recorder: an abandoned recording leaves the old trace and no te
         CHECK_FALSE(rec.push(randomSamples(1, 9).front())); // closed: it drops
     } // the destructor, after abandon(), commits nothing
     CHECK(test::readFile(p) == before);
-    CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace"});
+    CHECK(test::namesIn(dir.path()) == std::vector<std::string>{"t.trace"});
 }
 
 TEST_CASE("trace recorder: a symlink at the trace's name is replaced, never followed") {
@@ -417,7 +405,7 @@ TEST_CASE("trace recorder: a symlink at the trace's name is replaced, never foll
     CHECK(test::readFile(dir / "victim.txt") == "keep me");
     CHECK(std::filesystem::is_regular_file(std::filesystem::symlink_status(dir / "t.trace")));
     CHECK(TraceReader::load(dir / "t.trace") == randomSamples(3, 8));
-    CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace", "victim.txt"});
+    CHECK(test::namesIn(dir.path()) == std::vector<std::string>{"t.trace", "victim.txt"});
 }
 
 TEST_CASE("trace recorder: a folder or a missing folder is refused and nothing is left") {
@@ -425,6 +413,6 @@ TEST_CASE("trace recorder: a folder or a missing folder is refused and nothing i
     std::filesystem::create_directory(dir / "t.trace");
     CHECK_THROWS_WITH(TraceRecorder(dir / "t.trace", header()), Catch::Contains("t.trace"));
     CHECK_THROWS_AS(TraceRecorder(dir / "missing" / "t.trace", header()), InputError);
-    CHECK(namesIn(dir.path()) == std::vector<std::string>{"t.trace"});
+    CHECK(test::namesIn(dir.path()) == std::vector<std::string>{"t.trace"});
     CHECK(std::filesystem::is_empty(dir / "t.trace"));
 }

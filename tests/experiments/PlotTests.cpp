@@ -153,31 +153,6 @@ std::string hostile(const std::string& tag) {
            std::string(1, '\0') + "'; system('touch PWNED-" + tag + "-3'); '";
 }
 
-/// The files named PWNED-* anywhere under `root`.
-std::vector<std::string> pwned(const std::filesystem::path& root) {
-    std::vector<std::string> out;
-    for (const auto& e : std::filesystem::recursive_directory_iterator(root)) {
-        if (e.path().filename().string().rfind("PWNED", 0) == 0) {
-            out.push_back(e.path().string());
-        }
-    }
-    return out;
-}
-
-/// Runs the enclosing scope in `dir` (a relative command in a name would act there).
-class InFolder {
-public:
-    explicit InFolder(const std::filesystem::path& dir) : mOld(std::filesystem::current_path()) {
-        std::filesystem::current_path(dir);
-    }
-    ~InFolder() { std::filesystem::current_path(mOld); }
-    InFolder(const InFolder&) = delete;
-    InFolder& operator=(const InFolder&) = delete;
-
-private:
-    std::filesystem::path mOld;
-};
-
 /// A one-panel figure with `text` in every place a text reaches the script.
 PlotSpec figureNamed(const std::string& text) {
     PlotSpec spec;
@@ -222,7 +197,7 @@ TEST_CASE("gnuplot draws hostile names as text and runs none of them") {
     folder.erase(folder.find('\0'), 1);
     const std::filesystem::path dir = root / folder;
     std::filesystem::create_directories(dir);
-    const InFolder inRoot(root.path());
+    const test::InFolder inRoot(root.path());
     for (const std::string ext : {".png", ".svg"}) {
         INFO(ext);
         const std::filesystem::path out = dir / ("plot" + ext);
@@ -234,7 +209,7 @@ TEST_CASE("gnuplot draws hostile names as text and runs none of them") {
     }
     CHECK_THAT(test::readFile(dir / "plot.svg"),
                Catch::Contains("x`touch PWNED-name-1`y $(touch PWNED-name-2)"));
-    CHECK(pwned(root.path()).empty());
+    CHECK(test::pwned(root.path()).empty());
     // Only the outputs are left: no temporary, no log.
     std::set<std::string> names;
     for (const auto& e : std::filesystem::directory_iterator(dir)) {

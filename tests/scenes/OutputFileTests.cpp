@@ -26,15 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<std::string> namesIn(const fs::path& dir) {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) {
-        names.push_back(e.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
 /// While it lives, no file of this process grows past `bytes`: a write beyond fails with EFBIG
 /// (SIGXFSZ ignored), as on a full disk.
 struct FileSizeLimit {

@@ -1,6 +1,7 @@
 #pragma once
 /// Helpers shared by the tests: temporary files and running the `hapto` command.
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <string>
 #include <sys/wait.h>
 #include <thread>
+#include <vector>
 
 namespace hapto::test {
 
@@ -86,5 +88,53 @@ inline CommandResult runHapto(const std::string& args) {
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return r;
 }
+
+/// The lines of `text` (without their line ends).
+inline std::vector<std::string> linesOf(const std::string& text) {
+    std::vector<std::string> lines;
+    std::size_t start = 0;
+    while (start < text.size()) {
+        const std::size_t end = std::min(text.find('\n', start), text.size());
+        lines.push_back(text.substr(start, end - start));
+        start = end + 1;
+    }
+    return lines;
+}
+
+/// The names in a folder, sorted.
+inline std::vector<std::string> namesIn(const std::filesystem::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+        names.push_back(e.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+/// The files named PWNED* anywhere under `root`: made by a hostile name run as a command.
+inline std::vector<std::string> pwned(const std::filesystem::path& root) {
+    std::vector<std::string> out;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(root)) {
+        if (e.path().filename().string().rfind("PWNED", 0) == 0) {
+            out.push_back(e.path().string());
+        }
+    }
+    return out;
+}
+
+/// Runs the enclosing scope in `dir`, so a relative command in a name (run by hapto, started
+/// from here) would act there.
+class InFolder {
+public:
+    explicit InFolder(const std::filesystem::path& dir) : mOld(std::filesystem::current_path()) {
+        std::filesystem::current_path(dir);
+    }
+    ~InFolder() { std::filesystem::current_path(mOld); }
+    InFolder(const InFolder&) = delete;
+    InFolder& operator=(const InFolder&) = delete;
+
+private:
+    std::filesystem::path mOld;
+};
 
 } // namespace hapto::test

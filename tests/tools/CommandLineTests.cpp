@@ -20,23 +20,11 @@ using namespace hapto;
 
 namespace {
 
-/// The lines of `text`.
-std::vector<std::string> linesOf(const std::string& text) {
-    std::vector<std::string> lines;
-    std::size_t start = 0;
-    while (start < text.size()) {
-        const std::size_t end = std::min(text.find('\n', start), text.size());
-        lines.push_back(text.substr(start, end - start));
-        start = end + 1;
-    }
-    return lines;
-}
-
 /// The commands `help` (a `--help` text) lists under "Subcommands:".
 std::vector<std::string> commandsIn(const std::string& help) {
     std::vector<std::string> names;
     bool in = false;
-    for (const std::string& line : linesOf(help)) {
+    for (const std::string& line : test::linesOf(help)) {
         if (line == "Subcommands:") {
             in = true;
         } else if (in && line.empty()) {
@@ -52,7 +40,7 @@ std::vector<std::string> commandsIn(const std::string& help) {
 /// "--per-side" or "-o,--output", help flags left out.
 std::vector<std::string> optionsIn(const std::string& help) {
     std::vector<std::string> names;
-    for (const std::string& line : linesOf(help)) {
+    for (const std::string& line : test::linesOf(help)) {
         if (line.rfind("  -", 0) == 0) {
             const std::string name = line.substr(2, line.find(' ', 2) - 2);
             if (name != "-h,--help" && name != "--help-all") {
@@ -65,7 +53,7 @@ std::vector<std::string> optionsIn(const std::string& help) {
 
 /// The line of `help` that starts with `option` (after its indent), or "".
 std::string optionLine(const std::string& help, const std::string& option) {
-    for (const std::string& line : linesOf(help)) {
+    for (const std::string& line : test::linesOf(help)) {
         if (line.rfind("  " + option + " ", 0) == 0) {
             return line;
         }
@@ -150,7 +138,7 @@ TEST_CASE("hapto --help-all gives every command's options at every depth, each c
             todo.push_back(path + " " + name);
         }
         CHECK_THAT(help.output, Catch::Contains("\nExamples:\n  hapto " + path));
-        for (const std::string& line : linesOf(help.output)) {
+        for (const std::string& line : test::linesOf(help.output)) {
             CHECK(line.size() <= 100);
         }
         // Its part of --help-all: from its heading to the next command's.
@@ -168,7 +156,7 @@ TEST_CASE("hapto --help-all gives every command's options at every depth, each c
     }
     CHECK(commands >= 30); // scene grid ... view; CLI11 alone listed 12 with their options
     CHECK(options >= 150);
-    for (const std::string& line : linesOf(all.output)) {
+    for (const std::string& line : test::linesOf(all.output)) {
         INFO(line);
         CHECK(line.size() <= 100);
     }

@@ -3,6 +3,7 @@
 // renamed ones), the default index, and the help layout (wrapText, HelpFormatter, examples).
 
 #include "Options.h"
+#include "TestSupport.h"
 #include "hapto/scenes/InputError.h"
 
 #include <catch2/catch.hpp>
@@ -138,18 +139,6 @@ std::string helpOf(CLI::App& app, bool all = false) {
     return app.help("", all ? CLI::AppFormatMode::All : CLI::AppFormatMode::Normal);
 }
 
-/// The lines of `text`.
-std::vector<std::string> linesOf(const std::string& text) {
-    std::vector<std::string> lines;
-    std::size_t start = 0;
-    while (start < text.size()) {
-        const std::size_t end = std::min(text.find('\n', start), text.size());
-        lines.push_back(text.substr(start, end - start));
-        start = end + 1;
-    }
-    return lines;
-}
-
 } // namespace
 
 TEST_CASE("HelpFormatter: --help-all gives every command at every depth, wrapped, with examples") {
@@ -169,12 +158,12 @@ TEST_CASE("HelpFormatter: --help-all gives every command at every depth, wrapped
     CHECK_THAT(all, Catch::Contains("\ntool group leaf\n"));
     CHECK_THAT(all, Catch::Contains("--deep-option FLOAT"));
     CHECK_THAT(all, Catch::Contains("Examples:\n  tool group leaf --deep-option 2"));
-    for (const std::string& line : linesOf(all)) {
+    for (const std::string& line : hapto::test::linesOf(all)) {
         INFO(line);
         CHECK(line.size() <= kTextWidth);
     }
     // A command's own help wraps the same way.
-    for (const std::string& line : linesOf(helpOf(*leaf))) {
+    for (const std::string& line : hapto::test::linesOf(helpOf(*leaf))) {
         CHECK(line.size() <= kTextWidth);
     }
 }

@@ -108,15 +108,6 @@ bool catchesSigint(pid_t pid) {
     return false;
 }
 
-std::vector<std::string> namesIn(const std::filesystem::path& dir) {
-    std::vector<std::string> names;
-    for (const auto& e : std::filesystem::directory_iterator(dir)) {
-        names.push_back(e.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
 bool waitForFile(const std::filesystem::path& p) {
     const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
     while (!std::filesystem::exists(p) && std::chrono::steady_clock::now() < until) {

@@ -212,32 +212,6 @@ std::string shellWord(const std::string& s) {
     return q + "'";
 }
 
-/// The files named PWNED* anywhere under `root`: made by a name run as a command.
-std::vector<std::string> pwned(const std::filesystem::path& root) {
-    std::vector<std::string> out;
-    for (const auto& e : std::filesystem::recursive_directory_iterator(root)) {
-        if (e.path().filename().string().rfind("PWNED", 0) == 0) {
-            out.push_back(e.path().string());
-        }
-    }
-    return out;
-}
-
-/// Runs the enclosing scope in `dir`, so a relative command in a name (run by hapto, started
-/// from here) would act there.
-class InFolder {
-public:
-    explicit InFolder(const std::filesystem::path& dir) : mOld(std::filesystem::current_path()) {
-        std::filesystem::current_path(dir);
-    }
-    ~InFolder() { std::filesystem::current_path(mOld); }
-    InFolder(const InFolder&) = delete;
-    InFolder& operator=(const InFolder&) = delete;
-
-private:
-    std::filesystem::path mOld;
-};
-
 /// A run report, as `hapto report plot` reads it, of devices named by the JSON strings given.
 std::string reportOf(const std::vector<std::string>& jsonNames) {
     std::string devices;
@@ -262,7 +236,7 @@ TEST_CASE("hapto report plot draws hostile names and paths as text and runs none
     test::writeFile(dir / "report.json",
                     reportOf({R"("x`touch PWNED1`y")", R"x("$(touch PWNED2)")x",
                               R"("a'b\"c\\ @out")", R"("'; system('touch PWNED3'); '")"}));
-    const InFolder inRoot(root.path());
+    const test::InFolder inRoot(root.path());
     const auto r = test::runHapto("report plot " + shellWord((dir / "report.json").string()) +
                                   " -o " + shellWord((dir / "report.svg").string()) + " --script " +
                                   shellWord((dir / "report.gp").string()));
@@ -271,7 +245,7 @@ TEST_CASE("hapto report plot draws hostile names and paths as text and runs none
     const std::string svg = test::readFile(dir / "report.svg");
     CHECK_THAT(svg, Catch::Contains("x`touch PWNED1`y"));
     CHECK_THAT(svg, Catch::Contains("$(touch PWNED2)"));
-    CHECK(pwned(root.path()).empty());
+    CHECK(test::pwned(root.path()).empty());
 }
 
 TEST_CASE("hapto report plot refuses a device name with a control character, naming it") {
@@ -296,7 +270,7 @@ TEST_CASE("hapto trace plot draws hostile device names and paths as text and run
     // A device-name header of printable ASCII that gnuplot would run in a double-quoted string.
     writeContactTrace(dir / "left.trace", "x`touch PWNED4`$(touch PWNED5)'\"\\@out", -1.0);
     writeContactTrace(dir / "right.trace", "'; system('touch PWNED6'); '", 1.0);
-    const InFolder inRoot(root.path());
+    const test::InFolder inRoot(root.path());
     for (const std::string ext : {".png", ".svg"}) {
         const auto r = test::runHapto("trace plot " + shellWord((dir / "left.trace").string()) +
                                       " " + shellWord((dir / "right.trace").string()) + " -o " +
@@ -312,7 +286,7 @@ TEST_CASE("hapto trace plot draws hostile device names and paths as text and run
     INFO(one.output);
     CHECK(one.exitCode == 0);
     CHECK_THAT(test::readFile(dir / "one.svg"), Catch::Contains("touch PWNED-dir1"));
-    CHECK(pwned(root.path()).empty());
+    CHECK(test::pwned(root.path()).empty());
 }
 
 TEST_CASE("hapto trace plot refuses a device name with a control character, naming the field") {
