@@ -311,165 +311,180 @@ void addGeneratedSceneOutput(CLI::App* cmd, std::function<Scene()> make) {
     });
 }
 
+/// `hapto scene grid`. [control]
+void addGridCommand(CLI::App* scene) {
+    auto* cmd = scene->add_subcommand(
+        "grid", "Experiment 1: K x K x K cubes on a regular lattice with gaps, bounds a little "
+                "larger than the lattice");
+    auto opt = std::make_shared<LatticeOptions>();
+    cmd->add_option("--per-side", opt->perSide, "K, cubes per lattice side")
+        ->required()
+        ->check(finiteRange(1, 100000));
+    addCubeSizeOption(cmd, opt->cubeSize);
+    cmd->add_option("--gap", opt->gap, "Free space between neighbouring cubes (m)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e3));
+    addGeneratedSceneOutput(cmd, [opt] { return makeLatticeScene(*opt); });
+    setExamples(cmd, {"hapto scene grid --per-side 10 -o grid10.json",
+                      "hapto scene grid --per-side 100 --size 0.01 --gap 0.002 -o big.hsb"});
+}
+
+/// `hapto scene random`. [control]
+void addRandomCommand(CLI::App* scene) {
+    auto* cmd = scene->add_subcommand(
+        "random", "Experiment 2: N cubes placed uniformly at random in a work cube centred on "
+                  "the origin; bounds are the work cube");
+    auto opt = std::make_shared<RandomOptions>();
+    cmd->add_option("--count", opt->count, "Number of cubes (e.g. 200 or 1e6)")
+        ->required()
+        ->transform(wholeNumber(0, 4e9));
+    addRandomCubeOptions(cmd, *opt);
+    cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
+    cmd->add_option("--keep-clear", opt->keepClear,
+                    "No object within this distance of the centre, where cursors start (m)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e4));
+    addGeneratedSceneOutput(cmd, [opt] { return makeRandomScene(*opt); });
+    setExamples(cmd, {"hapto scene random --count 200 --seed 7 -o random200.json",
+                      "hapto scene random --count 1e6 --rotate -o million.hsb"});
+}
+
+/// `hapto scene cluster`. [control]
+void addClusterCommand(CLI::App* scene) {
+    auto* cmd = scene->add_subcommand(
+        "cluster", "A strongly non-uniform scene: N cubes in C Gaussian clusters (a uniform "
+                   "grid does badly here)");
+    auto opt = std::make_shared<ClusterOptions>();
+    cmd->add_option("--count", opt->count, "Number of cubes (e.g. 1e5)")
+        ->required()
+        ->transform(wholeNumber(0, 4e9));
+    cmd->add_option("--clusters", opt->clusters, "Number of clusters")
+        ->capture_default_str()
+        ->check(finiteRange(1, 1000000));
+    addRandomCubeOptions(cmd, *opt);
+    cmd->add_option("--spread", opt->spread, "Standard deviation of each cluster (m)")
+        ->capture_default_str()
+        ->check(finiteRange(0, 1e4));
+    cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
+    addGeneratedSceneOutput(cmd, [opt] { return makeClusterScene(*opt); });
+    setExamples(cmd, {"hapto scene cluster --count 1e5 --clusters 20 -o clusters.hsb"});
+}
+
+/// `hapto scene default`. [control]
+void addDefaultCommand(CLI::App* scene) {
+    auto* cmd = scene->add_subcommand(
+        "default", "Write the embedded default scene (200 random 5 cm cubes, seed 2004, 4 cm "
+                   "clear around the centre)");
+    addGeneratedSceneOutput(cmd, [] { return makeDefaultScene(); });
+    setExamples(cmd, {"hapto scene default -o default.json"});
+}
+
+/// `hapto scene mesh`. [control]
+void addMeshCommand(CLI::App* scene) {
+    auto* cmd = scene->add_subcommand(
+        "mesh", "A generated triangle mesh (geodesic sphere, torus or noise terrain) of about "
+                "N triangles, for load against triangle count: the scene file F.json and its "
+                "mesh F.ply beside it");
+    auto args = std::make_shared<MeshSceneArgs>();
+    cmd->add_option("--shape", args->shape, "sphere, torus or terrain")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"sphere", "torus", "terrain"}));
+    cmd->add_option("--triangles", args->mesh.triangles,
+                    "About how many triangles (1e2 .. 1e7; the sphere has 20 f^2, within "
+                    "1.5x of N, the others within 1.15x)")
+        ->required()
+        ->transform(wholeNumber(static_cast<double>(kMinGeneratedTriangles),
+                                static_cast<double>(kMaxGeneratedTriangles)));
+    cmd->add_option("--size", args->mesh.size,
+                    "Extent along x (m): sphere diameter, torus outer diameter, terrain edge")
+        ->capture_default_str()
+        ->check(finiteRange(1e-6, 1e3));
+    cmd->add_option("--seed", args->mesh.seed, "Terrain noise seed; same seed, same files")
+        ->capture_default_str()
+        ->check(finiteRange(0, kMaxSeed));
+    cmd->add_option("-o,--output", args->out, "Output scene file (the mesh goes to F.ply)")
+        ->required();
+    setExamples(cmd, {"hapto scene mesh --triangles 1e5 -o sphere.json   # and sphere.ply",
+                      "hapto scene mesh --shape terrain --triangles 2e6 --size 0.5 -o "
+                      "terrain.json"});
+    cmd->callback([args] { writeMeshScene(*args); });
+}
+
+/// `hapto scene import`. [control]
+void addImportCommand(CLI::App* scene) {
+    auto* cmd = scene->add_subcommand(
+        "import", "Wrap a model file (OBJ, STL or PLY) in a scene: one mesh object, id 0, "
+                  "which refers to the model by its path relative to the scene");
+    auto opt = std::make_shared<ImportOptions>();
+    cmd->add_option("model", opt->model, "The model file (.obj, .stl or .ply)")->required();
+    cmd->add_option("--scale", opt->scale, "Uniform scale: the model's units times it give metres")
+        ->capture_default_str()
+        ->check(positiveRange(1e6));
+    addNumberListOption(cmd, "--center", opt->center, 3, -1e6, 1e6,
+                        "Where the model's origin goes, x,y,z (m); default 0,0,0");
+    addNumberListOption(cmd, "--rotation", opt->rotation, 4, -1, 1,
+                        "Orientation, a unit quaternion w,x,y,z; default 1,0,0,0");
+    cmd->add_option("--stiffness", opt->stiffness, "Surface stiffness (N/m)")
+        ->capture_default_str()
+        ->check(positiveRange(Material::kMaxStiffness));
+    addNumberListOption(cmd, "--friction", opt->friction, 2, 0, Material::kMaxFriction,
+                        "Coulomb coefficients static,dynamic (dynamic <= static); "
+                        "default 0,0");
+    cmd->add_option("-o,--output", opt->out, "Output scene file ('-' for standard output)")
+        ->required();
+    setExamples(cmd, {"hapto scene import bunny.stl --scale 0.001 -o bunny.json   # mm to m",
+                      "hapto scene import part.obj --center 0,0.1,0 --stiffness 500 -o "
+                      "part.json"});
+    cmd->callback([opt] { importModel(*opt); });
+}
+
+/// `hapto scene convert`. [control]
+void addConvertCommand(CLI::App* scene) {
+    auto* cmd = scene->add_subcommand(
+        "convert", "Convert a scene between JSON and the binary format (for large scenes; "
+                   "every --scene reads both)");
+    auto opt = std::make_shared<ConvertOptions>();
+    cmd->add_option("input", opt->in, "The scene to read (JSON or binary)")->required();
+    cmd->add_option("-o,--output", opt->out,
+                    "Output scene file: .json for JSON, .hsb for binary, or --format ('-' "
+                    "for standard output)")
+        ->required();
+    cmd->add_option("--format", opt->format, "json or binary (default: from -o's extension)")
+        ->check(CLI::IsMember({"json", "binary"}));
+    setExamples(cmd, {"hapto scene convert million.json -o million.hsb",
+                      "hapto scene convert million.hsb -o - --format json | head"});
+    cmd->callback([opt] { convertScene(*opt); });
+}
+
+/// `hapto scene info`. [control]
+void addInfoCommand(CLI::App* scene) {
+    auto* cmd = scene->add_subcommand("info", "Load a scene (or the default) and describe it");
+    auto path = std::make_shared<std::string>();
+    cmd->add_option("--scene", *path, "Scene file (default: the embedded default scene)");
+    setExamples(cmd, {"hapto scene info", "hapto scene info --scene grid10.json"});
+    cmd->callback([path] {
+        const auto t0 = std::chrono::steady_clock::now();
+        const Scene s = loadSceneOrDefault(*path);
+        const double secs =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        printInfo(s, path->empty() ? "(embedded default scene)" : *path, secs);
+    });
+}
+
 } // namespace
 
 void addSceneCommands(CLI::App& app) {
     CLI::App* scene = app.add_subcommand("scene", "Generate scene files, or describe one");
     scene->require_subcommand(1);
 
-    // grid
-    {
-        auto* cmd = scene->add_subcommand(
-            "grid", "Experiment 1: K x K x K cubes on a regular lattice with gaps, bounds a little "
-                    "larger than the lattice");
-        auto opt = std::make_shared<LatticeOptions>();
-        cmd->add_option("--per-side", opt->perSide, "K, cubes per lattice side")
-            ->required()
-            ->check(finiteRange(1, 100000));
-        addCubeSizeOption(cmd, opt->cubeSize);
-        cmd->add_option("--gap", opt->gap, "Free space between neighbouring cubes (m)")
-            ->capture_default_str()
-            ->check(finiteRange(0, 1e3));
-        addGeneratedSceneOutput(cmd, [opt] { return makeLatticeScene(*opt); });
-        setExamples(cmd, {"hapto scene grid --per-side 10 -o grid10.json",
-                          "hapto scene grid --per-side 100 --size 0.01 --gap 0.002 -o big.hsb"});
-    }
-    // random
-    {
-        auto* cmd = scene->add_subcommand(
-            "random", "Experiment 2: N cubes placed uniformly at random in a work cube centred on "
-                      "the origin; bounds are the work cube");
-        auto opt = std::make_shared<RandomOptions>();
-        cmd->add_option("--count", opt->count, "Number of cubes (e.g. 200 or 1e6)")
-            ->required()
-            ->transform(wholeNumber(0, 4e9));
-        addRandomCubeOptions(cmd, *opt);
-        cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
-        cmd->add_option("--keep-clear", opt->keepClear,
-                        "No object within this distance of the centre, where cursors start (m)")
-            ->capture_default_str()
-            ->check(finiteRange(0, 1e4));
-        addGeneratedSceneOutput(cmd, [opt] { return makeRandomScene(*opt); });
-        setExamples(cmd, {"hapto scene random --count 200 --seed 7 -o random200.json",
-                          "hapto scene random --count 1e6 --rotate -o million.hsb"});
-    }
-    // cluster
-    {
-        auto* cmd = scene->add_subcommand(
-            "cluster", "A strongly non-uniform scene: N cubes in C Gaussian clusters (a uniform "
-                       "grid does badly here)");
-        auto opt = std::make_shared<ClusterOptions>();
-        cmd->add_option("--count", opt->count, "Number of cubes (e.g. 1e5)")
-            ->required()
-            ->transform(wholeNumber(0, 4e9));
-        cmd->add_option("--clusters", opt->clusters, "Number of clusters")
-            ->capture_default_str()
-            ->check(finiteRange(1, 1000000));
-        addRandomCubeOptions(cmd, *opt);
-        cmd->add_option("--spread", opt->spread, "Standard deviation of each cluster (m)")
-            ->capture_default_str()
-            ->check(finiteRange(0, 1e4));
-        cmd->add_flag("--rotate", opt->rotate, "Give every cube a random orientation");
-        addGeneratedSceneOutput(cmd, [opt] { return makeClusterScene(*opt); });
-        setExamples(cmd, {"hapto scene cluster --count 1e5 --clusters 20 -o clusters.hsb"});
-    }
-    // default
-    {
-        auto* cmd = scene->add_subcommand(
-            "default", "Write the embedded default scene (200 random 5 cm cubes, seed 2004, 4 cm "
-                       "clear around the centre)");
-        addGeneratedSceneOutput(cmd, [] { return makeDefaultScene(); });
-        setExamples(cmd, {"hapto scene default -o default.json"});
-    }
-    // mesh
-    {
-        auto* cmd = scene->add_subcommand(
-            "mesh", "A generated triangle mesh (geodesic sphere, torus or noise terrain) of about "
-                    "N triangles, for load against triangle count: the scene file F.json and its "
-                    "mesh F.ply beside it");
-        auto args = std::make_shared<MeshSceneArgs>();
-        cmd->add_option("--shape", args->shape, "sphere, torus or terrain")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"sphere", "torus", "terrain"}));
-        cmd->add_option("--triangles", args->mesh.triangles,
-                        "About how many triangles (1e2 .. 1e7; the sphere has 20 f^2, within "
-                        "1.5x of N, the others within 1.15x)")
-            ->required()
-            ->transform(wholeNumber(static_cast<double>(kMinGeneratedTriangles),
-                                    static_cast<double>(kMaxGeneratedTriangles)));
-        cmd->add_option("--size", args->mesh.size,
-                        "Extent along x (m): sphere diameter, torus outer diameter, terrain edge")
-            ->capture_default_str()
-            ->check(finiteRange(1e-6, 1e3));
-        cmd->add_option("--seed", args->mesh.seed, "Terrain noise seed; same seed, same files")
-            ->capture_default_str()
-            ->check(finiteRange(0, kMaxSeed));
-        cmd->add_option("-o,--output", args->out, "Output scene file (the mesh goes to F.ply)")
-            ->required();
-        setExamples(cmd, {"hapto scene mesh --triangles 1e5 -o sphere.json   # and sphere.ply",
-                          "hapto scene mesh --shape terrain --triangles 2e6 --size 0.5 -o "
-                          "terrain.json"});
-        cmd->callback([args] { writeMeshScene(*args); });
-    }
-    // import
-    {
-        auto* cmd = scene->add_subcommand(
-            "import", "Wrap a model file (OBJ, STL or PLY) in a scene: one mesh object, id 0, "
-                      "which refers to the model by its path relative to the scene");
-        auto opt = std::make_shared<ImportOptions>();
-        cmd->add_option("model", opt->model, "The model file (.obj, .stl or .ply)")->required();
-        cmd->add_option("--scale", opt->scale,
-                        "Uniform scale: the model's units times it give metres")
-            ->capture_default_str()
-            ->check(positiveRange(1e6));
-        addNumberListOption(cmd, "--center", opt->center, 3, -1e6, 1e6,
-                            "Where the model's origin goes, x,y,z (m); default 0,0,0");
-        addNumberListOption(cmd, "--rotation", opt->rotation, 4, -1, 1,
-                            "Orientation, a unit quaternion w,x,y,z; default 1,0,0,0");
-        cmd->add_option("--stiffness", opt->stiffness, "Surface stiffness (N/m)")
-            ->capture_default_str()
-            ->check(positiveRange(Material::kMaxStiffness));
-        addNumberListOption(cmd, "--friction", opt->friction, 2, 0, Material::kMaxFriction,
-                            "Coulomb coefficients static,dynamic (dynamic <= static); "
-                            "default 0,0");
-        cmd->add_option("-o,--output", opt->out, "Output scene file ('-' for standard output)")
-            ->required();
-        setExamples(cmd, {"hapto scene import bunny.stl --scale 0.001 -o bunny.json   # mm to m",
-                          "hapto scene import part.obj --center 0,0.1,0 --stiffness 500 -o "
-                          "part.json"});
-        cmd->callback([opt] { importModel(*opt); });
-    }
-    // convert
-    {
-        auto* cmd = scene->add_subcommand(
-            "convert", "Convert a scene between JSON and the binary format (for large scenes; "
-                       "every --scene reads both)");
-        auto opt = std::make_shared<ConvertOptions>();
-        cmd->add_option("input", opt->in, "The scene to read (JSON or binary)")->required();
-        cmd->add_option("-o,--output", opt->out,
-                        "Output scene file: .json for JSON, .hsb for binary, or --format ('-' "
-                        "for standard output)")
-            ->required();
-        cmd->add_option("--format", opt->format, "json or binary (default: from -o's extension)")
-            ->check(CLI::IsMember({"json", "binary"}));
-        setExamples(cmd, {"hapto scene convert million.json -o million.hsb",
-                          "hapto scene convert million.hsb -o - --format json | head"});
-        cmd->callback([opt] { convertScene(*opt); });
-    }
-    // info
-    {
-        auto* cmd = scene->add_subcommand("info", "Load a scene (or the default) and describe it");
-        auto path = std::make_shared<std::string>();
-        cmd->add_option("--scene", *path, "Scene file (default: the embedded default scene)");
-        setExamples(cmd, {"hapto scene info", "hapto scene info --scene grid10.json"});
-        cmd->callback([path] {
-            const auto t0 = std::chrono::steady_clock::now();
-            const Scene s = loadSceneOrDefault(*path);
-            const double secs =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            printInfo(s, path->empty() ? "(embedded default scene)" : *path, secs);
-        });
-    }
+    addGridCommand(scene);
+    addRandomCommand(scene);
+    addClusterCommand(scene);
+    addDefaultCommand(scene);
+    addMeshCommand(scene);
+    addImportCommand(scene);
+    addConvertCommand(scene);
+    addInfoCommand(scene);
     // Set last: a command inherits the footer its group has when it is added.
     setExamples(scene, {"hapto scene grid --per-side 10 -o grid10.json", "hapto scene info"});
 }
