@@ -147,7 +147,8 @@ DeviceStatus FalconDevice::read(DeviceState& state) noexcept {
         state.position = s.positionM;
         state.hasVelocity = false;
         // The Falcon senses its three arm encoders only: no stylus orientation, gimbal or
-        // gripper (../shared/devices/, libnifalcon's FalconKinematic).
+        // gripper (libnifalcon: FalconKinematic.h turns the three arm angles into a position only;
+        // the grips, FalconGripFourButton, report buttons).
         state.hasOrientation = false;
         state.hasAngularVelocity = false;
         state.hasGimbalAngles = false;
