@@ -357,7 +357,8 @@ TEST_CASE("a request head must arrive whole within the request timeout", "[realt
     CHECK(statusOf(request("GET", "/view.js", port)) == 200);
 }
 
-TEST_CASE("a header flood is refused with 431 and not read further, and long lines keep 414 and 400") {
+TEST_CASE(
+    "a header flood is refused with 431 and not read further, and long lines keep 414 and 400") {
     ViewServer server;
     const int port = server.start();
     const std::string start = "GET / HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\n";

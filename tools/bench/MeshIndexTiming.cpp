@@ -1,7 +1,7 @@
-// Times indexing one big mesh (a timing program beside the benchmarks, never a test). Builds an icosphere of
-// 20 * 4^S triangles in C++ (TriangleMesh::make, which also builds the mesh's local BVH), puts
-// it in a scene, and builds the grid and the octree over its triangles, printing the build
-// time and bytes per triangle of each, and the BVH's.
+// Times indexing one big mesh (a timing program beside the benchmarks, never a test). Builds an
+// icosphere of 20 * 4^S triangles in C++ (TriangleMesh::make, which also builds the mesh's local
+// BVH), puts it in a scene, and builds the grid and the octree over its triangles, printing the
+// build time and bytes per triangle of each, and the BVH's.
 //
 //   index_mesh_timing [SUBDIVISIONS=8] [GRID_N=64] [OCTREE=octree:8:0.0005]
 
