@@ -471,7 +471,8 @@ void checkBinaryStl(std::string_view b, std::uint32_t count, const std::string& 
     }
 }
 
-void checkAsciiStl(std::string_view text, const std::string& name, double scale) {
+/// Throws at the first byte of `text` no ASCII STL holds (a NUL or a control character).
+void checkAsciiStlBytes(std::string_view text, const std::string& name) {
     for (std::size_t i = 0; i < text.size(); ++i) {
         const auto c = static_cast<unsigned char>(text[i]);
         if (c == 0 || (c < 32 && !isSpace(static_cast<char>(c)) && c != '\n')) {
@@ -480,6 +481,10 @@ void checkAsciiStl(std::string_view text, const std::string& name, double scale)
                  "its size does not match its header's facet count (84 + 50 x count bytes)");
         }
     }
+}
+
+void checkAsciiStl(std::string_view text, const std::string& name, double scale) {
+    checkAsciiStlBytes(text, name);
     std::vector<std::string_view> tok;
     std::size_t facetLine = 0; // the open facet's line, 0 outside a facet
     int vertices = 0;
