@@ -4,9 +4,9 @@
 
 #include "hapto/devices/DeviceConfig.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
-#include "hapto/scenes/JsonInput.h"
+#include "hapto/io/JsonInput.h"
 
 #include <algorithm>
 #include <array>

@@ -4,7 +4,7 @@
 #include "hapto/devices/PhantomDevice.h"
 #include "hapto/devices/ReplayDevice.h"
 #include "hapto/devices/SimDevice.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 namespace hapto {
 

@@ -3,7 +3,7 @@
 #include "hapto/core/Finite.h"
 
 #include "hapto/devices/TraceReader.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <algorithm>
 #include <bit>

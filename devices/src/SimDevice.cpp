@@ -2,7 +2,7 @@
 
 #include "hapto/core/Finite.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <algorithm>
 #include <cmath>

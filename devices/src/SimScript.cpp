@@ -9,8 +9,8 @@
 
 #include "SceneQueries.h"
 
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/Random.h"
+#include "hapto/core/Random.h"
+#include "hapto/io/InputError.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 #include "hapto/devices/TraceReader.h"
 
 #include "hapto/core/Finite.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/InputFile.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/InputFile.h"
 
 #include <cmath>
 #include <cstring>

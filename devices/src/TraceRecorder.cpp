@@ -1,6 +1,6 @@
 #include "hapto/devices/TraceRecorder.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <cerrno>
 #include <cstring>

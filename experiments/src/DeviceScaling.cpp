@@ -10,12 +10,12 @@
 #include "hapto/experiments/Sweep.h"
 #include "hapto/experiments/Table.h"
 
+#include "hapto/core/Random.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/index/Overlap.h"
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/Random.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include <algorithm>

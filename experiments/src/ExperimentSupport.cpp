@@ -2,11 +2,11 @@
 
 #include "hapto/experiments/ExperimentSupport.h"
 
-#include "hapto/scenes/OutputFile.h"
+#include "hapto/io/OutputFile.h"
 
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/io/InputError.h"
 #include "hapto/runtime/HapticTick.h"
-#include "hapto/scenes/InputError.h"
 
 #include <algorithm>
 #include <chrono>

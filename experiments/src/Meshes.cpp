@@ -3,7 +3,7 @@
 #include "hapto/experiments/Experiments.h"
 #include "hapto/experiments/Sweep.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/MeshGenerators.h"
 
 #include <algorithm>

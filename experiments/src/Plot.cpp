@@ -2,9 +2,9 @@
 
 #include "hapto/experiments/Plot.h"
 
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/JsonInput.h"
-#include "hapto/scenes/OutputFile.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/JsonInput.h"
+#include "hapto/io/OutputFile.h"
 
 #include <algorithm>
 #include <array>

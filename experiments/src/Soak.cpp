@@ -9,13 +9,13 @@
 #include "hapto/experiments/ExperimentSupport.h"
 #include "hapto/experiments/Table.h"
 
+#include "hapto/core/Random.h"
 #include "hapto/devices/DeviceFactory.h"
 #include "hapto/devices/FaultInjectingDevice.h"
 #include "hapto/index/IndexSpec.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 #include "hapto/runtime/Runtime.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/OutputFile.h"
-#include "hapto/scenes/Random.h"
 
 #include <nlohmann/json.hpp>
 

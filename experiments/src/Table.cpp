@@ -4,7 +4,7 @@
 
 #include "hapto/experiments/ExperimentSupport.h"
 
-#include "hapto/scenes/OutputFile.h"
+#include "hapto/io/OutputFile.h"
 
 #include <cstdio>
 #include <set>

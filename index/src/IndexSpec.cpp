@@ -1,6 +1,6 @@
 #include "hapto/index/IndexSpec.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <charconv>
 #include <cmath>

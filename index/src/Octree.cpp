@@ -30,7 +30,7 @@
 #include "IndexMemory.h"
 #include "Parallel.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <algorithm>
 #include <bit>

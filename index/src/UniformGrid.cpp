@@ -4,7 +4,7 @@
 #include "IndexItems.h"
 #include "Parallel.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <algorithm>
 #include <array>

@@ -1,7 +1,7 @@
 #include "hapto/runtime/World.h"
 
+#include "hapto/io/InputError.h"
 #include "hapto/runtime/Realtime.h"
-#include "hapto/scenes/InputError.h"
 
 #include <algorithm>
 #include <stdexcept>

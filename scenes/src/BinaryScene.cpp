@@ -7,8 +7,8 @@
 
 #include "hapto/scenes/BinaryScene.h"
 
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/JsonInput.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/JsonInput.h"
 
 #include "SceneFileChecks.h"
 

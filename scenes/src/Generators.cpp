@@ -1,8 +1,8 @@
 #include "hapto/scenes/Generators.h"
 
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/JsonInput.h"
-#include "hapto/scenes/Random.h"
+#include "hapto/core/Random.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/JsonInput.h"
 
 #include <algorithm>
 #include <cmath>

@@ -16,8 +16,8 @@
 #include "MeshFileChecks.h"
 
 #include "hapto/core/Finite.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/InputFile.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/InputFile.h"
 
 #include <assimp/IOStream.hpp>
 #include <assimp/IOSystem.hpp>

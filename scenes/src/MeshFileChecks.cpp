@@ -9,8 +9,8 @@
 
 #include "MeshFileChecks.h"
 
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/JsonInput.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/JsonInput.h"
 #include "hapto/scenes/TriangleMesh.h"
 
 #include <algorithm>

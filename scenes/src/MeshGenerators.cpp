@@ -1,8 +1,8 @@
 #include "hapto/scenes/MeshGenerators.h"
 
+#include "hapto/core/Random.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/Random.h"
 
 #include <algorithm>
 #include <array>

@@ -6,10 +6,10 @@
 #include "hapto/scenes/SceneFile.h"
 
 #include "hapto/core/Finite.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/InputFile.h"
+#include "hapto/io/JsonInput.h"
 #include "hapto/scenes/BinaryScene.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/InputFile.h"
-#include "hapto/scenes/JsonInput.h"
 #include "hapto/scenes/MeshFile.h"
 
 #include "SceneFileChecks.h"

@@ -4,7 +4,7 @@
 /// refuse the same scenes with the same words. Each names the place through a json::Source and
 /// json::Path and throws InputError. All [control].
 
-#include "hapto/scenes/JsonInput.h"
+#include "hapto/io/JsonInput.h"
 #include "hapto/scenes/Scene.h"
 
 #include <cstdint>

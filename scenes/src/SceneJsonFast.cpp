@@ -12,8 +12,8 @@
 // Numbers are read as nlohmann reads them: an integer token (even "-0") as its integer value
 // converted to double, any other as the nearest double (both correctly rounded).
 
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/JsonInput.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/JsonInput.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include "SceneFileChecks.h"

@@ -1,8 +1,8 @@
 #include "hapto/scenes/TriangleMesh.h"
 
 #include "hapto/core/Finite.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/JsonInput.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/JsonInput.h"
 
 #include <algorithm>
 #include <array>

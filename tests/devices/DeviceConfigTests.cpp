@@ -3,8 +3,8 @@
 #include "hapto/devices/FalconDevice.h"
 #include "hapto/devices/PhantomDevice.h"
 #include "hapto/devices/SimDevice.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
 
 #include "TestSupport.h"
 

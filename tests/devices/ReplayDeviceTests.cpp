@@ -3,8 +3,8 @@
 #include "hapto/devices/SimDevice.h"
 #include "hapto/devices/TraceReader.h"
 #include "hapto/devices/TraceRecorder.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
 
 #include "TestSupport.h"
 

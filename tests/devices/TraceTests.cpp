@@ -1,7 +1,7 @@
+#include "hapto/core/Random.h"
 #include "hapto/devices/TraceReader.h"
 #include "hapto/devices/TraceRecorder.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/Random.h"
+#include "hapto/io/InputError.h"
 
 #include "TestSupport.h"
 

@@ -4,7 +4,7 @@
 
 #include "hapto/experiments/Plot.h"
 #include "hapto/experiments/Sweep.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include "TestSupport.h"
 

@@ -2,7 +2,7 @@
 // could test nothing. (The whole soak runs in tests/tools/SoakCommandTests.cpp.)
 
 #include "hapto/experiments/Soak.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <catch2/catch.hpp>
 

@@ -1,5 +1,5 @@
 #include "hapto/index/IndexSpec.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <catch2/catch.hpp>
 

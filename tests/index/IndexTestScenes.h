@@ -4,9 +4,9 @@
 
 #include "TestMeshes.h"
 
+#include "hapto/core/Random.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/Random.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
+#include "hapto/core/Random.h"
 #include "hapto/index/Overlap.h"
-#include "hapto/scenes/Random.h"
 
 #include <catch2/catch.hpp>
 

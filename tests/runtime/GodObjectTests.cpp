@@ -1,7 +1,7 @@
+#include "hapto/core/Random.h"
 #include "hapto/runtime/ForceSafety.h"
 #include "hapto/runtime/GodObjectRenderer.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/Random.h"
 
 #include "RenderTestSupport.h"
 

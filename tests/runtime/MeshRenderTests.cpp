@@ -8,7 +8,7 @@
 
 #include "MeshShapes.h"
 
-#include "hapto/scenes/Random.h"
+#include "hapto/core/Random.h"
 
 #include <catch2/catch.hpp>
 

@@ -2,9 +2,9 @@
 // on read with the JSON loader's own rules and words plus the byte offset, and no truncation or
 // bit flip gets past the reader as anything but an InputError or a valid scene.
 
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/BinaryScene.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include "TestSupport.h"

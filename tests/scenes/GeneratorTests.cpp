@@ -1,5 +1,5 @@
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include <catch2/catch.hpp>

@@ -5,7 +5,7 @@
 #include "CountingNew.h"
 #include "TestMeshes.h"
 
-#include "hapto/scenes/Random.h"
+#include "hapto/core/Random.h"
 #include "hapto/scenes/TriangleMesh.h"
 
 #include <catch2/catch.hpp>

@@ -2,7 +2,7 @@
 // their triangles, shared vertices, positions after scale, orientation and closed-ness; and
 // every kind of bad model refused with the file and the place.
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/MeshFile.h"
 
 #include "TestSupport.h"

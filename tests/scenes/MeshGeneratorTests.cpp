@@ -1,6 +1,6 @@
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 #include "hapto/scenes/MeshGenerators.h"
-#include "hapto/scenes/OutputFile.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include <catch2/catch.hpp>

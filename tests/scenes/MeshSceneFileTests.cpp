@@ -2,7 +2,7 @@
 // and scale; version 1 files and outputs unchanged; save and load round trips; bad meshes
 // refused with the scene file, the JSON path and, for model files, the model's place.
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include "TestSupport.h"

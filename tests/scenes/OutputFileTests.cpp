@@ -1,11 +1,11 @@
 // Output files written whole or not at all, output-path checks and same-file detection
-// (hapto/scenes/OutputFile.h), in process.
+// (hapto/io/OutputFile.h), in process.
 
-#include "hapto/scenes/OutputFile.h"
+#include "hapto/io/OutputFile.h"
 
 #include "TestSupport.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <catch2/catch.hpp>
 

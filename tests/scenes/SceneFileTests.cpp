@@ -1,6 +1,6 @@
+#include "hapto/io/InputError.h"
+#include "hapto/io/InputFile.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/InputFile.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include "TestSupport.h"

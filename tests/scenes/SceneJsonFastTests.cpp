@@ -2,8 +2,8 @@
 // for every valid file, bit for bit, and for every bad one the checked loader's message, word
 // for word (the fast path hands anything it does not vouch for to the checked loader).
 
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include "TestSupport.h"

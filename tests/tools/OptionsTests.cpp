@@ -4,7 +4,7 @@
 
 #include "Options.h"
 #include "TestSupport.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <catch2/catch.hpp>
 

@@ -2,8 +2,8 @@
 
 #include "hapto/experiments/HandWalk.h"
 
+#include "hapto/core/Random.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/Random.h"
 
 #include <cmath>
 #include <memory>

@@ -2,8 +2,8 @@
 // InputError; nothing else may escape, crash, hang or leak, and a header's counts never make it
 // allocate more than the input holds.
 
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/BinaryScene.h"
-#include "hapto/scenes/InputError.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include <cstddef>

@@ -2,7 +2,7 @@
 // InputError; nothing else may escape, crash, hang or leak.
 
 #include "hapto/devices/DeviceConfig.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <cstddef>
 #include <cstdint>

@@ -6,7 +6,7 @@
 // position), every triangle's plane a unit normal or zero, and its local BVH finds every
 // triangle exactly once over the mesh's bounds.
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/MeshFile.h"
 
 #include <algorithm>

@@ -2,7 +2,7 @@
 // InputError; nothing else may escape, crash, hang or leak; and its simdjson fast path gives
 // the checked loader's answer (the same scene or the same message) on every input.
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include <cstddef>

@@ -4,7 +4,7 @@
 // the one `hapto trace` and replay devices use.
 
 #include "hapto/devices/TraceReader.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <cmath>
 #include <cstddef>

@@ -11,6 +11,8 @@
 #include "hapto/experiments/HandWalk.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 #include "hapto/runtime/CandidateSet.h"
 #include "hapto/runtime/DeviceMetrics.h"
 #include "hapto/runtime/Effects.h"
@@ -21,8 +23,6 @@
 #include "hapto/runtime/Runtime.h"
 #include "hapto/runtime/ServoLoop.h"
 #include "hapto/runtime/World.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/OutputFile.h"
 
 #include <nlohmann/json.hpp>
 

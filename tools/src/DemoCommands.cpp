@@ -13,12 +13,12 @@
 #include "hapto/devices/SimDevice.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/index/IndexSpec.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 #include "hapto/runtime/GraspController.h"
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/OutputFile.h"
 
 #include <nlohmann/json.hpp>
 

@@ -7,7 +7,7 @@
 #include "hapto/experiments/ExperimentSupport.h"
 #include "hapto/experiments/Experiments.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <cstdlib>
 #include <memory>

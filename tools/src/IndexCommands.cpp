@@ -6,9 +6,9 @@
 #include "hapto/index/Cursor.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/index/SpatialIndex.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/InputFile.h"
-#include "hapto/scenes/OutputFile.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/InputFile.h"
+#include "hapto/io/OutputFile.h"
 
 #include <nlohmann/json.hpp>
 

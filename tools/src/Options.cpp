@@ -2,7 +2,7 @@
 
 #include "Options.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <arpa/inet.h>
 

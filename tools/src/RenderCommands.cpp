@@ -13,10 +13,10 @@
 
 #include "hapto/index/IndexSpec.h"
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 #include "hapto/runtime/HapticTick.h"
 #include "hapto/runtime/World.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/OutputFile.h"
 
 #include <charconv>
 #include <iostream>

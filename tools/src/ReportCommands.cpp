@@ -6,9 +6,9 @@
 #include "Options.h"
 
 #include "hapto/experiments/Plot.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/JsonInput.h"
-#include "hapto/scenes/OutputFile.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/JsonInput.h"
+#include "hapto/io/OutputFile.h"
 
 #include <iostream>
 #include <memory>

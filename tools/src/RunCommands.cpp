@@ -12,9 +12,9 @@
 #include "hapto/devices/ReplayDevice.h"
 #include "hapto/devices/TraceRecorder.h"
 #include "hapto/index/IndexSpec.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 #include "hapto/runtime/Runtime.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/OutputFile.h"
 
 #include <atomic>
 #include <chrono>

@@ -3,12 +3,12 @@
 #include "Commands.h"
 #include "Options.h"
 
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 #include "hapto/scenes/BinaryScene.h"
 #include "hapto/scenes/Generators.h"
-#include "hapto/scenes/InputError.h"
 #include "hapto/scenes/MeshFile.h"
 #include "hapto/scenes/MeshGenerators.h"
-#include "hapto/scenes/OutputFile.h"
 #include "hapto/scenes/SceneFile.h"
 
 #include <chrono>

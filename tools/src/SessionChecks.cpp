@@ -2,9 +2,9 @@
 
 #include "SessionChecks.h"
 
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 #include "hapto/runtime/World.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/OutputFile.h"
 
 #include <cstdio>
 #include <filesystem>

@@ -5,8 +5,8 @@
 
 #include "hapto/devices/TraceReader.h"
 #include "hapto/experiments/Plot.h"
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/OutputFile.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/OutputFile.h"
 
 #include <algorithm>
 #include <charconv>

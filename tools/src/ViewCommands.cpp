@@ -6,7 +6,7 @@
 
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/TraceReader.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 #include "hapto/view/ViewDocuments.h"
 #include "hapto/view/ViewServer.h"
 

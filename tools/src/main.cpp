@@ -4,7 +4,7 @@
 #include "Options.h"
 
 #include "hapto/Version.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <CLI/CLI.hpp>
 

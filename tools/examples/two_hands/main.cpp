@@ -15,13 +15,13 @@
 #include <hapto/devices/DeviceConfig.h>
 #include <hapto/devices/DeviceFactory.h>
 #include <hapto/index/IndexSpec.h>
+#include <hapto/io/InputError.h>
 #include <hapto/runtime/GraspController.h>
 #include <hapto/runtime/ManualClock.h>
 #include <hapto/runtime/Realtime.h>
 #include <hapto/runtime/Runtime.h>
 #include <hapto/runtime/World.h>
 #include <hapto/scenes/Generators.h>
-#include <hapto/scenes/InputError.h>
 
 #include <chrono>
 #include <cstdio>

@@ -1,11 +1,11 @@
 #pragma once
 /// A simulated hand on a simulated device (`"kind": "sim"`): scripted, seeded, force-feeling.
 
+#include "hapto/core/Random.h"
 #include "hapto/devices/Device.h"
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/HandModel.h"
 #include "hapto/devices/SimScript.h"
-#include "hapto/scenes/Random.h"
 #include "hapto/scenes/Scene.h"
 
 #include <atomic>

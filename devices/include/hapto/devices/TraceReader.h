@@ -21,7 +21,7 @@ class TraceReader {
 public:
     /// Opens `path` and checks the header against the file size. Throws InputError, also for
     /// anything but a regular file (a FIFO, a pipe, a device) and for a file larger than
-    /// kMaxInputFileBytes (hapto/scenes/InputFile.h). [control]
+    /// kMaxInputFileBytes (hapto/io/InputFile.h). [control]
     explicit TraceReader(const std::filesystem::path& path);
     ~TraceReader();
     TraceReader(const TraceReader&) = delete;

@@ -13,7 +13,7 @@
 /// Cost: a few flops and two normal draws per axis per step; no allocation in next().
 
 #include "hapto/core/Geometry.h"
-#include "hapto/scenes/Random.h"
+#include "hapto/core/Random.h"
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 
 #include "hapto/index/IndexSpec.h"
 #include "hapto/index/IndexStats.h"
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/Scene.h"
 
 #include <cstdint>

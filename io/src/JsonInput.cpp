@@ -1,7 +1,7 @@
-#include "hapto/scenes/JsonInput.h"
+#include "hapto/io/JsonInput.h"
 
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/InputFile.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/InputFile.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,9 +1,9 @@
 // Output files written whole or not at all (temporary beside the target, then rename).
 
-#include "hapto/scenes/OutputFile.h"
+#include "hapto/io/OutputFile.h"
 
-#include "hapto/scenes/InputError.h"
-#include "hapto/scenes/InputFile.h"
+#include "hapto/io/InputError.h"
+#include "hapto/io/InputFile.h"
 
 #include <cerrno>
 #include <cstring>

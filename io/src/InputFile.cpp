@@ -2,9 +2,9 @@
 // then fstat the descriptor; only a regular file is read, and only up to the limit. Checking
 // the descriptor rather than the path means nothing can be swapped in between.
 
-#include "hapto/scenes/InputFile.h"
+#include "hapto/io/InputFile.h"
 
-#include "hapto/scenes/InputError.h"
+#include "hapto/io/InputError.h"
 
 #include <algorithm>
 #include <cerrno>
