@@ -232,6 +232,464 @@ std::vector<CursorRow> cursorWalk(std::size_t n, const IndexSpec& spec, std::siz
     return rows;
 }
 
+/// A whole number as a table cell.
+Cell whole(auto value) {
+    return Cell(static_cast<std::int64_t>(value));
+}
+
+/// What the whole run shares: its arguments, the scene, the two index specs and the verdict.
+struct ScalingSetup {
+    const DevicesArgs& args;
+    const Scene& scene;
+    IndexSpec spec;       ///< The index the hands run over.
+    IndexSpec cursorSpec; ///< The octree the cursor part walks.
+    ServoSettings servo;  ///< Duration, repeats, realtime and the verdict's percentile.
+};
+
+/// The device-scaling part's results, in measurement order.
+struct ScalingResults {
+    std::vector<ScalingRow> rows;        ///< One per (rate, device count).
+    std::vector<PerDeviceRow> perDevice; ///< One per (rate, device count, repeat, device).
+    std::string realtimeNote;            ///< The last run's note when SCHED_FIFO was refused.
+};
+
+/// One repeat of one cell, over its devices: sums, the mean device, and the worst device per
+/// figure (each figure's own worst).
+struct RepeatFigures {
+    double loadSumPct = 0, loadPerCorePct = 0, deviceMeanLoadPct = 0;
+    double worstP50Pct = 0, worstP99Pct = 0, worstP999Pct = 0, worstMaxPct = 0;
+    double worstMissedPct = 0, lateWakeups = 0;
+    bool allStable = true; ///< The run was stable and so was every device.
+    bool realtime = true;  ///< Every device got SCHED_FIFO.
+    std::string fault;     ///< The last device fault, or empty.
+};
+
+/// Folds one run's per-device figures into the repeat's figures. [control]
+RepeatFigures repeatFigures(const RunReport& r, const std::vector<LoadFigures>& devices) {
+    RepeatFigures x;
+    x.allStable = r.stable;
+    double mean = 0;
+    for (const LoadFigures& f : devices) {
+        mean += f.meanPct;
+        x.worstP50Pct = std::max(x.worstP50Pct, f.p50Pct);
+        x.worstP99Pct = std::max(x.worstP99Pct, f.p99Pct);
+        x.worstP999Pct = std::max(x.worstP999Pct, f.p999Pct);
+        x.worstMaxPct = std::max(x.worstMaxPct, f.maxPct);
+        x.worstMissedPct = std::max(x.worstMissedPct, f.missedPct);
+        x.lateWakeups += f.lateWakeups;
+        x.realtime = x.realtime && f.realtime;
+        x.allStable = x.allStable && f.stable();
+        if (!f.fault.empty()) {
+            x.fault = f.fault;
+        }
+    }
+    x.loadSumPct = 100.0 * r.loadSum;
+    x.loadPerCorePct = 100.0 * r.loadPerCore;
+    x.deviceMeanLoadPct = mean / std::max<std::size_t>(1, devices.size());
+    return x;
+}
+
+/// The median over repeats of one figure.
+double medianOver(const std::vector<RepeatFigures>& runs, double RepeatFigures::*figure) {
+    std::vector<double> values;
+    for (const RepeatFigures& x : runs) {
+        values.push_back(x.*figure);
+    }
+    return median(values);
+}
+
+/// Fills a cell's row from its repeats: medians of every figure, stable repeats counted,
+/// realtime only when every device of every repeat had it, the last fault as the note.
+void concludeScalingRow(ScalingRow& row, const std::vector<RepeatFigures>& runs) {
+    for (const RepeatFigures& x : runs) {
+        row.realtime = row.realtime && x.realtime;
+        row.stableRuns += x.allStable ? 1 : 0;
+        if (!x.fault.empty()) {
+            row.note = "fault: " + x.fault;
+        }
+    }
+    row.loadSumPct = medianOver(runs, &RepeatFigures::loadSumPct);
+    row.loadPerCorePct = medianOver(runs, &RepeatFigures::loadPerCorePct);
+    row.deviceMeanLoadPct = medianOver(runs, &RepeatFigures::deviceMeanLoadPct);
+    row.worstP50Pct = medianOver(runs, &RepeatFigures::worstP50Pct);
+    row.worstP99Pct = medianOver(runs, &RepeatFigures::worstP99Pct);
+    row.worstP999Pct = medianOver(runs, &RepeatFigures::worstP999Pct);
+    row.worstMaxPct = medianOver(runs, &RepeatFigures::worstMaxPct);
+    row.worstMissedPct = medianOver(runs, &RepeatFigures::worstMissedPct);
+    row.lateWakeups = medianOver(runs, &RepeatFigures::lateWakeups);
+}
+
+/// `devices` simulated hands at `rateHz`, hand i from starts[i] with seed i + 1.
+std::vector<HandPlan> scalingHands(const ScalingSetup& setup, const std::vector<Vec3>& starts,
+                                   double rateHz, int devices) {
+    std::vector<HandPlan> hands;
+    for (int i = 0; i < devices; ++i) {
+        hands.push_back(
+            {simHand("hand" + std::to_string(i), rateHz, setup.args.script,
+                     static_cast<std::uint64_t>(i + 1), starts[static_cast<std::size_t>(i)]),
+             &setup.scene});
+    }
+    return hands;
+}
+
+/// Runs one (rate, device count) cell `repeats` times over `world`; appends its row and its
+/// per-device rows to `results`. [control]
+void measureCell(World& world, const ScalingSetup& setup, const std::vector<Vec3>& starts,
+                 double rate, int devices, ScalingResults& results, Progress& progress) {
+    const std::vector<HandPlan> hands = scalingHands(setup, starts, rate, devices);
+    ScalingRow row;
+    row.rateHz = rate;
+    row.devices = devices;
+    row.repeats = setup.args.common.repeats;
+    row.tail = setup.servo.tail;
+    std::vector<RepeatFigures> runs;
+    for (int k = 0; k < setup.args.common.repeats; ++k) {
+        progress.show(std::to_string(devices) + " devices at " + rateText(rate));
+        const RunReport r = runSession(world, hands, setup.servo).report;
+        row.cores = r.cores;
+        if (!r.realtimeNote.empty()) {
+            results.realtimeNote = r.realtimeNote;
+        }
+        std::vector<LoadFigures> figures;
+        for (std::size_t i = 0; i < r.devices.size(); ++i) {
+            figures.push_back(figuresOf(r.devices[i], setup.servo.tail));
+            results.perDevice.push_back({rate, devices, k, static_cast<int>(i), figures.back()});
+        }
+        runs.push_back(repeatFigures(r, figures));
+        progress.advance(1, std::to_string(devices) + " devices at " + rateText(rate));
+    }
+    concludeScalingRow(row, runs);
+    results.rows.push_back(row);
+}
+
+/// The cursor part: one walk per N, three rows each (root, climb, links).
+std::vector<CursorRow> measureCursors(const ScalingSetup& setup, Progress& progress) {
+    std::vector<CursorRow> rows;
+    if (!setup.args.cursor) {
+        return rows;
+    }
+    for (const std::size_t n : setup.args.cursorObjects) {
+        for (CursorRow& r : cursorWalk(n, setup.cursorSpec, setup.args.walkSteps, progress)) {
+            rows.push_back(r);
+        }
+        progress.advance(1, "cursor N=" + std::to_string(n));
+    }
+    return rows;
+}
+
+/// One row per (rate, device count); the p99 column shows in markdown only for quick runs,
+/// whose verdict reads it.
+Table scalingTable(const std::vector<ScalingRow>& rows, bool quick) {
+    Table t({
+        {"rate_hz", "Hz", -1, "", ColumnIn::Data},
+        {"devices", "", -1, "devices"},
+        {"repeats", "", -1, "", ColumnIn::Data},
+        {"load_sum_pct", "%", 2, "load sum % (one core)"},
+        {"load_per_core_pct", "%", 2, "per core %"},
+        {"device_load_mean_pct", "%", 2, "per device mean %"},
+        {"worst_load_p50_pct", "%", 2, "worst p50 %"},
+        {"worst_load_p99_pct", "%", 1, "worst p99 %", quick ? ColumnIn::All : ColumnIn::Data},
+        {"worst_load_p999_pct", "%", 1, "worst p99.9 %"},
+        {"worst_load_max_pct", "%", 1, "worst max %"},
+        {"worst_missed_pct", "%", 2, "worst missed %"},
+        {"late_wakeups", "", -1, "", ColumnIn::Data},
+        {"stable_runs", "", -1, "", ColumnIn::Data},
+        {"stable", "", -1, "", ColumnIn::Data},
+        {"realtime", "", -1, "", ColumnIn::Data},
+        {"cores", "", -1, "", ColumnIn::Data},
+        {"note", "", -1, "", ColumnIn::Data},
+        {"verdict", "", -1, "verdict", ColumnIn::Markdown},
+    });
+    for (const ScalingRow& r : rows) {
+        t.add({r.rateHz, whole(r.devices), whole(r.repeats), r.loadSumPct, r.loadPerCorePct,
+               r.deviceMeanLoadPct, r.worstP50Pct, r.worstP99Pct, r.worstP999Pct, r.worstMaxPct,
+               r.worstMissedPct, r.lateWakeups, whole(r.stableRuns), r.stable(), r.realtime,
+               whole(r.cores), r.note,
+               std::string(r.stable() ? "stable" : "UNSTABLE") + " (" +
+                   std::to_string(r.stableRuns) + "/" + std::to_string(r.repeats) + " runs)"});
+    }
+    return t;
+}
+
+/// One row per device of every run.
+Table perDeviceTable(const std::vector<PerDeviceRow>& rows) {
+    Table t({
+        {"rate_hz", "Hz"},
+        {"devices", ""},
+        {"repeat", ""},
+        {"device", ""},
+        {"load_mean_pct", "%"},
+        {"load_p50_pct", "%"},
+        {"load_p99_pct", "%"},
+        {"load_p999_pct", "%"},
+        {"load_max_pct", "%"},
+        {"ticks", ""},
+        {"missed", ""},
+        {"missed_pct", "%"},
+        {"late_wakeups", ""},
+        {"contact_pct", "%"},
+        {"candidates_mean", ""},
+        {"stable", ""},
+        {"fault", ""},
+    });
+    for (const PerDeviceRow& r : rows) {
+        t.add({r.rateHz, whole(r.devices), whole(r.repeat), whole(r.device), r.f.meanPct,
+               r.f.p50Pct, r.f.p99Pct, r.f.p999Pct, r.f.maxPct, r.f.ticks, r.f.missed,
+               r.f.missedPct, r.f.lateWakeups, r.f.contactPct, r.f.candidatesMean, r.f.stable(),
+               r.f.fault});
+    }
+    return t;
+}
+
+/// One row per (N, strategy).
+Table cursorTable(const std::vector<CursorRow>& rows) {
+    Table t({
+        {"objects", ""},
+        {"per_side", ""},
+        {"depth", ""},
+        {"leaves", ""},
+        {"log8_n_over_m", ""},
+        {"strategy", ""},
+        {"locates", ""},
+        {"leaf_changes", ""},
+        {"steps_per_locate", ""},
+        {"steps_per_leaf_change", ""},
+        {"ns_per_locate", "ns"},
+        {"leaf_mismatches", ""},
+    });
+    for (const CursorRow& r : rows) {
+        t.add({whole(r.objects), whole(r.perSide), whole(r.depth), whole(r.leaves), r.log8NOverM,
+               r.strategy, whole(r.locates), whole(r.leafChanges), r.stepsPerLocate(),
+               r.stepsPerChange(), r.nsPerLocate, whole(r.mismatches)});
+    }
+    return t;
+}
+
+/// devices.json: the machine, the options, the scaling rows each with its per-device rows, and
+/// the cursor rows.
+Json scalingJson(const ScalingSetup& setup, const ScalingResults& results, const Table& scaling,
+                 const Table& perDevice, const Table& cursor) {
+    const DevicesArgs& args = setup.args;
+    Json j;
+    j["experiment"] = "devices";
+    j["machine"] = machineJson();
+    j["options"] = {{"rates_hz", args.ratesHz},
+                    {"max_devices", args.maxDevices},
+                    {"scene", args.scene.empty() ? "(embedded default scene)" : args.scene},
+                    {"objects", setup.scene.size()},
+                    {"index", setup.spec.toString()},
+                    {"script", args.script},
+                    {"duration_s", args.common.durationS},
+                    {"repeats", args.common.repeats},
+                    {"realtime_requested", args.common.realtime},
+                    {"quick", args.common.quick},
+                    {"verdict_percentile", tailName(setup.servo.tail)},
+                    {"cursor_index", setup.cursorSpec.toString()},
+                    {"cursor_objects", args.cursorObjects},
+                    {"walk_steps", args.walkSteps}};
+    j["realtime_note"] = results.realtimeNote;
+    Json jd = scaling.json();
+    for (std::size_t i = 0; i < results.rows.size(); ++i) {
+        Json devs = Json::array();
+        for (std::size_t k = 0; k < results.perDevice.size(); ++k) {
+            const PerDeviceRow& d = results.perDevice[k];
+            if (d.rateHz == results.rows[i].rateHz && d.devices == results.rows[i].devices) {
+                devs.push_back(perDevice.json(k));
+            }
+        }
+        jd[i]["per_device"] = devs;
+    }
+    j["devices"] = jd;
+    j["cursor"] = cursor.json();
+    return j;
+}
+
+/// Draws `spec` into `out`, adding the files to `plots`; a plot that cannot be drawn is noted.
+void drawInto(const std::filesystem::path& out, const PlotSpec& spec, Progress& progress,
+              std::vector<std::filesystem::path>& plots) {
+    const PlotResult pr = drawPlot(out, spec);
+    if (!pr.problem.empty()) {
+        progress.note("hapto experiment: plot skipped: " + pr.problem);
+    }
+    plots.insert(plots.end(), pr.files.begin(), pr.files.end());
+}
+
+/// devices-load: total load and the worst device's p99.9 and p50 against the device count, a
+/// series per rate, rings where a cell was unstable.
+PlotSpec scalingPlot(const ScalingSetup& setup, const std::vector<ScalingRow>& rows,
+                     const std::vector<int>& counts) {
+    PlotSpec p;
+    p.name = "devices-load";
+    p.title = "Haptic load against devices over one world (" + setup.spec.toString() + ", " +
+              std::to_string(setup.scene.size()) + " objects, script " + setup.args.script + ")";
+    // Two quantities (% of one core, % of the period), so each panel keeps its own scale.
+    p.unstableTitle = "unstable (" + std::string(tailName(setup.servo.tail)) +
+                      " load >= 100 % or > 0.1 % missed)";
+    PlotPanel total{
+        "total: sum of mean loads", "devices", "load (% of one core)", true, false, {}, {}, {}, {}};
+    PlotPanel worst{"worst device: p99.9 solid, p50 dashed",
+                    "devices",
+                    "load (% of the period)",
+                    true,
+                    true,
+                    {},
+                    100.0,
+                    "100 % (one period)",
+                    {}};
+    for (const int d : counts) {
+        total.xTics.push_back(d);
+        worst.xTics.push_back(d);
+    }
+    int style = 1;
+    for (const double rate : setup.args.ratesHz) {
+        PlotSeries a{rateText(rate), {}, {}, false, style};
+        PlotSeries b{rateText(rate) + " p99.9", {}, {}, false, style};
+        PlotSeries c{rateText(rate) + " p50", {}, {}, true, style};
+        for (const ScalingRow& r : rows) {
+            if (r.rateHz == rate) {
+                a.points.emplace_back(r.devices, r.loadSumPct);
+                a.unstable.push_back(!r.stable());
+                b.points.emplace_back(r.devices, r.worstP999Pct);
+                b.unstable.push_back(!r.stable());
+                c.points.emplace_back(r.devices, r.worstP50Pct);
+            }
+        }
+        total.series.push_back(a);
+        worst.series.push_back(b);
+        worst.series.push_back(c);
+        ++style;
+    }
+    p.panels = {total, worst};
+    return p;
+}
+
+/// cursor-steps: steps per locate and per leaf change against N, a series per strategy, with
+/// log8(N/M) for reference (root has no per-change series: it descends at every locate).
+PlotSpec cursorPlot(const ScalingSetup& setup, const std::vector<CursorRow>& rows) {
+    PlotSpec p;
+    p.name = "cursor-steps";
+    p.title = "Cursor steps against N (" + setup.cursorSpec.toString() +
+              ", K^3 lattices, hand-speed walk)";
+    PlotPanel perLocate{
+        "per locate (log scale)", "objects N", "mean steps per locate", true, true, {}, {}, {}, {}};
+    PlotPanel perChange{
+        "per leaf change", "objects N", "mean steps per leaf change", true, false, {}, {}, {}, {}};
+    for (const std::size_t n : setup.args.cursorObjects) {
+        perLocate.xTics.push_back(static_cast<double>(n));
+        perChange.xTics.push_back(static_cast<double>(n));
+    }
+    for (const char* s : {"root", "climb", "links"}) {
+        PlotSeries a{s, {}, {}, false, -1}, b{s, {}, {}, false, -1};
+        for (const CursorRow& r : rows) {
+            if (r.strategy == s) {
+                a.points.emplace_back(r.objects, r.stepsPerLocate());
+                b.points.emplace_back(r.objects, r.stepsPerChange());
+            }
+        }
+        perLocate.series.push_back(a);
+        if (std::string(s) == "root") { // root descends at every locate, change or not
+            b.points.clear();
+        }
+        perChange.series.push_back(b);
+    }
+    PlotSeries ref{"log8(N/M)", {}, {}, true, -1};
+    for (const CursorRow& r : rows) {
+        if (r.strategy == std::string("root")) {
+            ref.points.emplace_back(r.objects, r.log8NOverM);
+        }
+    }
+    perChange.series.push_back(ref);
+    p.panels = {perLocate, perChange};
+    return p;
+}
+
+/// The scaling section of devices.md: how it was measured, a table per rate, the realtime note.
+std::string scalingMarkdown(const ScalingSetup& setup, const ScalingResults& results,
+                            const Table& scaling) {
+    const DevicesArgs& args = setup.args;
+    std::string md = "## Load against devices: " + std::to_string(setup.scene.size()) +
+                     " objects, " + setup.spec.toString() + ", script " + args.script + "\n\n" +
+                     "Every device has its own servo thread over one shared World. Loads in % "
+                     "(wake-up to force written over the period); medians of " +
+                     std::to_string(args.common.repeats) + " run(s) of " +
+                     fmt(args.common.durationS, 2) + " s. " + verdictNote(setup.servo.tail) + "\n";
+    for (const double rate : args.ratesHz) {
+        md += "\n### " + rateText(rate) + "\n\n";
+        md += scaling.markdown([&](std::size_t i) { return results.rows[i].rateHz == rate; });
+    }
+    if (!results.realtimeNote.empty()) {
+        md += "\nNote: " + results.realtimeNote + "\n";
+    }
+    return md;
+}
+
+/// The cursor section of devices.md: what the strategies are, and a line per N with the three
+/// side by side (rows come in threes: root, climb, links). Empty without cursor rows.
+std::string cursorMarkdown(const ScalingSetup& setup, const std::vector<CursorRow>& rows) {
+    if (rows.empty()) {
+        return {};
+    }
+    std::string md =
+        "\n## Cursor steps against N (" + setup.cursorSpec.toString() +
+        ", K^3 lattices of 5 cm cubes, " + std::to_string(setup.args.walkSteps) +
+        " steps of a 1 ms hand-speed walk)\n\n"
+        "Steps = links followed (parent, child, neighbour) per locate. root: descend from "
+        "the root at every locate (no cache); climb: from the cached leaf up to the first "
+        "ancestor holding the point and down (the paper's octree without neighbour "
+        "links); links: across faces through neighbour links. The paper's claim (2.2.4): "
+        "O(M + log8(N/M)) per leaf change without links, O(M) with them.\n\n";
+    std::vector<std::vector<std::string>> t;
+    for (std::size_t i = 0; i + 2 < rows.size(); i += 3) {
+        const CursorRow& root = rows[i];
+        const CursorRow& climb = rows[i + 1];
+        const CursorRow& links = rows[i + 2];
+        t.push_back({std::to_string(root.objects), std::to_string(root.depth),
+                     fmt(root.log8NOverM, 2),
+                     fmt(1000.0 * double(links.leafChanges) / double(links.locates), 1),
+                     fmt(root.stepsPerLocate(), 3), fmt(climb.stepsPerLocate(), 3),
+                     fmt(links.stepsPerLocate(), 3), fmt(climb.stepsPerChange(), 2),
+                     fmt(links.stepsPerChange(), 2),
+                     fmt(root.nsPerLocate, 1) + " / " + fmt(climb.nsPerLocate, 1) + " / " +
+                         fmt(links.nsPerLocate, 1)});
+    }
+    return md + markdownTable({"N", "depth", "log8(N/M)", "leaf changes /1000 locates",
+                               "steps/locate root", "climb", "links", "steps/leaf change climb",
+                               "links", "ns/locate root / climb / links"},
+                              t);
+}
+
+/// Writes the CSVs, devices.json, the plots and devices.md into `out`; returns the markdown.
+std::string writeScalingFiles(const std::filesystem::path& out, const ScalingSetup& setup,
+                              const ScalingResults& results, const std::vector<CursorRow>& cursors,
+                              const std::vector<int>& counts, Progress& progress) {
+    // Each table declared once, written as CSV and JSON (and markdown).
+    const Table scaling = scalingTable(results.rows, setup.args.common.quick);
+    const Table perDevice = perDeviceTable(results.perDevice);
+    const Table cursor = cursorTable(cursors);
+    scaling.writeCsv(out / "devices.csv");
+    perDevice.writeCsv(out / "devices-per-device.csv");
+    cursor.writeCsv(out / "cursor.csv");
+    writeText(out / "devices.json",
+              scalingJson(setup, results, scaling, perDevice, cursor).dump(2) + "\n");
+
+    std::vector<std::filesystem::path> plots;
+    drawInto(out, scalingPlot(setup, results.rows, counts), progress, plots);
+    if (!cursors.empty()) {
+        drawInto(out, cursorPlot(setup, cursors), progress, plots);
+    }
+
+    std::string md = scalingMarkdown(setup, results, scaling) + cursorMarkdown(setup, cursors);
+    md += "\nFiles: " + (out / "devices.csv").string() + ", " +
+          (out / "devices-per-device.csv").string() + ", " + (out / "cursor.csv").string() + ", " +
+          (out / "devices.json").string() + ", " + (out / "devices.md").string();
+    for (const auto& p : plots) {
+        md += ", " + p.string();
+    }
+    md += "\n";
+    writeText(out / "devices.md", md);
+    return md;
+}
+
 } // namespace
 
 int runDevices(const DevicesArgs& args) {
@@ -256,366 +714,21 @@ int runDevices(const DevicesArgs& args) {
     World world(shared, spec);
     const std::vector<Vec3> starts = clearStarts(scene, *world.current().index, args.maxDevices);
 
-    ServoSettings servo;
-    servo.durationS = args.common.durationS;
-    servo.repeats = args.common.repeats;
-    servo.realtime = args.common.realtime;
-    servo.tail = tailFor(args.common.quick);
-    const bool quick = args.common.quick;
+    ScalingSetup setup{args, scene, spec, cursorSpec, {}};
+    setup.servo.durationS = args.common.durationS;
+    setup.servo.repeats = args.common.repeats;
+    setup.servo.realtime = args.common.realtime;
+    setup.servo.tail = tailFor(args.common.quick);
 
-    std::vector<ScalingRow> rows;
-    std::vector<PerDeviceRow> perDevice;
-    std::string realtimeNote;
+    ScalingResults results;
     for (const double rate : args.ratesHz) {
         for (const int d : counts) {
-            std::vector<HandPlan> hands;
-            for (int i = 0; i < d; ++i) {
-                hands.push_back({simHand("hand" + std::to_string(i), rate, args.script,
-                                         static_cast<std::uint64_t>(i + 1),
-                                         starts[static_cast<std::size_t>(i)]),
-                                 &scene});
-            }
-            ScalingRow row;
-            row.rateHz = rate;
-            row.devices = d;
-            row.repeats = args.common.repeats;
-            row.tail = servo.tail;
-            std::vector<double> sum, perCore, devMean, w50, w99, w999, wMax, wMissed, late;
-            for (int k = 0; k < args.common.repeats; ++k) {
-                progress.show(std::to_string(d) + " devices at " + rateText(rate));
-                const SessionResult s = runSession(world, hands, servo);
-                const RunReport& r = s.report;
-                row.cores = r.cores;
-                if (!r.realtimeNote.empty()) {
-                    realtimeNote = r.realtimeNote;
-                }
-                double mean = 0, a = 0, a99 = 0, b = 0, c = 0, m = 0, l = 0;
-                bool allStable = r.stable;
-                for (std::size_t i = 0; i < r.devices.size(); ++i) {
-                    const LoadFigures f = figuresOf(r.devices[i], servo.tail);
-                    perDevice.push_back({rate, d, k, static_cast<int>(i), f});
-                    mean += f.meanPct;
-                    a = std::max(a, f.p50Pct);
-                    a99 = std::max(a99, f.p99Pct);
-                    b = std::max(b, f.p999Pct);
-                    c = std::max(c, f.maxPct);
-                    m = std::max(m, f.missedPct);
-                    l += f.lateWakeups;
-                    row.realtime = row.realtime && f.realtime;
-                    allStable = allStable && f.stable();
-                    if (!f.fault.empty()) {
-                        row.note = "fault: " + f.fault;
-                    }
-                }
-                sum.push_back(100.0 * r.loadSum);
-                perCore.push_back(100.0 * r.loadPerCore);
-                devMean.push_back(mean / std::max<std::size_t>(1, r.devices.size()));
-                w50.push_back(a);
-                w99.push_back(a99);
-                w999.push_back(b);
-                wMax.push_back(c);
-                wMissed.push_back(m);
-                late.push_back(l);
-                row.stableRuns += allStable ? 1 : 0;
-                progress.advance(1, std::to_string(d) + " devices at " + rateText(rate));
-            }
-            row.loadSumPct = median(sum);
-            row.loadPerCorePct = median(perCore);
-            row.deviceMeanLoadPct = median(devMean);
-            row.worstP50Pct = median(w50);
-            row.worstP99Pct = median(w99);
-            row.worstP999Pct = median(w999);
-            row.worstMaxPct = median(wMax);
-            row.worstMissedPct = median(wMissed);
-            row.lateWakeups = median(late);
-            rows.push_back(row);
+            measureCell(world, setup, starts, rate, d, results, progress);
         }
     }
+    const std::vector<CursorRow> cursors = measureCursors(setup, progress);
 
-    std::vector<CursorRow> cursorRows;
-    if (args.cursor) {
-        for (const std::size_t n : args.cursorObjects) {
-            for (CursorRow& r : cursorWalk(n, cursorSpec, args.walkSteps, progress)) {
-                cursorRows.push_back(r);
-            }
-            progress.advance(1, "cursor N=" + std::to_string(n));
-        }
-    }
-
-    // Files: each table declared once, written as CSV and JSON (and markdown below).
-    const auto I = [](auto v) { return Cell(static_cast<std::int64_t>(v)); };
-    Table devicesTable({
-        {"rate_hz", "Hz", -1, "", ColumnIn::Data},
-        {"devices", "", -1, "devices"},
-        {"repeats", "", -1, "", ColumnIn::Data},
-        {"load_sum_pct", "%", 2, "load sum % (one core)"},
-        {"load_per_core_pct", "%", 2, "per core %"},
-        {"device_load_mean_pct", "%", 2, "per device mean %"},
-        {"worst_load_p50_pct", "%", 2, "worst p50 %"},
-        {"worst_load_p99_pct", "%", 1, "worst p99 %", quick ? ColumnIn::All : ColumnIn::Data},
-        {"worst_load_p999_pct", "%", 1, "worst p99.9 %"},
-        {"worst_load_max_pct", "%", 1, "worst max %"},
-        {"worst_missed_pct", "%", 2, "worst missed %"},
-        {"late_wakeups", "", -1, "", ColumnIn::Data},
-        {"stable_runs", "", -1, "", ColumnIn::Data},
-        {"stable", "", -1, "", ColumnIn::Data},
-        {"realtime", "", -1, "", ColumnIn::Data},
-        {"cores", "", -1, "", ColumnIn::Data},
-        {"note", "", -1, "", ColumnIn::Data},
-        {"verdict", "", -1, "verdict", ColumnIn::Markdown},
-    });
-    for (const ScalingRow& r : rows) {
-        devicesTable.add({r.rateHz, I(r.devices), I(r.repeats), r.loadSumPct, r.loadPerCorePct,
-                          r.deviceMeanLoadPct, r.worstP50Pct, r.worstP99Pct, r.worstP999Pct,
-                          r.worstMaxPct, r.worstMissedPct, r.lateWakeups, I(r.stableRuns),
-                          r.stable(), r.realtime, I(r.cores), r.note,
-                          std::string(r.stable() ? "stable" : "UNSTABLE") + " (" +
-                              std::to_string(r.stableRuns) + "/" + std::to_string(r.repeats) +
-                              " runs)"});
-    }
-    Table perDeviceTable({
-        {"rate_hz", "Hz"},
-        {"devices", ""},
-        {"repeat", ""},
-        {"device", ""},
-        {"load_mean_pct", "%"},
-        {"load_p50_pct", "%"},
-        {"load_p99_pct", "%"},
-        {"load_p999_pct", "%"},
-        {"load_max_pct", "%"},
-        {"ticks", ""},
-        {"missed", ""},
-        {"missed_pct", "%"},
-        {"late_wakeups", ""},
-        {"contact_pct", "%"},
-        {"candidates_mean", ""},
-        {"stable", ""},
-        {"fault", ""},
-    });
-    for (const PerDeviceRow& r : perDevice) {
-        perDeviceTable.add({r.rateHz, I(r.devices), I(r.repeat), I(r.device), r.f.meanPct,
-                            r.f.p50Pct, r.f.p99Pct, r.f.p999Pct, r.f.maxPct, r.f.ticks, r.f.missed,
-                            r.f.missedPct, r.f.lateWakeups, r.f.contactPct, r.f.candidatesMean,
-                            r.f.stable(), r.f.fault});
-    }
-    Table cursorTable({
-        {"objects", ""},
-        {"per_side", ""},
-        {"depth", ""},
-        {"leaves", ""},
-        {"log8_n_over_m", ""},
-        {"strategy", ""},
-        {"locates", ""},
-        {"leaf_changes", ""},
-        {"steps_per_locate", ""},
-        {"steps_per_leaf_change", ""},
-        {"ns_per_locate", "ns"},
-        {"leaf_mismatches", ""},
-    });
-    for (const CursorRow& r : cursorRows) {
-        cursorTable.add({I(r.objects), I(r.perSide), I(r.depth), I(r.leaves), r.log8NOverM,
-                         r.strategy, I(r.locates), I(r.leafChanges), r.stepsPerLocate(),
-                         r.stepsPerChange(), r.nsPerLocate, I(r.mismatches)});
-    }
-    devicesTable.writeCsv(out / "devices.csv");
-    perDeviceTable.writeCsv(out / "devices-per-device.csv");
-    cursorTable.writeCsv(out / "cursor.csv");
-    Json j;
-    j["experiment"] = "devices";
-    j["machine"] = machineJson();
-    j["options"] = {{"rates_hz", args.ratesHz},
-                    {"max_devices", args.maxDevices},
-                    {"scene", args.scene.empty() ? "(embedded default scene)" : args.scene},
-                    {"objects", scene.size()},
-                    {"index", spec.toString()},
-                    {"script", args.script},
-                    {"duration_s", args.common.durationS},
-                    {"repeats", args.common.repeats},
-                    {"realtime_requested", args.common.realtime},
-                    {"quick", args.common.quick},
-                    {"verdict_percentile", tailName(servo.tail)},
-                    {"cursor_index", cursorSpec.toString()},
-                    {"cursor_objects", args.cursorObjects},
-                    {"walk_steps", args.walkSteps}};
-    j["realtime_note"] = realtimeNote;
-    Json jd = devicesTable.json();
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-        Json devs = Json::array();
-        for (std::size_t k = 0; k < perDevice.size(); ++k) {
-            if (perDevice[k].rateHz == rows[i].rateHz && perDevice[k].devices == rows[i].devices) {
-                devs.push_back(perDeviceTable.json(k));
-            }
-        }
-        jd[i]["per_device"] = devs;
-    }
-    j["devices"] = jd;
-    j["cursor"] = cursorTable.json();
-    writeText(out / "devices.json", j.dump(2) + "\n");
-
-    // Plots.
-    std::vector<std::filesystem::path> plots;
-    {
-        PlotSpec p;
-        p.name = "devices-load";
-        p.title = "Haptic load against devices over one world (" + spec.toString() + ", " +
-                  std::to_string(scene.size()) + " objects, script " + args.script + ")";
-        // Two quantities (% of one core, % of the period), so each panel keeps its own scale.
-        p.unstableTitle =
-            "unstable (" + std::string(tailName(servo.tail)) + " load >= 100 % or > 0.1 % missed)";
-        PlotPanel total{"total: sum of mean loads",
-                        "devices",
-                        "load (% of one core)",
-                        true,
-                        false,
-                        {},
-                        {},
-                        {},
-                        {}};
-        PlotPanel worst{"worst device: p99.9 solid, p50 dashed",
-                        "devices",
-                        "load (% of the period)",
-                        true,
-                        true,
-                        {},
-                        100.0,
-                        "100 % (one period)",
-                        {}};
-        for (const int d : counts) {
-            total.xTics.push_back(d);
-            worst.xTics.push_back(d);
-        }
-        int style = 1;
-        for (const double rate : args.ratesHz) {
-            PlotSeries a{rateText(rate), {}, {}, false, style};
-            PlotSeries b{rateText(rate) + " p99.9", {}, {}, false, style};
-            PlotSeries c{rateText(rate) + " p50", {}, {}, true, style};
-            for (const ScalingRow& r : rows) {
-                if (r.rateHz == rate) {
-                    a.points.emplace_back(r.devices, r.loadSumPct);
-                    a.unstable.push_back(!r.stable());
-                    b.points.emplace_back(r.devices, r.worstP999Pct);
-                    b.unstable.push_back(!r.stable());
-                    c.points.emplace_back(r.devices, r.worstP50Pct);
-                }
-            }
-            total.series.push_back(a);
-            worst.series.push_back(b);
-            worst.series.push_back(c);
-            ++style;
-        }
-        p.panels = {total, worst};
-        const PlotResult pr = drawPlot(out, p);
-        if (!pr.problem.empty()) {
-            progress.note("hapto experiment: plot skipped: " + pr.problem);
-        }
-        plots.insert(plots.end(), pr.files.begin(), pr.files.end());
-    }
-    if (!cursorRows.empty()) {
-        PlotSpec p;
-        p.name = "cursor-steps";
-        p.title =
-            "Cursor steps against N (" + cursorSpec.toString() + ", K^3 lattices, hand-speed walk)";
-        PlotPanel perLocate{"per locate (log scale)",
-                            "objects N",
-                            "mean steps per locate",
-                            true,
-                            true,
-                            {},
-                            {},
-                            {},
-                            {}};
-        PlotPanel perChange{"per leaf change",
-                            "objects N",
-                            "mean steps per leaf change",
-                            true,
-                            false,
-                            {},
-                            {},
-                            {},
-                            {}};
-        for (const std::size_t n : args.cursorObjects) {
-            perLocate.xTics.push_back(static_cast<double>(n));
-            perChange.xTics.push_back(static_cast<double>(n));
-        }
-        for (const char* s : {"root", "climb", "links"}) {
-            PlotSeries a{s, {}, {}, false, -1}, b{s, {}, {}, false, -1};
-            for (const CursorRow& r : cursorRows) {
-                if (r.strategy == s) {
-                    a.points.emplace_back(r.objects, r.stepsPerLocate());
-                    b.points.emplace_back(r.objects, r.stepsPerChange());
-                }
-            }
-            perLocate.series.push_back(a);
-            if (std::string(s) == "root") { // root descends at every locate, change or not
-                b.points.clear();
-            }
-            perChange.series.push_back(b);
-        }
-        PlotSeries ref{"log8(N/M)", {}, {}, true, -1};
-        for (const CursorRow& r : cursorRows) {
-            if (r.strategy == std::string("root")) {
-                ref.points.emplace_back(r.objects, r.log8NOverM);
-            }
-        }
-        perChange.series.push_back(ref);
-        p.panels = {perLocate, perChange};
-        const PlotResult pr = drawPlot(out, p);
-        if (!pr.problem.empty()) {
-            progress.note("hapto experiment: plot skipped: " + pr.problem);
-        }
-        plots.insert(plots.end(), pr.files.begin(), pr.files.end());
-    }
-
-    // Tables.
-    std::string md = "## Load against devices: " + std::to_string(scene.size()) + " objects, " +
-                     spec.toString() + ", script " + args.script + "\n\n" +
-                     "Every device has its own servo thread over one shared World. Loads in % "
-                     "(wake-up to force written over the period); medians of " +
-                     std::to_string(args.common.repeats) + " run(s) of " +
-                     fmt(args.common.durationS, 2) + " s. " + verdictNote(servo.tail) + "\n";
-    for (const double rate : args.ratesHz) {
-        md += "\n### " + rateText(rate) + "\n\n";
-        md += devicesTable.markdown([&](std::size_t i) { return rows[i].rateHz == rate; });
-    }
-    if (!realtimeNote.empty()) {
-        md += "\nNote: " + realtimeNote + "\n";
-    }
-    if (!cursorRows.empty()) {
-        md += "\n## Cursor steps against N (" + cursorSpec.toString() +
-              ", K^3 lattices of 5 cm cubes, " + std::to_string(args.walkSteps) +
-              " steps of a 1 ms hand-speed walk)\n\n"
-              "Steps = links followed (parent, child, neighbour) per locate. root: descend from "
-              "the root at every locate (no cache); climb: from the cached leaf up to the first "
-              "ancestor holding the point and down (the paper's octree without neighbour "
-              "links); links: across faces through neighbour links. The paper's claim (2.2.4): "
-              "O(M + log8(N/M)) per leaf change without links, O(M) with them.\n\n";
-        std::vector<std::vector<std::string>> t;
-        for (std::size_t i = 0; i + 2 < cursorRows.size(); i += 3) {
-            const CursorRow& root = cursorRows[i];
-            const CursorRow& climb = cursorRows[i + 1];
-            const CursorRow& links = cursorRows[i + 2];
-            t.push_back({std::to_string(root.objects), std::to_string(root.depth),
-                         fmt(root.log8NOverM, 2),
-                         fmt(1000.0 * double(links.leafChanges) / double(links.locates), 1),
-                         fmt(root.stepsPerLocate(), 3), fmt(climb.stepsPerLocate(), 3),
-                         fmt(links.stepsPerLocate(), 3), fmt(climb.stepsPerChange(), 2),
-                         fmt(links.stepsPerChange(), 2),
-                         fmt(root.nsPerLocate, 1) + " / " + fmt(climb.nsPerLocate, 1) + " / " +
-                             fmt(links.nsPerLocate, 1)});
-        }
-        md += markdownTable({"N", "depth", "log8(N/M)", "leaf changes /1000 locates",
-                             "steps/locate root", "climb", "links", "steps/leaf change climb",
-                             "links", "ns/locate root / climb / links"},
-                            t);
-    }
-    md += "\nFiles: " + (out / "devices.csv").string() + ", " +
-          (out / "devices-per-device.csv").string() + ", " + (out / "cursor.csv").string() + ", " +
-          (out / "devices.json").string() + ", " + (out / "devices.md").string();
-    for (const auto& p : plots) {
-        md += ", " + p.string();
-    }
-    md += "\n";
-    writeText(out / "devices.md", md);
+    const std::string md = writeScalingFiles(out, setup, results, cursors, counts, progress);
     progress.finish(); // the results never share a line with the bar
     std::cout << md << std::flush;
     return 0;
