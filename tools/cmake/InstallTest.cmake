@@ -8,9 +8,9 @@
 # nothing and the view's and the Falcon's packages are disabled (tools/cmake/consumers/index),
 # and the view's component asked for there fails naming what it needs; an application serving
 # the installed view answers the page and three.js (tools/cmake/consumers/view); hapto-index.pc
-# links the index program with nothing of USB, HTTP or meshes; README's pkg-config line builds
-# tools/cmake/PkgConfigApp.cpp and it runs; the udev rule, the licence and hapto/Version.h are
-# installed.
+# links the index program with nothing of USB, HTTP or meshes and hapto-view.pc the view's;
+# README's pkg-config line builds tools/cmake/PkgConfigApp.cpp and it runs; the udev rule, the
+# licence and hapto/Version.h are installed.
 cmake_minimum_required(VERSION 3.25)
 foreach(var BINARY_DIR SOURCE_DIR WORK_DIR GENERATOR CXX)
   if(NOT DEFINED ${var})
@@ -139,7 +139,8 @@ if(NOT EXISTS ${inc}/hapto/Version.h)
 endif()
 
 # 5. One library's pkg-config file links that library and what it needs, nothing more: the
-#    index program builds with hapto-index.pc alone, which names no USB, HTTP or mesh library.
+#    index program builds with hapto-index.pc alone, which names no USB, HTTP or mesh library;
+#    the view program builds with hapto-view.pc.
 execute_process(COMMAND ${PKG_CONFIG} --cflags --libs hapto-index RESULT_VARIABLE rc
                 OUTPUT_VARIABLE flags ERROR_VARIABLE flags OUTPUT_STRIP_TRAILING_WHITESPACE)
 if(NOT rc EQUAL 0 OR flags MATCHES "usb|httplib|meshoptimizer|hapto_devices|hapto_view")
@@ -150,3 +151,6 @@ file(MAKE_DIRECTORY ${index_app})
 run(sh -c "cd '${index_app}' && '${CXX}' ${CXX_FLAGS} '${SOURCE_DIR}/tools/cmake/consumers/index/main.cpp' $(${PKG_CONFIG} --cflags --libs hapto-index) -o index ${LINKER_FLAGS}")
 run(${index_app}/index)
 message(STATUS "hapto-index.pc: ${flags}")
+# And hapto-view.pc links the program serving the view (cpp-httplib through it).
+run(sh -c "cd '${index_app}' && '${CXX}' ${CXX_FLAGS} '${SOURCE_DIR}/tools/cmake/consumers/view/main.cpp' $(${PKG_CONFIG} --cflags --libs hapto-view) -o view ${LINKER_FLAGS}")
+run(${index_app}/view)
