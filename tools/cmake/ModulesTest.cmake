@@ -2,8 +2,9 @@
 # library". Run as: cmake -DSOURCE_DIR=... -DWORK_DIR=... -DGENERATOR=... -P ModulesTest.cmake
 # Configures hapto's sources for the index alone where pkg-config finds nothing (no libusb-1.0,
 # no cpp-httplib) and meshoptimizer and Eigen are disabled, and checks that the build holds the
-# index and what it needs and nothing above it; then that the same environment does hide the
-# view's needs (configuring for the view fails, naming one). Configures only: nothing is built.
+# index and what it needs and nothing above it (built or installed); then that the same
+# environment does hide the view's needs (configuring for the view fails, naming one).
+# Configures only: nothing is built.
 cmake_minimum_required(VERSION 3.25)
 foreach(var SOURCE_DIR WORK_DIR GENERATOR)
   if(NOT DEFINED ${var})
@@ -33,6 +34,17 @@ endforeach()
 foreach(module devices runtime experiments view)
   if(ninja MATCHES "libhapto_${module}\\.a")
     message(FATAL_ERROR "-DHAPTO_MODULES=index builds hapto_${module} too")
+  endif()
+endforeach()
+# Its install holds those libraries' package and nothing that needs the others (the example,
+# the Falcon's udev rule, the hapto command).
+file(READ ${WORK_DIR}/index/cmake_install.cmake install_rules)
+if(NOT install_rules MATCHES "haptoTargets-index\\.cmake" OR install_rules MATCHES "haptoTargets-devices")
+  message(FATAL_ERROR "-DHAPTO_MODULES=index does not install exactly core, io, scenes and index")
+endif()
+foreach(needs_more "99-hapto-falcon\\.rules" "hapto/examples" "/bin/hapto")
+  if(install_rules MATCHES "${needs_more}")
+    message(FATAL_ERROR "-DHAPTO_MODULES=index installs ${needs_more}, which needs other modules")
   endif()
 endforeach()
 
