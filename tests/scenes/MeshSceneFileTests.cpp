@@ -327,7 +327,7 @@ TEST_CASE("duplicate triangles are dropped and counted, however their corners ar
     CHECK(mesh.triangles()[3] == TriangleIndices{1, 2, 3});
 }
 
-TEST_CASE("the README's inline mesh loads, and the README shows it as tested") {
+TEST_CASE("the user guide's inline mesh loads, and the guide shows it as tested") {
     const std::string object =
         R"({"id": 1, "shape": "mesh", "center": [0.05, 0, 0], "rotation": [1, 0, 0, 0], "scale": 0.01,
    "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
@@ -340,6 +340,7 @@ TEST_CASE("the README's inline mesh loads, and the README shows it as tested") {
         t.erase(std::remove_if(t.begin(), t.end(), ::isspace), t.end());
         return t;
     };
-    const std::string readme = test::readFile(std::string(HAPTO_SOURCE_DIR) + "/README.md");
+    const std::string readme =
+        test::readFile(std::string(HAPTO_SOURCE_DIR) + "/docs/guide/scenes.md");
     CHECK(squash(readme).find(squash(object)) != std::string::npos);
 }

@@ -18,7 +18,7 @@ using namespace hapto;
 
 namespace {
 
-// The exact example from README.md and the issue.
+// The exact example from the user guide (docs/guide/scenes.md) and the issue.
 const char* kReadmeExample = R"({"format": "hapto-scene", "version": 1,
  "bounds": {"min": [-0.125, -0.125, -0.125], "max": [0.125, 0.125, 0.125]},
  "objects": [
@@ -43,7 +43,7 @@ std::string withObject(const std::string& object) {
 
 } // namespace
 
-TEST_CASE("the README example loads with its defaults applied") {
+TEST_CASE("the user guide's scene example loads with its defaults applied") {
     const Scene s = parseScene(kReadmeExample, "example.json");
     REQUIRE(s.size() == 2);
     CHECK(s.bounds().min == Vec3(-0.125));
@@ -62,8 +62,9 @@ TEST_CASE("the README example loads with its defaults applied") {
     CHECK(sphere.rotation == Quat(1, 0, 0, 0));
 }
 
-TEST_CASE("the README shows the same example the tests load") {
-    const std::string readme = test::readFile(std::string(HAPTO_SOURCE_DIR) + "/README.md");
+TEST_CASE("the user guide shows the same scene example the tests load") {
+    const std::string readme =
+        test::readFile(std::string(HAPTO_SOURCE_DIR) + "/docs/guide/scenes.md");
     // Compare ignoring white space.
     auto squash = [](std::string s) {
         s.erase(std::remove_if(s.begin(), s.end(), ::isspace), s.end());

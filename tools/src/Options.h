@@ -2,8 +2,7 @@
 /// The command line's shared conventions: the checks numeric options go through, the options
 /// several commands share, and how help is laid out (wrapped, with examples, every depth).
 
-#include "hapto/index/IndexSpec.h"
-#include "hapto/scenes/Scene.h"
+#include "hapto/index/DefaultIndex.h" // defaultIndexSpec, sessionIndexSpec: what --index chooses
 
 #include <CLI/CLI.hpp>
 
@@ -45,7 +44,7 @@ CLI::Option* addNumberListOption(CLI::App* cmd, const std::string& name,
                                  std::vector<double>& values, std::size_t count, double lo,
                                  double hi, const std::string& help);
 
-/// The option conventions every command follows (README, "Commands"): durations in seconds
+/// The option conventions every command follows (docs/guide/conventions.md): durations in seconds
 /// (`--duration S`), one servo rate `--rate HZ`, several `--rates HZ,HZ`, lists
 /// comma-separated, numbers read as numbers by CLI11, real-time scheduling asked for with
 /// `--realtime` and declined with `--no-realtime`, `--devices FILE` a device file, the view
@@ -66,18 +65,9 @@ CLI::Option* addRenamedOption(CLI::App* cmd, const std::string& oldName,
 CLI::App* addRenamedCommand(CLI::App* parent, const std::string& oldName,
                             const std::string& newSpelling);
 /// Adds `--index SPEC` (brute, grid:N, octree:M:MIN, optional :aabb); left empty when not
-/// given, for defaultIndexSpec to choose. [control]
+/// given, for the library's defaultIndexSpec (hapto/index/DefaultIndex.h) to choose; a
+/// session's index is then sessionIndexSpec(spec, scene, `--max-index-mb`). [control]
 CLI::Option* addIndexOption(CLI::App* cmd, std::string& spec);
-/// The index a session builds when `--index` is not given: the paper's octree:2:0.005 over
-/// boxes and spheres; over mesh triangles an octree of at most 8 items per leaf whose smallest
-/// leaf is the scene's median triangle's longest edge (two significant digits, within 0.1 to
-/// 5 mm), so that a leaf of a fine scan holds a few triangles rather than hundreds. [control]
-std::string defaultIndexSpec(const Scene& scene);
-/// The index a session over `scene` builds: `given` (an `--index` text) or, when it is empty,
-/// defaultIndexSpec(scene); at most `maxMegabytes` (`--max-index-mb`). Throws InputError for a
-/// bad `given`. [control]
-IndexSpec sessionIndexSpec(const std::string& given, const Scene& scene,
-                           std::uint64_t maxMegabytes);
 /// Adds `--max-index-mb MB`, the most memory an index build may take. [control]
 CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes);
 /// Adds `--wake-latency-us US` (0 or more; unset leaves `us` at -1): a CPU wake-latency

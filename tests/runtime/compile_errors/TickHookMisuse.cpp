@@ -1,7 +1,7 @@
 // Compiled (syntax only) by the "tick hook misuse" ctests, once per HAPTO_MISUSE: each misuse
 // must stop the compilation with TickHook's own message (tests/runtime/CMakeLists.txt), not
 // with "cannot convert '<brace-enclosed initializer list>' to 'const hapto::TickHook&'".
-// HAPTO_MISUSE=0 compiles: the forms README shows.
+// HAPTO_MISUSE=0 compiles: the forms the user guide shows (docs/guide/library.md).
 
 #include "hapto/runtime/Runtime.h"
 
