@@ -28,15 +28,15 @@ double triangleDistance2(const Vec3& p, const TriangleCorners& t) noexcept;
 /// unit normal crossed with it), points into a counter-clockwise triangle and is as long as
 /// the edge; length2[i] is its squared length (m^2).
 struct TriangleEdges {
-    std::array<Vec3, 3> inward{};
-    std::array<double, 3> length2{};
+    std::array<Vec3, 3> inward{};    ///< Edge i's inward vector, as long as the edge (m).
+    std::array<double, 3> length2{}; ///< Edge i's squared length (m^2).
 };
 /// The edges of triangle t with unit normal `normal`. [servo]
 TriangleEdges triangleEdges(const TriangleCorners& t, const Vec3& normal) noexcept;
 /// A triangle's corners and in-plane edges, as the tests below read them.
 struct TriangleGeometry {
-    TriangleCorners corners{};
-    TriangleEdges edges;
+    TriangleCorners corners{}; ///< The corners, counter-clockwise seen from outside (m).
+    TriangleEdges edges;       ///< The in-plane edges, from triangleEdges().
 };
 
 /// How far (m) p's projection onto the plane of triangle t lies outside the farthest of its

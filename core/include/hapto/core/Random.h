@@ -11,6 +11,7 @@ namespace hapto {
 /// xoshiro256** seeded through splitmix64. Not thread-safe: one per thread. [any thread]
 class Random {
 public:
+    /// A generator whose sequence is fixed by `seed` (the same seed, the same numbers).
     explicit Random(std::uint64_t seed) {
         for (auto& s : mState) {
             seed += 0x9E3779B97F4A7C15ull;

@@ -28,6 +28,7 @@ const char* injectedFaultName(InjectedFault fault) noexcept;
 /// while "disconnected", so a test can see what the runtime commanded.
 class FaultInjectingDevice : public Device {
 public:
+    /// Wraps `inner`, passing everything through until a fault is injected. [control]
     explicit FaultInjectingDevice(std::unique_ptr<Device> inner);
 
     /// Arms `fault` for the next read(). `durationNs` is how long a Disconnect lasts or a

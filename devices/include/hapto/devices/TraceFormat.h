@@ -118,6 +118,7 @@ struct TraceSample {
     bool hasAngularVelocity = false; ///< The device gave the angular velocity.
     bool missedDeadline = false;     ///< The tick's force came after its deadline (a miss).
 
+    /// Field by field, exactly (a replayed tick equals the recorded one bit for bit).
     bool operator==(const TraceSample&) const = default;
 };
 

@@ -33,6 +33,7 @@
 
 namespace hapto::experiments {
 
+/// The JSON the experiments write: nlohmann's, keys kept in the order they were added.
 using Json = nlohmann::ordered_json;
 
 /// The paper's three hand conditions, as simulated hand scripts.
@@ -131,11 +132,17 @@ void requireClear(const Scene& scene, const Vec3& point, double marginM, std::st
 
 /// One device's figures from one run, loads in percent of the period.
 struct LoadFigures {
-    double meanPct = 0, p50Pct = 0, p99Pct = 0, p999Pct = 0, maxPct = 0; ///< Load (%).
-    double tickNsP50 = 0, tickNsP999 = 0, tickNsMax = 0; ///< Wake-up to force written (ns).
-    double ticks = 0;                                    ///< Ticks run.
-    double missed = 0;                                   ///< Missed deadlines.
-    double missedPct = 0;                                ///< Missed deadlines, % of ticks.
+    double meanPct = 0;         ///< Mean load (%).
+    double p50Pct = 0;          ///< Median load (%).
+    double p99Pct = 0;          ///< p99 load (%).
+    double p999Pct = 0;         ///< p99.9 load (%).
+    double maxPct = 0;          ///< Largest load (%).
+    double tickNsP50 = 0;       ///< Median tick, wake-up to force written (ns).
+    double tickNsP999 = 0;      ///< p99.9 tick, wake-up to force written (ns).
+    double tickNsMax = 0;       ///< Longest tick, wake-up to force written (ns).
+    double ticks = 0;           ///< Ticks run.
+    double missed = 0;          ///< Missed deadlines.
+    double missedPct = 0;       ///< Missed deadlines, % of ticks.
     double lateWakeups = 0;     ///< Wake-ups later than 10 % of the period.
     double contactPct = 0;      ///< Ticks in contact, % of ticks.
     double candidatesMean = 0;  ///< Candidate slots the renderer examined per tick.

@@ -22,13 +22,15 @@ struct PlotSeries {
 
 /// One set of axes.
 struct PlotPanel {
-    std::string title;               ///< Above the panel.
-    std::string xLabel, yLabel;      ///< Axis labels, with units.
-    bool logX = false, logY = false; ///< Log scales (non-positive values are dropped).
-    std::vector<PlotSeries> series;  ///< The lines.
-    std::optional<double> limitY;    ///< A dashed horizontal line (e.g. 100 % load).
-    std::string limitTitle;          ///< Its legend text.
-    std::vector<double> xTics;       ///< A labelled tic at each of these x (empty: gnuplot's).
+    std::string title;              ///< Above the panel.
+    std::string xLabel;             ///< The x axis's label, with its unit.
+    std::string yLabel;             ///< The y axis's label, with its unit.
+    bool logX = false;              ///< Log x scale (non-positive values are dropped).
+    bool logY = false;              ///< Log y scale (non-positive values are dropped).
+    std::vector<PlotSeries> series; ///< The lines.
+    std::optional<double> limitY;   ///< A dashed horizontal line (e.g. 100 % load).
+    std::string limitTitle;         ///< Its legend text.
+    std::vector<double> xTics;      ///< A labelled tic at each of these x (empty: gnuplot's).
     std::vector<std::string> xTicLabels{}; ///< Text for each of xTics (empty: the numbers).
     /// Shaded x intervals [from, to] behind the lines (e.g. when a device was in contact).
     std::vector<std::pair<double, double>> spans{};
@@ -37,12 +39,12 @@ struct PlotPanel {
 
 /// A figure: panels side by side, or in a grid of `columns` columns.
 struct PlotSpec {
-    std::string name;  ///< File stem: NAME.gp, NAME.png, NAME.svg.
-    std::string title; ///< Figure title.
-    std::vector<PlotPanel> panels;
-    int panelWidthPx = 520; ///< Width of one panel (px).
-    int heightPx = 420;     ///< Height (px).
-    bool shareY = false;    ///< One y range for every panel (panels of the same quantity).
+    std::string name;              ///< File stem: NAME.gp, NAME.png, NAME.svg.
+    std::string title;             ///< Figure title.
+    std::vector<PlotPanel> panels; ///< The figure's panels, in layout order.
+    int panelWidthPx = 520;        ///< Width of one panel (px).
+    int heightPx = 420;            ///< Height (px).
+    bool shareY = false;           ///< One y range for every panel (panels of the same quantity).
     std::string unstableTitle = "unstable"; ///< Key text of the unstable mark.
     int columns = 0; ///< Panels per row (0: all in one row); the image grows by rows.
     bool png = true; ///< Draw NAME.png.

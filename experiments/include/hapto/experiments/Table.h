@@ -52,8 +52,11 @@ public:
     /// Appends a row with one cell per column. Throws std::logic_error otherwise.
     void add(std::vector<Cell> row);
 
+    /// The columns, in order.
     const std::vector<Column>& columns() const { return mColumns; }
+    /// The rows added, in order, one cell per column.
     const std::vector<std::vector<Cell>>& rows() const { return mRows; }
+    /// The number of rows.
     std::size_t size() const { return mRows.size(); }
     /// The index of a column by name; throws std::logic_error when there is none.
     std::size_t column(const std::string& name) const;

@@ -53,6 +53,7 @@ struct IndexSpec {
     /// The text form; parse(toString()) gives this spec back. [any thread]
     std::string toString() const;
 
+    /// Every field equal (the same text form and the same memory limit).
     bool operator==(const IndexSpec&) const = default;
 };
 

@@ -45,6 +45,7 @@ struct LocateResult {
 /// `--max-index-mb`.
 class IndexTooLargeError : public InputError {
 public:
+    /// The message names the index, its estimated size and the limit.
     using InputError::InputError;
 };
 

@@ -10,6 +10,7 @@ namespace hapto {
 /// Thrown only on control threads; the `hapto` command turns it into exit code 2.
 class InputError : public std::runtime_error {
 public:
+    /// `message` is the whole text shown to the user: what, where and what to do.
     explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };
 

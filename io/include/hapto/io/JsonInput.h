@@ -16,6 +16,7 @@
 
 namespace hapto::json {
 
+/// The JSON value type every reader here takes (nlohmann's).
 using Json = nlohmann::json;
 
 /// A JSON path such as `objects[12].half_extents[1]`, built only when a message needs it: each
@@ -63,7 +64,7 @@ std::string typeName(const Json& j);
 /// "1e+06", but "100.0000001"), so a value just past a limit never reads as the limit.
 std::string show(double v);
 /// Text for messages and figures: control characters, DEL and bytes that are not UTF-8 written
-/// as escapes (\n, \t, \r, \xHH), so a name or a file's bytes cannot break a line or a
+/// as escapes (`\n`, `\t`, `\r`, `\xHH`), so a name or a file's bytes cannot break a line or a
 /// terminal. [any thread]
 std::string printable(std::string_view text);
 /// A value for messages: a scalar as JSON text (a long string cut short), an array or object

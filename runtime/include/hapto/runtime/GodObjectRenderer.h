@@ -113,11 +113,11 @@ public:
         /// Pose of a touched object at the end of the last tick, to carry the proxy when it
         /// moves.
         struct ContactPose {
-            ObjectId id = 0;
-            Vec3 center{0.0};
-            Quat rotation{1, 0, 0, 0};
+            ObjectId id = 0;           ///< The touched object.
+            Vec3 center{0.0};          ///< Its centre then (m).
+            Quat rotation{1, 0, 0, 0}; ///< Its orientation then.
         };
-        std::array<ContactPose, kMaxContacts> contactPoses{};
+        std::array<ContactPose, kMaxContacts> contactPoses{}; ///< One per last tick's contact.
     };
     /// The state that the next update() starts from. [servo]
     const State& state() const noexcept { return mState; }

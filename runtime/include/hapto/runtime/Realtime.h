@@ -35,11 +35,12 @@ RealtimeGrant makeCurrentThreadRealtime(int priority, int cpu);
 /// (Documentation/power/pm_qos_interface.rst, "From user space"): a process that holds
 /// /dev/cpu_dma_latency open has a request registered; writing an s32 sets its value; closing
 /// the file removes it. With 0, the cpuidle governor picks only states that wake at once (on
-/// this VM's haltpoll driver: POLL, never the halt that exits to the host), as cyclictest does
-/// by default. The price: idle CPUs spin instead of sleeping, on every core, while it is held.
+/// a virtual machine's haltpoll driver: POLL, never the halt that exits to the host), as cyclictest
+/// does by default. The price: idle CPUs spin instead of sleeping, on every core, while it is held.
 /// Move-only. [control]
 class WakeLatencyHold {
 public:
+    /// The kernel's CPU latency request file (PM QoS).
     static constexpr std::string_view kDefaultPath = "/dev/cpu_dma_latency";
 
     WakeLatencyHold() = default;
@@ -48,7 +49,9 @@ public:
     /// on an I/O error.
     explicit WakeLatencyHold(std::int32_t us, std::string_view path = kDefaultPath);
     ~WakeLatencyHold();
+    /// Takes over `other`'s request; `other` then holds none.
     WakeLatencyHold(WakeLatencyHold&& other) noexcept;
+    /// Releases this request, then takes over `other`'s.
     WakeLatencyHold& operator=(WakeLatencyHold&& other) noexcept;
     WakeLatencyHold(const WakeLatencyHold&) = delete;
     WakeLatencyHold& operator=(const WakeLatencyHold&) = delete;

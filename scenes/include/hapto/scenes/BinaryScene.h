@@ -65,8 +65,9 @@ namespace hapto {
 inline constexpr std::string_view kBinarySceneMagic{"HAPTOSCN", 8};
 /// The binary scene format version this build reads and writes.
 inline constexpr std::uint32_t kBinarySceneVersion = 1;
-/// Header and object record sizes (bytes).
+/// Header size (bytes).
 inline constexpr std::uint32_t kBinarySceneHeaderBytes = 96;
+/// Object record size (bytes).
 inline constexpr std::uint32_t kBinarySceneRecordBytes = 112;
 
 /// True when `bytes` start with the binary scene magic. [any thread]

@@ -43,12 +43,14 @@ std::string_view meshShapeName(MeshShape shape);
 /// Parses a shape name; nullopt for anything else. [any thread]
 std::optional<MeshShape> parseMeshShape(std::string_view name);
 
-/// The fewest and most triangles a generator is asked for.
+/// The fewest triangles a generator is asked for.
 inline constexpr std::size_t kMinGeneratedTriangles = 100;
+/// The most triangles a generator is asked for.
 inline constexpr std::size_t kMaxGeneratedTriangles = 10'000'000;
 
 /// What to generate.
 struct MeshOptions {
+    /// Sphere, torus or terrain.
     MeshShape shape = MeshShape::Sphere;
     std::size_t triangles = 1000; ///< N, the triangles asked for (see the design note).
     double size = 0.1;            ///< Extent along x (m): the sphere's diameter, the torus's

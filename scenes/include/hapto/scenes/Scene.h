@@ -32,14 +32,14 @@ struct TriangleRef {
 /// the scene is made or the object moves (on the control thread, never in a tick), so that no
 /// tick turns a quaternion into a matrix or recomputes a bounding radius. 128 bytes.
 struct RenderBody {
-    Vec3 center{0.0};      ///< Box, sphere: the centre; mesh: its local origin (m, world).
-    Vec3 halfExtents{0.0}; ///< Box: half size per own axis; sphere: the radius, thrice; mesh:
-                           ///< unused (zero) (m).
-    Mat3 axes{1.0};        ///< The rotation as a matrix: column i is own axis i (world). A
-                           ///< sphere's is the identity.
-    double radius = 0.0;   ///< Bounding sphere about `center` (m): SceneObject::radius().
-    Shape shape = Shape::Box;
-    bool axisAligned = true; ///< `axes` is exactly the identity: local = p - center, no product.
+    Vec3 center{0.0};         ///< Box, sphere: the centre; mesh: its local origin (m, world).
+    Vec3 halfExtents{0.0};    ///< Box: half size per own axis; sphere: the radius, thrice; mesh:
+                              ///< unused (zero) (m).
+    Mat3 axes{1.0};           ///< The rotation as a matrix: column i is own axis i (world). A
+                              ///< sphere's is the identity.
+    double radius = 0.0;      ///< Bounding sphere about `center` (m): SceneObject::radius().
+    Shape shape = Shape::Box; ///< Box, sphere or mesh triangle.
+    bool axisAligned = true;  ///< `axes` is exactly the identity: local = p - center, no product.
 
     /// A box's or sphere's oriented box (SceneObject::obb(), bit for bit). [any thread]
     Obb obb() const noexcept { return {center, halfExtents, axes}; }
@@ -137,6 +137,7 @@ public:
     /// the 25 cm cube around the origin when there are no objects. [any thread]
     static Aabb defaultBounds(std::span<const SceneObject> objects);
 
+    /// The same objects in the same order and the same bounds.
     bool operator==(const Scene& o) const {
         return mObjects == o.mObjects && mBounds.min == o.mBounds.min &&
                mBounds.max == o.mBounds.max;

@@ -1,5 +1,5 @@
 #pragma once
-/// Scene files: the versioned JSON format "hapto-scene" (documented in README.md).
+/// Scene files: the versioned JSON format "hapto-scene" (documented in docs/guide/scenes.md).
 
 #include "hapto/scenes/Scene.h"
 

@@ -39,6 +39,7 @@ struct Material {
     double staticFriction = 0.0;          ///< Coulomb static coefficient mu_s (unitless), >= 0.
     double dynamicFriction = 0.0;         ///< Coulomb dynamic coefficient mu_d, 0 <= mu_d <= mu_s.
 
+    /// Every coefficient equal.
     bool operator==(const Material&) const = default;
 };
 
@@ -70,6 +71,7 @@ struct SceneObject {
     /// for tools and tests, not for the servo path. [any thread]
     bool contains(const Vec3& p) const;
 
+    /// Every field equal (a mesh compared by its pointer: the same loaded mesh).
     bool operator==(const SceneObject&) const = default;
 };
 
