@@ -23,6 +23,10 @@ std::string_view sessionEndName(SessionEnd end) {
     return "?";
 }
 
+bool runsOnStepClock(DeviceKind kind) {
+    return kind == DeviceKind::Sim || kind == DeviceKind::Replay || kind == DeviceKind::Scripted;
+}
+
 Session::Session(Runtime& runtime, SessionOptions options)
     : mRuntime(runtime), mOptions(std::move(options)) {}
 
@@ -56,7 +60,7 @@ std::size_t Session::start() {
 
 double Session::timeS() const {
     if (mOptions.steppedClock) {
-        return 1e-9 * static_cast<double>(mOptions.steppedClock->nowNs() - mSteppedT0Ns);
+        return static_cast<double>(mOptions.steppedClock->nowNs() - mSteppedT0Ns) / 1e9;
     }
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - mWallT0).count();
 }

@@ -39,6 +39,11 @@ enum class SessionEnd : std::uint8_t {
 /// "duration", "requested", "finished", "none running". [any thread]
 std::string_view sessionEndName(SessionEnd end);
 
+/// True for the device kinds a session in step mode can drive: those whose time the session
+/// gives them (simulated hands, replays, scripted test devices). A Falcon or PHANToM keeps real
+/// time: stepped, it would be read as fast as the machine goes, not at its rate. [any thread]
+bool runsOnStepClock(DeviceKind kind);
+
 /// A caller's work in one control step, at session time `tS` (s, 0 at Session::start()),
 /// after the world's upkeep: return false to end the session. [control]
 using ControlStep = std::function<bool(double tS)>;
