@@ -15,9 +15,11 @@
 #include "hapto/index/IndexSpec.h"
 #include "hapto/io/InputError.h"
 #include "hapto/io/OutputFile.h"
+#include "hapto/runtime/DeviceFile.h"
 #include "hapto/runtime/GraspController.h"
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Runtime.h"
+#include "hapto/runtime/Session.h"
 #include "hapto/scenes/Generators.h"
 
 #include <nlohmann/json.hpp>
@@ -26,7 +28,6 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <thread>
 
 namespace hapto::cli {
 namespace {
@@ -68,40 +69,13 @@ std::vector<DeviceConfig> graspHands(ObjectId object) {
 // (a Falcon or PHANToM would be read as fast as the machine goes, not at its rate).
 void checkSteppable(const std::vector<DeviceConfig>& configs) {
     for (const DeviceConfig& c : configs) {
-        if (c.kind != DeviceKind::Sim && c.kind != DeviceKind::Replay) {
+        if (!runsOnStepClock(c.kind)) {
             throw InputError("--stepped: device '" + c.name + "' is a " +
                              std::string(name(c.kind)) +
                              "; only simulated hands (sim) and replays run on the step clock");
         }
     }
 }
-
-// The control loop's milliseconds. On the wall clock a step sleeps until its millisecond
-// while the servo threads run on their own; stepped (--stepped), it first runs the servo ticks
-// due in its millisecond on this thread (Runtime::runUntil), so the session's outcome is the
-// same every run however busy the machine is.
-class ControlClock {
-public:
-    ControlClock(Runtime& runtime, ManualClock* stepped)
-        : mRuntime(runtime), mStepped(stepped), mT0Ns(stepped ? stepped->nowNs() : 0) {}
-    /// Runs or waits for the next millisecond; returns the session's time then (s).
-    double next() {
-        if (mStepped) {
-            mRuntime.runUntil(mStepped->nowNs() + 1'000'000);
-            return 1e-9 * static_cast<double>(mStepped->nowNs() - mT0Ns);
-        }
-        mNext += std::chrono::milliseconds(1);
-        std::this_thread::sleep_until(mNext);
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - mWallT0).count();
-    }
-
-private:
-    Runtime& mRuntime;
-    ManualClock* mStepped;
-    std::uint64_t mT0Ns;
-    std::chrono::steady_clock::time_point mWallT0 = std::chrono::steady_clock::now();
-    std::chrono::steady_clock::time_point mNext = mWallT0;
-};
 
 // Per device: what the hand felt while the object was held.
 struct Felt {
@@ -110,6 +84,22 @@ struct Felt {
     double verticalSumN = 0;
     std::uint64_t samples = 0;
 };
+
+// While the object is held: what each hand feels, the grasp axis from left to right.
+void feel(const Runtime& runtime, Felt (&felt)[2]) {
+    ContactReport c[2];
+    if (!runtime.lastTick(0, c[0]) || !runtime.lastTick(1, c[1])) {
+        return;
+    }
+    const Vec3 axis = glm::normalize(c[1].devicePoint - c[0].devicePoint);
+    for (int i = 0; i < 2; ++i) {
+        const double sign = i == 0 ? -1.0 : 1.0; // left is pushed to -axis
+        felt[i].maxForceN = std::max(felt[i].maxForceN, glm::length(c[i].force));
+        felt[i].squeezeSumN += sign * glm::dot(c[i].force, axis);
+        felt[i].verticalSumN += c[i].force.y;
+        ++felt[i].samples;
+    }
+}
 
 // After the session: where the object ended, whether the rebuilt index finds it there, what
 // each hand felt, the force each device was left with; the JSON report when asked for.
@@ -224,8 +214,9 @@ void reportDemo(const DemoArgs& a, const Scene& scene, const World& world, const
 
 int runDemo(const DemoArgs& a) {
     StopSignals signals; // before any thread starts; see `hapto run`
-    std::vector<DeviceConfig> configs =
-        a.devices.empty() ? graspHands(a.object) : loadDeviceConfigFile(a.devices);
+    DeviceFile file =
+        a.devices.empty() ? DeviceFile{graspHands(a.object), {}} : loadDeviceFile(a.devices);
+    std::vector<DeviceConfig>& configs = file.devices;
     if (configs.size() != 2) {
         throw InputError(a.devices +
                          ": the grasp demo takes exactly two devices (left, right), got " +
@@ -251,8 +242,9 @@ int runDemo(const DemoArgs& a) {
     signals.endStartUp(); // a signal from now on stops the demo in order
     std::vector<RuntimeDevice> devices;
     std::vector<SimDevice*> sims;
-    for (const DeviceConfig& c : configs) {
-        RuntimeDevice rd{makeDevice(c, scene), c, nullptr};
+    for (std::size_t i = 0; i < configs.size(); ++i) {
+        const DeviceConfig& c = configs[i];
+        RuntimeDevice rd{makeDevice(c, scene), c, nullptr, file.renderingOf(i)};
         sims.push_back(dynamic_cast<SimDevice*>(rd.device.get()));
         devices.push_back(std::move(rd));
     }
@@ -270,8 +262,17 @@ int runDemo(const DemoArgs& a) {
         "hapto demo grasp: object %u at (%.3f, %.3f, %.3f) m, %u objects, devices %s + %s\n",
         a.object, startPosition.x, startPosition.y, startPosition.z, scene.size(),
         configs[0].name.c_str(), configs[1].name.c_str());
-    if ((a.stepped ? runtime.startStepped(clock) : runtime.start()) != 2) {
-        runtime.stop();
+    // A control step every millisecond: on the wall clock it sleeps while the servo threads run
+    // on their own; stepped (--stepped), it first runs the servo ticks due in its millisecond
+    // on this thread, so the session's outcome is the same every run however busy the machine
+    // is.
+    SessionOptions control;
+    control.controlPeriodNs = 1'000'000;
+    control.steppedClock = a.stepped ? &clock : nullptr;
+    control.stopRequested = [&signals] { return signals.requested(); };
+    Session session(runtime, std::move(control));
+    if (session.start() != 2) {
+        session.stop();
         throw std::runtime_error(
             "a device could not be opened: " + runtime.report().devices[0].fault + " " +
             runtime.report().devices[1].fault);
@@ -281,11 +282,8 @@ int runDemo(const DemoArgs& a) {
     // Until both scripts are done (simulated hands) or 12 s of session time, plus a second to
     // settle.
     Felt felt[2];
-    ControlClock control(runtime, a.stepped ? &clock : nullptr);
     GraspState last = GraspState::Idle;
-    for (;;) {
-        const double t = control.next();
-        runtime.maintain();
+    session.run([&](double t) {
         grasp.step(0.001);
         view.update(world);
         if (grasp.state() != last) {
@@ -298,28 +296,15 @@ int runDemo(const DemoArgs& a) {
             last = grasp.state();
         }
         if (grasp.state() == GraspState::Grasped) {
-            ContactReport c[2];
-            if (runtime.lastTick(0, c[0]) && runtime.lastTick(1, c[1])) {
-                const Vec3 axis = glm::normalize(c[1].devicePoint - c[0].devicePoint);
-                for (int i = 0; i < 2; ++i) {
-                    const double sign = i == 0 ? -1.0 : 1.0; // left is pushed to -axis
-                    felt[i].maxForceN = std::max(felt[i].maxForceN, glm::length(c[i].force));
-                    felt[i].squeezeSumN += sign * glm::dot(c[i].force, axis);
-                    felt[i].verticalSumN += c[i].force.y;
-                    ++felt[i].samples;
-                }
-            }
+            feel(runtime, felt);
         }
         // The servo threads own the scripts: read the phase they publish.
         const bool scriptsDone = sims[0] && sims[1] &&
                                  sims[0]->publishedPhase() == ScriptPhase::Done &&
                                  sims[1]->publishedPhase() == ScriptPhase::Done;
-        if ((scriptsDone && grasp.state() == GraspState::Idle && t > 1.0) || t > 12.0 ||
-            !runtime.anyRunning() || signals.requested()) {
-            break;
-        }
-    }
-    runtime.stop();
+        return !((scriptsDone && grasp.state() == GraspState::Idle && t > 1.0) || t > 12.0);
+    });
+    session.stop();
     view.stop();
     world.setRestDelay(std::chrono::nanoseconds(0));
     world.settle();

@@ -14,7 +14,9 @@
 #include "hapto/index/IndexSpec.h"
 #include "hapto/io/InputError.h"
 #include "hapto/io/OutputFile.h"
+#include "hapto/runtime/DeviceFile.h"
 #include "hapto/runtime/Runtime.h"
+#include "hapto/runtime/Session.h"
 
 #include <atomic>
 #include <chrono>
@@ -24,7 +26,6 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
-#include <thread>
 #include <unistd.h>
 
 namespace hapto::cli {
@@ -126,8 +127,9 @@ int runSession(const RunArgs& a) {
     // thread inherits the blocked stop signals and only the signal thread takes them.
     // Until endStartUp() below, a signal ends the process at once: nothing is open or written.
     StopSignals signals;
-    std::vector<DeviceConfig> configs =
-        a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
+    DeviceFile file =
+        a.devices.empty() ? DeviceFile{defaultDeviceConfigs(), {}} : loadDeviceFile(a.devices);
+    std::vector<DeviceConfig>& configs = file.devices;
     if (a.rateHz > 0) {
         for (DeviceConfig& c : configs) {
             c.rateHz = a.rateHz;
@@ -146,8 +148,9 @@ int runSession(const RunArgs& a) {
         std::filesystem::create_directories(a.record);
     }
     std::vector<RuntimeDevice> devices;
-    for (const DeviceConfig& c : configs) {
-        RuntimeDevice rd{makeDevice(c, scene), c, nullptr};
+    for (std::size_t i = 0; i < configs.size(); ++i) {
+        const DeviceConfig& c = configs[i];
+        RuntimeDevice rd{makeDevice(c, scene), c, nullptr, file.renderingOf(i)};
         if (!a.record.empty()) {
             TraceHeader header;
             header.rateHz = c.rateHz;
@@ -188,43 +191,35 @@ int runSession(const RunArgs& a) {
     std::snprintf(header, sizeof header, "hapto run: %zu devices, %u objects, index %s, %.1f s%s\n",
                   configs.size(), scene.size(), spec.toString().c_str(), a.durationS,
                   a.durationS <= 0 ? " (until Ctrl-C)" : "");
+    SessionOptions options;
+    options.durationS = a.durationS;
+    options.stopRequested = [&signals] { return signals.requested(); };
+    for (const auto& rec : recorders) {
+        options.recorders.push_back(rec.get());
+    }
+    Session session(runtime, std::move(options));
+    RunReport r;
     {
         // Everything for the terminal goes through its own thread while devices are driven: a
         // paused terminal blocks only that thread, never the session, its stop or its signals.
         LiveLines terminal(live ? &runtime : nullptr);
         terminal.say(header);
-        if (runtime.start() == 0) {
+        if (session.start() == 0) { // the recordings are abandoned: older traces stay
             std::string why;
             for (const DeviceReport& d : runtime.report().devices) {
                 why += "hapto run: " + d.name + ": " + d.fault + "\n";
             }
             terminal.say(why + "hapto run: no device could be opened\n");
-            for (auto& rec : recorders) {
-                rec->abandon(); // nothing recorded: an older trace of that name stays
-            }
             return 1;
         }
         view.start();
-        const auto start = std::chrono::steady_clock::now();
-        while (!signals.requested() && runtime.anyRunning()) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(5));
-            runtime.maintain();
+        session.run([&](double) {
             view.update(world);
-            for (auto& rec : recorders) {
-                rec->drain();
-            }
-            const auto now = std::chrono::steady_clock::now();
-            if (a.durationS > 0 && now - start >= std::chrono::duration<double>(a.durationS)) {
-                break;
-            }
-        }
-        runtime.stop(); // zero force on every device before anything else
+            return true;
+        });
+        r = session.stop(); // zero force on every device before anything else
         view.stop();
     }
-    for (auto& rec : recorders) {
-        rec->close();
-    }
-    const RunReport r = runtime.report();
     if (!a.report.empty()) {
         writeFileAtomically(a.report, reportToJson(r));
     }

@@ -14,19 +14,20 @@
 
 #include <hapto/devices/DeviceConfig.h>
 #include <hapto/devices/DeviceFactory.h>
+#include <hapto/index/DefaultIndex.h>
 #include <hapto/index/IndexSpec.h>
 #include <hapto/io/InputError.h>
+#include <hapto/runtime/DeviceFile.h>
 #include <hapto/runtime/GraspController.h>
 #include <hapto/runtime/ManualClock.h>
 #include <hapto/runtime/Realtime.h>
 #include <hapto/runtime/Runtime.h>
+#include <hapto/runtime/Session.h>
 #include <hapto/runtime/World.h>
 #include <hapto/scenes/Generators.h>
 
-#include <chrono>
 #include <cstdio>
 #include <string_view>
-#include <thread>
 
 using namespace hapto;
 
@@ -83,27 +84,30 @@ int main(int argc, char** argv) try {
         }
     }
 
-    // 1. The scene (metres, y up) and the world: one index, shared by every servo thread.
+    // 1. The scene (metres, y up) and the world: one index (the library's default for this
+    //    scene), shared by every servo thread.
     //    Stepped, the world's time is the program's clock too.
     const Scene scene = makeGraspScene();
     ManualClock clock;
-    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    World world(scene, IndexSpec::parse(defaultIndexSpec(scene)));
     if (stepped) {
         world.useClock(clock);
     }
 
-    // 2. The devices, from a file or in code.
-    const std::vector<DeviceConfig> configs =
-        deviceFile ? loadDeviceConfigFile(deviceFile) : simulatedHands();
+    // 2. The devices, from a file (with their force effects and renderer settings) or in code.
+    const DeviceFile file =
+        deviceFile ? loadDeviceFile(deviceFile) : DeviceFile{simulatedHands(), {}};
+    const std::vector<DeviceConfig>& configs = file.devices;
     if (configs.size() != 2) {
         throw InputError(std::string(deviceFile) + ": two devices, please (left and right hands)");
     }
     std::vector<RuntimeDevice> devices;
-    for (const DeviceConfig& config : configs) {
-        if (stepped && config.kind != DeviceKind::Sim && config.kind != DeviceKind::Replay) {
+    for (std::size_t i = 0; i < configs.size(); ++i) {
+        const DeviceConfig& config = configs[i];
+        if (stepped && !runsOnStepClock(config.kind)) {
             throw InputError("--stepped: device '" + config.name + "' keeps real time");
         }
-        devices.push_back({makeDevice(config, scene), config, nullptr});
+        devices.push_back({makeDevice(config, scene), config, nullptr, file.renderingOf(i)});
     }
 
     // 3. One servo thread per device; grasping runs here, on the control thread, which must
@@ -122,33 +126,34 @@ int main(int argc, char** argv) try {
     runtime.setTickHook(0, {&feelTheOtherHand, &leftFeelsRight});
     runtime.setTickHook(1, {&feelTheOtherHand, &rightFeelsLeft});
     GraspController grasp(world, runtime, 0, 1);
-    if ((stepped ? runtime.startStepped(clock) : runtime.start()) != configs.size()) {
+
+    // 4. The session: a control step every millisecond grasps, carries, releases (the watchdog
+    //    runs on the runtime's own thread). On the wall clock a step sleeps while the servo
+    //    threads run; stepped, it first runs the servo ticks due in its millisecond. The grasp
+    //    scripts take about 9 s of device time: 9500 ticks of the first device.
+    SessionOptions options;
+    options.controlPeriodNs = 1'000'000;
+    options.steppedClock = stepped ? &clock : nullptr;
+    Session session(runtime, options);
+    if (session.start() != configs.size()) {
         std::fprintf(stderr, "two_hands: a device did not open\n");
         return 1;
     }
     const Vec3 start = scene.object(0).center;
-    // The grasp scripts take about 9 s of device time: 9500 ticks of the first device. Each
-    // control step is a millisecond: on the wall clock it sleeps while the servo threads run;
-    // stepped, it first runs the servo ticks due in its millisecond.
-    while (runtime.metrics(0).ticks.load() < 9500 && runtime.anyRunning()) {
-        if (stepped) {
-            runtime.runUntil(clock.nowNs() + 1'000'000);
-        } else {
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        }
-        runtime.maintain(); // world upkeep (the watchdog runs on the runtime's own thread)
-        grasp.step(0.001);  // grasp, carry, release, fall
-    }
+    session.run([&](double) {
+        grasp.step(0.001); // grasp, carry, release, fall
+        return runtime.metrics(0).ticks.load() < 9500;
+    });
     const bool ranToTheEnd = runtime.metrics(0).ticks.load() >= 9500;
-    runtime.stop(); // every device at zero force
+    const RunReport& report = session.stop(); // every device at zero force
 
-    // 4. What happened.
+    // 5. What happened.
     const WorldSnapshot& now = world.current();
     const Vec3 end = now.scene->object(*now.scene->slotOf(0)).center;
     std::printf("cube moved from (%.3f, %.3f, %.3f) to (%.3f, %.3f, %.3f) m, held for %llu ms\n",
                 start.x, start.y, start.z, end.x, end.y, end.z,
                 static_cast<unsigned long long>(grasp.graspedSteps()));
-    for (const DeviceReport& d : runtime.report().devices) {
+    for (const DeviceReport& d : report.devices) {
         std::printf("%-6s %llu ticks, load p50 %.2f%%, p99.9 %.2f%%\n", d.name.c_str(),
                     static_cast<unsigned long long>(d.ticks), 100 * d.loadFraction.p50,
                     100 * d.loadFraction.p999);
