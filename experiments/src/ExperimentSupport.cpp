@@ -7,6 +7,7 @@
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/io/InputError.h"
 #include "hapto/runtime/HapticTick.h"
+#include "hapto/runtime/Session.h"
 
 #include <algorithm>
 #include <chrono>
@@ -290,16 +291,13 @@ SessionResult runSession(World& world, const std::vector<HandPlan>& hands,
     options.realtime = settings.realtime;
     options.reopenAfterNs = 0; // a fault spoils the measurement: the cell reports it
     Runtime runtime(world, std::move(devices), options);
-    if (runtime.start() > 0) {
-        const auto start = std::chrono::steady_clock::now();
-        const auto until = start + std::chrono::duration<double>(settings.durationS);
-        while (runtime.anyRunning() && std::chrono::steady_clock::now() < until) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(5));
-            runtime.maintain();
-        }
+    SessionOptions timed;
+    timed.durationS = settings.durationS;
+    Session session(runtime, timed);
+    if (session.start() > 0 && settings.durationS > 0) { // 0: no limit to the driver
+        session.run();
     }
-    runtime.stop();
-    result.report = runtime.report();
+    result.report = session.stop();
     return result;
 }
 
