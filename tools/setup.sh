@@ -2,7 +2,8 @@
 # hapto's one set-up script. On a fresh Debian 12 machine (root, apt reachable) it installs
 # what is missing, builds, and then:
 #   tools/setup.sh main   runs the main job: a two-device simulated session over the
-#                         embedded default scene, printing each device's haptic load;
+#                         embedded default scene, printing each device's haptic load
+#                         (installs and builds only what the `hapto` command needs);
 #   tools/setup.sh test   runs the whole test suite through ctest: in the release build, then
 #                         under AddressSanitizer + UBSan (asan) and ThreadSanitizer (tsan).
 # Both are idempotent: a second run installs nothing and rebuilds only what changed.
@@ -15,13 +16,20 @@ case "$mode" in
   *) echo "usage: tools/setup.sh main|test [extra arguments for hapto run]" >&2; exit 2 ;;
 esac
 
-packages=(
-  build-essential cmake ninja-build pkg-config git
-  libtbb-dev libglm-dev libeigen3-dev catch2 libusb-1.0-0-dev libcli11-dev nlohmann-json3-dev
-  gnuplot-nox libbenchmark-dev libbullet-dev libfcl-dev libboost-dev
-  umockdev libumockdev-dev libglib2.0-dev libassimp-dev libsimdjson-dev
-  libcpp-httplib-dev libmeshoptimizer-dev libjs-three chromium python3
+# The main job needs only what the `hapto` command links; the test suite needs the test and
+# benchmark libraries, the references (Bullet, FCL, Boost), umockdev for the Falcon's USB tests,
+# gnuplot for plots, three.js and Chromium for the view's page, Doxygen for the API reference.
+main_packages=(
+  build-essential cmake ninja-build pkg-config
+  libtbb-dev libglm-dev libeigen3-dev libusb-1.0-0-dev libcli11-dev nlohmann-json3-dev
+  libassimp-dev libsimdjson-dev libcpp-httplib-dev libmeshoptimizer-dev
 )
+test_packages=(
+  git catch2 gnuplot-nox libbenchmark-dev libbullet-dev libfcl-dev libboost-dev
+  umockdev libumockdev-dev libglib2.0-dev libjs-three chromium python3 doxygen
+)
+packages=("${main_packages[@]}")
+[ "$mode" = test ] && packages+=("${test_packages[@]}")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'ok installed' || missing+=("$p")
@@ -43,8 +51,9 @@ build() {
 
 case "$mode" in
   main)
-    build release
-    exec build/release/tools/hapto run "$@"
+    # Only the `hapto` command (the main preset: no tests, no benchmarks; build/main).
+    build main
+    exec build/main/tools/hapto run "$@"
     ;;
   test)
     for preset in release asan tsan; do
