@@ -504,16 +504,6 @@ Json scalingJson(const ScalingSetup& setup, const ScalingResults& results, const
     return j;
 }
 
-/// Draws `spec` into `out`, adding the files to `plots`; a plot that cannot be drawn is noted.
-void drawInto(const std::filesystem::path& out, const PlotSpec& spec, Progress& progress,
-              std::vector<std::filesystem::path>& plots) {
-    const PlotResult pr = drawPlot(out, spec);
-    if (!pr.problem.empty()) {
-        progress.note("hapto experiment: plot skipped: " + pr.problem);
-    }
-    plots.insert(plots.end(), pr.files.begin(), pr.files.end());
-}
-
 /// devices-load: total load and the worst device's p99.9 and p50 against the device count, a
 /// series per rate, rings where a cell was unstable.
 PlotSpec scalingPlot(const ScalingSetup& setup, const std::vector<ScalingRow>& rows,
@@ -673,9 +663,9 @@ std::string writeScalingFiles(const std::filesystem::path& out, const ScalingSet
               scalingJson(setup, results, scaling, perDevice, cursor).dump(2) + "\n");
 
     std::vector<std::filesystem::path> plots;
-    drawInto(out, scalingPlot(setup, results.rows, counts), progress, plots);
+    drawPlotNoting(out, scalingPlot(setup, results.rows, counts), progress, plots);
     if (!cursors.empty()) {
-        drawInto(out, cursorPlot(setup, cursors), progress, plots);
+        drawPlotNoting(out, cursorPlot(setup, cursors), progress, plots);
     }
 
     std::string md = scalingMarkdown(setup, results, scaling) + cursorMarkdown(setup, cursors);

@@ -95,46 +95,37 @@ int runMeshes(const MeshesArgs& args) {
 
     std::string md = "## Load against triangle count: one " +
                      std::string(meshShapeName(args.shape)) + " of " + fmt(args.sizeM, 3) +
-                     " m\n\n"
-                     "Load = wake-up to force written, % of the servo period: p50 / p99.9 / max,"
-                     " median of " +
-                     std::to_string(args.common.repeats) + " run(s) of " +
-                     fmt(args.common.durationS, 2) +
-                     " s. UNSTABLE: " + std::string(tailName(options.servo.tail)) +
-                     " >= 100 % or > 0.1 % deadlines missed. A renderer stops growing after its "
-                     "first unstable size, and a cell whose probed tick takes more than 10 "
-                     "periods is skipped: that is what caps brute force.\n";
+                     " m\n\n" +
+                     loadNote(args.common, options.servo.tail, ": p50 / p99.9 / max,", "") +
+                     " A renderer stops growing after its first unstable size, and a cell whose "
+                     "probed tick takes more than 10 periods is skipped: that is what caps brute "
+                     "force.\n";
     md += "\n" + platformNote(rows, args.verdict);
-    for (const double rate : args.ratesHz) {
-        for (const SweepRenderer& r : renderers) {
-            std::vector<std::vector<std::string>> table;
-            for (const SweepStep& step : steps) {
-                std::vector<std::string> line{std::to_string(step.objects)};
-                std::string build = "-";
-                bool any = false;
-                for (const Condition c : kConditions) {
-                    std::string cell = "-";
-                    for (const SweepRow& row : rows) {
-                        if (row.renderer == r.name && row.rateHz == rate && row.size == step.size &&
-                            row.condition == c) {
-                            cell = loadCell(row);
-                            if (!row.skipped) {
-                                build = fmt(row.buildS, 3) + " s, " + fmt(row.indexMb, 1) + " MB";
-                            }
-                            any = true;
-                        }
-                    }
-                    line.push_back(cell);
+    const auto lines = [&](const SweepRenderer& r, double rate) {
+        std::vector<std::vector<std::string>> table;
+        for (const SweepStep& step : steps) {
+            std::vector<std::string> line{std::to_string(step.objects)};
+            std::string build = "-";
+            bool any = false;
+            for (const Condition c : kConditions) {
+                const SweepRow* row = findSweepRow(rows, r.name, rate, step.size, args.seed, c);
+                line.push_back(row ? loadCell(*row) : "-");
+                if (row && !row->skipped) {
+                    build = fmt(row->buildS, 3) + " s, " + fmt(row->indexMb, 1) + " MB";
                 }
-                line.push_back(build);
-                if (any) {
-                    table.push_back(line);
-                }
+                any = any || row;
             }
-            md += "\n### " + r.name + " (" + r.spec.toString() + "), " + rateText(rate) + "\n\n";
-            md += markdownTable(
-                {"# triangles", "no touch", "touch", "sliding", "index build, memory"}, table);
+            line.push_back(build);
+            if (any) {
+                table.push_back(line);
+            }
         }
+        return table;
+    };
+    for (const double rate : args.ratesHz) {
+        md += rendererTables(renderers, rate,
+                             {"# triangles", "no touch", "touch", "sliding", "index build, memory"},
+                             "", lines);
     }
     md += "\n### Max stable triangles per renderer\n\n" +
           limitsTable(renderers, args.ratesHz, rows, args.verdict, "triangles asked");

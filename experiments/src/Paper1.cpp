@@ -91,39 +91,28 @@ int runPaper1(const Paper1Args& args) {
                                        args.verdict, "per_side", progress);
 
     // Tables.
-    std::string md = "## Experiment 1: K x K x K lattices of 5 cm cubes\n\n"
-                     "Load = wake-up to force written, % of the servo period: p50 / p99.9 / max,"
-                     " median of " +
-                     std::to_string(args.common.repeats) + " run(s) of " +
-                     fmt(args.common.durationS, 2) +
-                     " s. UNSTABLE: " + std::string(tailName(options.servo.tail)) +
-                     " >= 100 % or > 0.1 % deadlines missed.\n";
+    std::string md = "## Experiment 1: K x K x K lattices of 5 cm cubes\n\n" +
+                     loadNote(args.common, options.servo.tail, ": p50 / p99.9 / max,", "") + "\n";
     md += "\n" + platformNote(rows, args.verdict);
-    for (const double rate : args.ratesHz) {
-        for (const SweepRenderer& r : renderers) {
-            std::vector<std::vector<std::string>> table;
-            for (const SweepStep& step : steps) {
-                std::vector<std::string> line{std::to_string(step.objects),
-                                              std::to_string(step.size)};
-                bool any = false;
-                for (const Condition c : kConditions) {
-                    std::string cell = "-";
-                    for (const SweepRow& row : rows) {
-                        if (row.renderer == r.name && row.rateHz == rate && row.size == step.size &&
-                            row.condition == c) {
-                            cell = loadCell(row);
-                            any = true;
-                        }
-                    }
-                    line.push_back(cell);
-                }
-                if (any) {
-                    table.push_back(line);
-                }
+    const auto lines = [&](const SweepRenderer& r, double rate) {
+        std::vector<std::vector<std::string>> table;
+        for (const SweepStep& step : steps) {
+            std::vector<std::string> line{std::to_string(step.objects), std::to_string(step.size)};
+            bool any = false;
+            for (const Condition c : kConditions) {
+                const SweepRow* row = findSweepRow(rows, r.name, rate, step.size, 0, c);
+                line.push_back(row ? loadCell(*row) : "-");
+                any = any || row;
             }
-            md += "\n### " + r.name + " (" + r.spec.toString() + "), " + rateText(rate) + "\n\n";
-            md += markdownTable({"# objects", "K", "no touch", "touch", "sliding"}, table);
+            if (any) {
+                table.push_back(line);
+            }
         }
+        return table;
+    };
+    for (const double rate : args.ratesHz) {
+        md += rendererTables(renderers, rate, {"# objects", "K", "no touch", "touch", "sliding"},
+                             "", lines);
     }
     md += "\n### Max stable objects per renderer\n\n" +
           limitsTable(renderers, args.ratesHz, rows, args.verdict, "K");

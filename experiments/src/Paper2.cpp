@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 
 namespace hapto::experiments {
 namespace {
@@ -33,19 +34,16 @@ std::string p999Cell(const SweepRow* row) {
     return cell;
 }
 
-} // namespace
-
-int runPaper2(const Paper2Args& args) {
-    const std::filesystem::path out = prepareOutDir(args.common.out);
-    const std::vector<SweepRenderer> renderers = {
-        {"standard", IndexSpec::brute(), "20 (50 unstable)"},
-        {"grid 2x2x2", IndexSpec::grid(2), "100 (unstable when sliding)"},
-        {"grid 5x5x5", IndexSpec::grid(5), "200"},
-        {"octree M=2", IndexSpec::octree(2, 0.005), "200 (and some 500-object scenes)"},
-    };
-    std::vector<std::size_t> counts = args.counts;
+/// The counts asked for, sorted, each once.
+std::vector<std::size_t> sortedCounts(std::vector<std::size_t> counts) {
     std::sort(counts.begin(), counts.end());
     counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
+    return counts;
+}
+
+/// One step per count: scenes of seeds 1..seeds, the hand at the centre the generator keeps
+/// clear; the Table 2 renderers always run at the Table 2 count.
+std::vector<SweepStep> paper2Steps(const Paper2Args& args, const std::vector<std::size_t>& counts) {
     std::vector<SweepStep> steps;
     const double keepClear = args.keepClearM;
     for (const std::size_t n : counts) {
@@ -71,6 +69,88 @@ int runPaper2(const Paper2Args& args) {
         }
         steps.push_back(std::move(step));
     }
+    return steps;
+}
+
+/// The analogue of the paper's Table 2 at one rate: per seed, the p99.9 load of the grid 5x5x5
+/// and the octree in each condition.
+std::string table2(const std::vector<SweepRow>& rows, double rate, int seeds) {
+    std::vector<std::vector<std::string>> t2;
+    for (int s = 1; s <= seeds; ++s) {
+        std::vector<std::string> line{std::to_string(s)};
+        for (const char* r : {kTable2Grid, kTable2Octree}) {
+            for (const Condition c : kConditions) {
+                line.push_back(p999Cell(findSweepRow(rows, r, rate, int{kTable2Count},
+                                                     static_cast<std::uint64_t>(s), c)));
+            }
+        }
+        t2.push_back(line);
+    }
+    return "\n### Table 2 analogue: " + std::to_string(kTable2Count) +
+           "-object scenes, p99.9 load, " + rateText(rate) + "\n\n" +
+           markdownTable({"scene (seed)", "grid no touch", "grid touch", "grid sliding",
+                          "octree no touch", "octree touch", "octree sliding"},
+                         t2);
+}
+
+/// One count's cell of a renderer's table: the median over the scenes' p99.9 loads and how many
+/// scenes were stable ("skipped" when every scene was); nullopt when no scene was measured.
+std::optional<std::string> overScenesCell(const std::vector<SweepRow>& rows,
+                                          const std::string& renderer, double rate, std::size_t n,
+                                          int seeds, Condition c) {
+    std::vector<double> p999;
+    int stable = 0, measured = 0;
+    for (int s = 1; s <= seeds; ++s) {
+        if (const SweepRow* row = findSweepRow(rows, renderer, rate, static_cast<int>(n),
+                                               static_cast<std::uint64_t>(s), c)) {
+            ++measured;
+            stable += row->stable() ? 1 : 0;
+            if (!row->skipped) {
+                p999.push_back(row->median.p999Pct);
+            }
+        }
+    }
+    if (measured == 0) {
+        return std::nullopt;
+    }
+    const double m = median(p999);
+    return (p999.empty() ? std::string("skipped") : fmt(m, m < 10 ? 2 : 1) + "%") + " (" +
+           std::to_string(stable) + "/" + std::to_string(measured) + " stable)";
+}
+
+/// A renderer's table at one rate: a line per count it reached, a cell per condition.
+std::vector<std::vector<std::string>> overScenesLines(const std::vector<SweepRow>& rows,
+                                                      const std::vector<std::size_t>& counts,
+                                                      int seeds, const SweepRenderer& r,
+                                                      double rate) {
+    std::vector<std::vector<std::string>> table;
+    for (const std::size_t n : counts) {
+        std::vector<std::string> line{std::to_string(n)};
+        bool any = false;
+        for (const Condition c : kConditions) {
+            const std::optional<std::string> cell = overScenesCell(rows, r.name, rate, n, seeds, c);
+            line.push_back(cell.value_or("-"));
+            any = any || cell;
+        }
+        if (any) {
+            table.push_back(line);
+        }
+    }
+    return table;
+}
+
+} // namespace
+
+int runPaper2(const Paper2Args& args) {
+    const std::filesystem::path out = prepareOutDir(args.common.out);
+    const std::vector<SweepRenderer> renderers = {
+        {"standard", IndexSpec::brute(), "20 (50 unstable)"},
+        {"grid 2x2x2", IndexSpec::grid(2), "100 (unstable when sliding)"},
+        {"grid 5x5x5", IndexSpec::grid(5), "200"},
+        {"octree M=2", IndexSpec::octree(2, 0.005), "200 (and some 500-object scenes)"},
+    };
+    const std::vector<std::size_t> counts = sortedCounts(args.counts);
+    const std::vector<SweepStep> steps = paper2Steps(args, counts);
     const SweepOptions options = sweepOptionsOf("paper2", args);
 
     Progress progress("paper2", renderers.size() * args.ratesHz.size() * counts.size() *
@@ -82,86 +162,24 @@ int runPaper2(const Paper2Args& args) {
                                             {"seeds", args.seeds},
                                             {"workspace_m", kWorkspaceM},
                                             {"cube_m", kCubeM},
-                                            {"keep_clear_m", keepClear}},
+                                            {"keep_clear_m", args.keepClearM}},
                                        args.common, args.maxIndexMb, renderers, args.ratesHz, rows,
                                        args.verdict, "count", progress);
 
-    const auto find = [&](const std::string& renderer, double rate, std::size_t count,
-                          std::uint64_t seed, Condition c) -> const SweepRow* {
-        for (const SweepRow& row : rows) {
-            if (row.renderer == renderer && row.rateHz == rate && row.objects == count &&
-                row.seed == seed && row.condition == c) {
-                return &row;
-            }
-        }
-        return nullptr;
-    };
-
-    std::string md = "## Experiment 2: random scenes of 5 cm cubes in a 25 cm cube\n\n"
-                     "Load = wake-up to force written, % of the servo period; median of " +
-                     std::to_string(args.common.repeats) + " run(s) of " +
-                     fmt(args.common.durationS, 2) +
-                     " s per scene. UNSTABLE: " + std::string(tailName(options.servo.tail)) +
-                     " >= 100 % or > 0.1 % deadlines missed.\n";
+    std::string md = "## Experiment 2: random scenes of 5 cm cubes in a 25 cm cube\n\n" +
+                     loadNote(args.common, options.servo.tail, ";", " per scene") + "\n";
     md += "\n" + platformNote(rows, args.verdict);
+    const bool hasTable2 = std::find(counts.begin(), counts.end(), kTable2Count) != counts.end();
     for (const double rate : args.ratesHz) {
-        // Table 2: the 200-object scenes, grid 5x5x5 and octree, p99.9 load.
-        std::vector<std::vector<std::string>> t2;
-        for (int s = 1; s <= args.seeds; ++s) {
-            std::vector<std::string> line{std::to_string(s)};
-            for (const char* r : {kTable2Grid, kTable2Octree}) {
-                for (const Condition c : kConditions) {
-                    line.push_back(
-                        p999Cell(find(r, rate, kTable2Count, static_cast<std::uint64_t>(s), c)));
-                }
-            }
-            t2.push_back(line);
-        }
-        if (std::find(counts.begin(), counts.end(), kTable2Count) != counts.end()) {
-            md += "\n### Table 2 analogue: " + std::to_string(kTable2Count) +
-                  "-object scenes, p99.9 load, " + rateText(rate) + "\n\n";
-            md += markdownTable({"scene (seed)", "grid no touch", "grid touch", "grid sliding",
-                                 "octree no touch", "octree touch", "octree sliding"},
-                                t2);
+        if (hasTable2) {
+            md += table2(rows, rate, args.seeds);
         }
         // Per renderer: median over scenes of p99.9, and how many scenes were stable.
-        for (const SweepRenderer& r : renderers) {
-            std::vector<std::vector<std::string>> table;
-            for (const std::size_t n : counts) {
-                std::vector<std::string> line{std::to_string(n)};
-                bool any = false;
-                for (const Condition c : kConditions) {
-                    std::vector<double> p999;
-                    int stable = 0, measured = 0;
-                    for (int s = 1; s <= args.seeds; ++s) {
-                        if (const SweepRow* row =
-                                find(r.name, rate, n, static_cast<std::uint64_t>(s), c)) {
-                            ++measured;
-                            stable += row->stable() ? 1 : 0;
-                            if (!row->skipped) {
-                                p999.push_back(row->median.p999Pct);
-                            }
-                        }
-                    }
-                    if (measured == 0) {
-                        line.push_back("-");
-                        continue;
-                    }
-                    any = true;
-                    const double m = median(p999);
-                    line.push_back(
-                        (p999.empty() ? std::string("skipped") : fmt(m, m < 10 ? 2 : 1) + "%") +
-                        " (" + std::to_string(stable) + "/" + std::to_string(measured) +
-                        " stable)");
-                }
-                if (any) {
-                    table.push_back(line);
-                }
-            }
-            md += "\n### " + r.name + " (" + r.spec.toString() + "), " + rateText(rate) +
-                  ": median p99.9 load over scenes\n\n";
-            md += markdownTable({"# objects", "no touch", "touch", "sliding"}, table);
-        }
+        md += rendererTables(renderers, rate, {"# objects", "no touch", "touch", "sliding"},
+                             ": median p99.9 load over scenes",
+                             [&](const SweepRenderer& r, double rateHz) {
+                                 return overScenesLines(rows, counts, args.seeds, r, rateHz);
+                             });
     }
     md += "\n### Max stable objects per renderer (every scene stable)\n\n" +
           limitsTable(renderers, args.ratesHz, rows, args.verdict, "count");

@@ -479,6 +479,36 @@ std::string loadCell(const SweepRow& row) {
     return cell;
 }
 
+const SweepRow* findSweepRow(const std::vector<SweepRow>& rows, const std::string& renderer,
+                             double rateHz, int size, std::uint64_t seed, Condition condition) {
+    for (const SweepRow& row : rows) {
+        if (row.renderer == renderer && row.rateHz == rateHz && row.size == size &&
+            row.seed == seed && row.condition == condition) {
+            return &row;
+        }
+    }
+    return nullptr;
+}
+
+std::string rendererTables(const std::vector<SweepRenderer>& renderers, double rateHz,
+                           const std::vector<std::string>& header, const std::string& suffix,
+                           const RendererLines& linesOf) {
+    std::string md;
+    for (const SweepRenderer& r : renderers) {
+        md += "\n### " + r.name + " (" + r.spec.toString() + "), " + rateText(rateHz) + suffix +
+              "\n\n";
+        md += markdownTable(header, linesOf(r, rateHz));
+    }
+    return md;
+}
+
+std::string loadNote(const CommonArgs& common, Tail tail, const std::string& figures,
+                     const std::string& per) {
+    return "Load = wake-up to force written, % of the servo period" + figures + " median of " +
+           std::to_string(common.repeats) + " run(s) of " + fmt(common.durationS, 2) + " s" + per +
+           ". UNSTABLE: " + std::string(tailName(tail)) + " >= 100 % or > 0.1 % deadlines missed.";
+}
+
 PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRenderer>& renderers,
                    double rateHz, const std::vector<SweepRow>& rows, Verdict verdict) {
     PlotSpec spec;
@@ -530,17 +560,22 @@ PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRendere
     return spec;
 }
 
+void drawPlotNoting(const std::filesystem::path& dir, const PlotSpec& spec, Progress& progress,
+                    std::vector<std::filesystem::path>& files) {
+    const PlotResult pr = drawPlot(dir, spec);
+    if (!pr.problem.empty()) {
+        progress.note("hapto experiment: plot skipped: " + pr.problem);
+    }
+    files.insert(files.end(), pr.files.begin(), pr.files.end());
+}
+
 std::vector<std::filesystem::path>
 plotSweep(const std::filesystem::path& dir, const std::string& experiment,
           const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
           const std::vector<SweepRow>& rows, Verdict verdict, Progress& progress) {
     std::vector<std::filesystem::path> files;
     for (const double rate : ratesHz) {
-        const PlotResult pr = drawPlot(dir, sweepPlot(experiment, renderers, rate, rows, verdict));
-        if (!pr.problem.empty()) {
-            progress.note("hapto experiment: plot skipped: " + pr.problem);
-        }
-        files.insert(files.end(), pr.files.begin(), pr.files.end());
+        drawPlotNoting(dir, sweepPlot(experiment, renderers, rate, rows, verdict), progress, files);
     }
     return files;
 }

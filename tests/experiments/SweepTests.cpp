@@ -145,3 +145,56 @@ TEST_CASE("a measured sweep cell takes its runs' medians and notes a missed phas
     CHECK_THAT(r.note, Catch::Contains("fault: read-failed"));
     CHECK_FALSE(r.stable(Verdict::Load));
 }
+
+TEST_CASE("findSweepRow: the first row of the cell named by all five keys, null for any other") {
+    std::vector<SweepRow> rows = {row("grid", 200, 1, 10), row("grid", 200, 2, 20),
+                                  row("octree", 200, 1, 30), row("grid", 200, 1, 40)};
+    rows[3].condition = Condition::Touch;
+    const SweepRow* hit = findSweepRow(rows, "grid", 1000, 200, 2, Condition::NoTouch);
+    REQUIRE(hit == &rows[1]);
+    CHECK(findSweepRow(rows, "grid", 1000, 200, 1, Condition::Touch) == &rows[3]);
+    CHECK(findSweepRow(rows, "octree", 1000, 200, 1, Condition::NoTouch) == &rows[2]);
+    CHECK(findSweepRow(rows, "grid", 4000, 200, 1, Condition::NoTouch) == nullptr);
+    CHECK(findSweepRow(rows, "grid", 1000, 100, 1, Condition::NoTouch) == nullptr);
+    CHECK(findSweepRow(rows, "grid", 1000, 200, 3, Condition::NoTouch) == nullptr);
+    CHECK(findSweepRow(rows, "grid", 1000, 200, 2, Condition::Sliding) == nullptr);
+    CHECK(findSweepRow(rows, "brute", 1000, 200, 1, Condition::NoTouch) == nullptr);
+
+    rows.push_back(row("grid", 200, 2, 50)); // a second row of one cell: the first wins
+    CHECK(findSweepRow(rows, "grid", 1000, 200, 2, Condition::NoTouch) == &rows[1]);
+}
+
+TEST_CASE("rendererTables: a heading and a table per renderer, in order, from its own lines") {
+    const std::vector<SweepRenderer> renderers = {{"standard", IndexSpec::brute(), "-"},
+                                                  {"grid 5x5x5", IndexSpec::grid(5), "-"}};
+    const std::string md = rendererTables(
+        renderers, 4000, {"n", "load"}, ": over scenes", [](const SweepRenderer& r, double rate) {
+            return std::vector<std::vector<std::string>>{{r.name, std::to_string(int(rate))}};
+        });
+    const std::size_t first = md.find("\n### standard (brute), 4 kHz: over scenes\n\n");
+    const std::size_t second = md.find("\n### grid 5x5x5 (grid:5), 4 kHz: over scenes\n\n");
+    REQUIRE(first != std::string::npos);
+    REQUIRE(second != std::string::npos);
+    CHECK(first < second);
+    const std::string standardPart = md.substr(first, second - first);
+    CHECK_THAT(standardPart, Catch::Contains("| standard | 4000 |"));
+    CHECK_THAT(standardPart, !Catch::Contains("grid 5x5x5 |"));
+    CHECK_THAT(md.substr(second), Catch::Contains("| grid 5x5x5 | 4000 |"));
+    CHECK(rendererTables({}, 1000, {"n"}, "", [](const SweepRenderer&, double) {
+              return std::vector<std::vector<std::string>>{};
+          }).empty());
+}
+
+TEST_CASE("loadNote: the load, the runs behind each cell and what UNSTABLE reads, in one line") {
+    CommonArgs common;
+    common.repeats = 3;
+    common.durationS = 0.5;
+    CHECK(loadNote(common, Tail::P999, ": p50 / p99.9 / max,", "") ==
+          "Load = wake-up to force written, % of the servo period: p50 / p99.9 / max, median of "
+          "3 run(s) of 0.50 s. UNSTABLE: p99.9 >= 100 % or > 0.1 % deadlines missed.");
+    common.repeats = 1;
+    common.durationS = 0.15;
+    CHECK(loadNote(common, Tail::P99, ";", " per scene") ==
+          "Load = wake-up to force written, % of the servo period; median of 1 run(s) of 0.15 s "
+          "per scene. UNSTABLE: p99 >= 100 % or > 0.1 % deadlines missed.");
+}

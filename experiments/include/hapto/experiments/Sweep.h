@@ -163,12 +163,37 @@ void finishSweepReport(const std::filesystem::path& out, const std::string& name
 /// A load cell as the tables show it: "p50 / p99.9 / max" in %, or UNSTABLE/skipped marks.
 std::string loadCell(const SweepRow& row);
 
+/// The first row of one cell: `renderer` at `rateHz`, step size `size` (K, count or triangles
+/// asked), scene `seed` (0 where the step has no seed), `condition`; nullptr when the sweep did
+/// not reach that cell. [any thread]
+const SweepRow* findSweepRow(const std::vector<SweepRow>& rows, const std::string& renderer,
+                             double rateHz, int size, std::uint64_t seed, Condition condition);
+
+/// The lines of one renderer's table at one rate (empty: the renderer has no table there).
+using RendererLines =
+    std::function<std::vector<std::vector<std::string>>(const SweepRenderer&, double rateHz)>;
+/// Per renderer at `rateHz`: a markdown heading "### NAME (SPEC), RATE" followed by `suffix`,
+/// and the table of `header` over the lines `linesOf` gives. [control]
+std::string rendererTables(const std::vector<SweepRenderer>& renderers, double rateHz,
+                           const std::vector<std::string>& header, const std::string& suffix,
+                           const RendererLines& linesOf);
+
+/// The sentence a sweep report opens with: what the load is, then `figures` (": p50 / p99.9 /
+/// max," or ";"), the runs each cell is the median of, `per` (" per scene" or empty), and what
+/// UNSTABLE means under the percentile `tail`. [any thread]
+std::string loadNote(const CommonArgs& common, Tail tail, const std::string& figures,
+                     const std::string& per);
+
 /// The figure of one rate: load (%) against objects, a panel per condition on one shared y
 /// scale, per renderer a solid p99.9 line and a dashed p50 line of one colour (medians over a
 /// size's scenes), a tic at every size measured, and a ring on each p99.9 point where some
 /// cell of that size was unstable under `verdict`. [any thread]
 PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRenderer>& renderers,
                    double rateHz, const std::vector<SweepRow>& rows, Verdict verdict);
+/// Draws `spec` into `dir` and appends the files drawn to `files`; a plot that cannot be drawn
+/// (no gnuplot, a failed run) is noted on `progress`, not thrown. [control]
+void drawPlotNoting(const std::filesystem::path& dir, const PlotSpec& spec, Progress& progress,
+                    std::vector<std::filesystem::path>& files);
 /// One sweepPlot() per rate, drawn. Returns the files drawn; notes problems. [control]
 std::vector<std::filesystem::path>
 plotSweep(const std::filesystem::path& dir, const std::string& experiment,
