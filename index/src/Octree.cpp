@@ -235,16 +235,87 @@ std::unique_ptr<Octree> Octree::build(const Scene& scene, const IndexSpec& spec)
     return tree;
 }
 
-void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items) {
-    const std::uint32_t count = static_cast<std::uint32_t>(items.size());
-    const IndexSpec& sp = spec();
-    const std::uint32_t maxObjects = static_cast<std::uint32_t>(sp.maxObjects);
-    // Work on the items in Morton order of their centres, so a node's items are close
-    // together in memory (the build is bound by memory latency otherwise); "local" ids index
-    // that order and become item ids again when leaves are written.
-    const Aabb box = bounds();
-    std::vector<std::uint64_t> keys(count);
-    parallel::forEach(0, count, 4096, [&](std::size_t i) {
+/// One build of an octree's nodes, level by level (the design note above): the items in Morton
+/// order, the current level's object lists back to back, and what each step of a level hands
+/// the next. A friend of Octree: it writes the tree's arrays.
+class OctreeBuilder {
+public:
+    OctreeBuilder(Octree& tree, const Scene& scene, std::span<const std::uint32_t> items);
+    /// Builds the root's list, then every level until no node splits.
+    void run();
+
+private:
+    /// Of a node that splits: its eight children's cells, its own cell and its midpoint.
+    struct SplitCells {
+        OverlapCell child[8];
+        OverlapCell whole;
+        Vec3 mid{0.0};
+    };
+
+    void sortByMorton(const Scene& scene, std::span<const std::uint32_t> items);
+    void listRoot();
+    void classifyLevel();
+    SplitCells splitCells(std::uint64_t node) const;
+    void classifyObjects(const SplitCells& cells, std::size_t lo, std::size_t hi);
+    void allocateLevel();
+    std::uint64_t levelBytes(std::uint64_t nodes, std::uint64_t slots, std::uint64_t next) const;
+    void refuseAbove(std::uint64_t bytes) const;
+    void placeNode(std::size_t k, std::uint64_t& leafTotal, std::uint64_t& nextTotal);
+    void fillLists();
+    void cutChildLists(std::size_t k, std::uint64_t childBase);
+    void linkLevel(std::uint64_t begin, std::uint64_t end);
+
+    Octree& mTree;
+    const IndexSpec& mSpec;
+    const std::uint32_t mCount;          // items
+    const std::uint32_t mMaxObjects;     // M
+    std::vector<std::uint32_t> mSlotOf;  // per local id (Morton order): the item id
+    std::vector<OverlapShape> mShapes;   // per local id: the item's shape
+    std::vector<std::uint32_t> mEntries; // the lists of the current level's nodes, back to back
+    std::vector<std::uint64_t> mStart;   // per node of the level, + 1: where its list starts
+    std::vector<std::uint8_t> mMasks;    // per entry: the octants it overlaps (nodes that split)
+    std::vector<std::uint32_t> mNext;    // the next level's lists
+    std::vector<std::uint64_t> mNextStart;
+    // The level being built: nodes [mLevelBegin, mLevelEnd), all of depth mLevel.
+    std::uint64_t mLevelBegin = 0, mLevelEnd = 1;
+    int mLevel = 0;
+    std::size_t mWidth = 0;
+    std::vector<std::uint8_t> mSplits;                     // per node: 1 if it splits
+    std::vector<std::array<std::uint32_t, 8>> mChildCount; // per node that splits, per octant
+    std::vector<std::uint64_t> mLeafAt;                    // per node that stays a leaf: 1st slot
+    std::uint64_t mSplitCount = 0, mSlotBase = 0;
+};
+
+OctreeBuilder::OctreeBuilder(Octree& tree, const Scene& scene, std::span<const std::uint32_t> items)
+    : mTree(tree), mSpec(tree.spec()), mCount(static_cast<std::uint32_t>(items.size())),
+      mMaxObjects(static_cast<std::uint32_t>(tree.spec().maxObjects)) {
+    sortByMorton(scene, items);
+}
+
+void OctreeBuilder::run() {
+    listRoot();
+    while (mLevelBegin < mLevelEnd) {
+        mLevel = mTree.mNodes[mLevelBegin].level();
+        mWidth = mLevelEnd - mLevelBegin;
+        classifyLevel();
+        allocateLevel();
+        fillLists();
+        const std::uint64_t newBegin = mLevelEnd, newEnd = mTree.mNodes.size();
+        linkLevel(newBegin, newEnd);
+        mEntries.swap(mNext);
+        mStart.swap(mNextStart);
+        mLevelBegin = newBegin;
+        mLevelEnd = newEnd;
+    }
+}
+
+// Work on the items in Morton order of their centres, so a node's items are close together in
+// memory (the build is bound by memory latency otherwise); "local" ids index that order and
+// become item ids again when leaves are written.
+void OctreeBuilder::sortByMorton(const Scene& scene, std::span<const std::uint32_t> items) {
+    const Aabb box = mTree.bounds();
+    std::vector<std::uint64_t> keys(mCount);
+    parallel::forEach(0, mCount, 4096, [&](std::size_t i) {
         const Vec3 c = itemCenter(scene, items[i]);
         std::uint64_t code = 0;
         for (int a = 0; a < 3; ++a) {
@@ -257,236 +328,266 @@ void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items
         keys[i] = (code << 32) | i;
     });
     parallel::sort(keys.begin(), keys.end());
-    std::vector<std::uint32_t> slotOf(count);
-    std::vector<OverlapShape> shapes(count);
-    parallel::forEach(0, count, 4096, [&](std::size_t local) {
-        slotOf[local] = items[static_cast<std::uint32_t>(keys[local])];
-        shapes[local] = OverlapShape::of(scene, slotOf[local]);
+    mSlotOf.resize(mCount);
+    mShapes.resize(mCount);
+    parallel::forEach(0, mCount, 4096, [&](std::size_t local) {
+        mSlotOf[local] = items[static_cast<std::uint32_t>(keys[local])];
+        mShapes[local] = OverlapShape::of(scene, mSlotOf[local]);
     });
-    keys = {};
+}
 
-    // The root's list: every object overlapping the bounds.
-    std::vector<std::uint8_t> keep(count);
-    parallel::forEach(0, count, 4096,
-                      [&](std::size_t i) { keep[i] = overlaps(shapes[i], box, sp.mode); });
-    std::vector<std::uint32_t> entries; // the lists of the current level's nodes, back to back
-    entries.reserve(count);
-    for (std::uint32_t i = 0; i < count; ++i) {
+// The root's list: every object overlapping the bounds; the root node itself.
+void OctreeBuilder::listRoot() {
+    const Aabb box = mTree.bounds();
+    std::vector<std::uint8_t> keep(mCount);
+    parallel::forEach(0, mCount, 4096,
+                      [&](std::size_t i) { keep[i] = overlaps(mShapes[i], box, mSpec.mode); });
+    mEntries.reserve(mCount);
+    for (std::uint32_t i = 0; i < mCount; ++i) {
         if (keep[i]) {
-            entries.push_back(i);
+            mEntries.push_back(i);
         }
     }
-    keep = {};
-    std::vector<std::uint64_t> start{0, entries.size()}; // per node of the level, + 1
-    mNodes.emplace_back();
+    mStart = {0, mEntries.size()};
+    mTree.mNodes.emplace_back();
+}
 
-    std::vector<std::uint8_t> masks;
-    std::vector<std::uint32_t> next;
-    std::vector<std::uint64_t> nextStart;
-    std::uint64_t levelBegin = 0, levelEnd = 1;
-    while (levelBegin < levelEnd) {
-        const int level = mNodes[levelBegin].level();
-        const bool splittable = canSplit(level);
-        const std::size_t width = levelEnd - levelBegin;
-        std::vector<std::array<std::uint32_t, 8>> childCount(width);
-        std::vector<std::uint8_t> splits(width, 0);
-        masks.assign(entries.size(), 0);
-
-        // 1. Which nodes split, and for their objects, which octants each overlaps.
-        parallel::forEach(0, width, 16, [&](std::size_t k) {
-            const std::uint64_t b = start[k], e = start[k + 1];
-            if (!splittable || e - b <= maxObjects) {
-                return;
-            }
-            splits[k] = 1;
-            const OctreeNode& n = mNodes[levelBegin + k];
-            OverlapCell child[8];
+// Step 1, in parallel: which nodes of the level split, and for their objects, which octants
+// each overlaps; then each child's object count.
+void OctreeBuilder::classifyLevel() {
+    const bool splittable = mTree.canSplit(mLevel);
+    mChildCount.assign(mWidth, {});
+    mSplits.assign(mWidth, 0);
+    mMasks.assign(mEntries.size(), 0);
+    parallel::forEach(0, mWidth, 16, [&](std::size_t k) {
+        const std::uint64_t b = mStart[k], e = mStart[k + 1];
+        if (!splittable || e - b <= mMaxObjects) {
+            return;
+        }
+        mSplits[k] = 1;
+        const SplitCells cells = splitCells(mLevelBegin + k);
+        if (e - b > kNestedGrain) { // only big lists are worth a nested parallel loop
+            parallel::forRanges(b, e, kNestedGrain / 4, [&](std::size_t lo, std::size_t hi) {
+                classifyObjects(cells, lo, hi);
+            });
+        } else {
+            classifyObjects(cells, b, e);
+        }
+        std::array<std::uint32_t, 8> c{};
+        for (std::uint64_t i = b; i < e; ++i) {
             for (std::uint32_t o = 0; o < 8; ++o) {
-                Aabb box;
-                for (int a = 0; a < 3; ++a) {
-                    const std::uint32_t c = 2 * n.cell(a) + ((o >> a) & 1);
-                    box.min[a] = coord(level + 1, c, a);
-                    box.max[a] = coord(level + 1, c + 1, a);
-                }
-                child[o] = OverlapCell::of(box);
+                c[o] += (mMasks[i] >> o) & 1;
             }
-            const OverlapCell whole = OverlapCell::of(nodeBounds(levelBegin + k));
-            Vec3 mid(0.0);
-            for (int a = 0; a < 3; ++a) {
-                mid[a] = coord(level + 1, 2 * n.cell(a) + 1, a);
-            }
-            const auto classify = [&](std::size_t lo, std::size_t hi) {
-                for (std::size_t i = lo; i < hi; ++i) {
-                    const OverlapShape& s = shapes[entries[i]];
-                    // Octants the AABB reaches (with the parent's tolerance, which is no
-                    // smaller than any child's), then the full test on those only.
-                    const double tol = overlapTolerance(s, whole);
-                    std::uint32_t reach = 0xFF;
-                    for (int a = 0; a < 3; ++a) {
-                        const std::uint32_t upper = a == 0 ? 0xAA : a == 1 ? 0xCC : 0xF0;
-                        if (s.aabb.min[a] > mid[a] + tol) {
-                            reach &= upper;
-                        } else if (s.aabb.max[a] + tol < mid[a]) {
-                            reach &= ~upper;
-                        }
-                    }
-                    std::uint8_t m = 0;
-                    for (std::uint32_t o = 0; o < 8; ++o) {
-                        if ((reach >> o) & 1) {
-                            m |= std::uint8_t(overlaps(s, child[o], sp.mode)) << o;
-                        }
-                    }
-                    masks[i] = m;
-                }
-            };
-            if (e - b > kNestedGrain) { // only big lists are worth a nested parallel loop
-                parallel::forRanges(b, e, kNestedGrain / 4, classify);
-            } else {
-                classify(b, e);
-            }
-            std::array<std::uint32_t, 8> c{};
-            for (std::uint64_t i = b; i < e; ++i) {
-                for (std::uint32_t o = 0; o < 8; ++o) {
-                    c[o] += (masks[i] >> o) & 1;
-                }
-            }
-            childCount[k] = c;
-        });
+        }
+        mChildCount[k] = c;
+    });
+}
 
-        // 2. Serially: allocate children (eight siblings together) and leaf runs.
-        std::uint64_t splitCount = 0;
-        for (std::size_t k = 0; k < width; ++k) {
-            splitCount += splits[k];
+// The cells a node's objects are tested against when it splits.
+OctreeBuilder::SplitCells OctreeBuilder::splitCells(std::uint64_t node) const {
+    const OctreeNode& n = mTree.mNodes[node];
+    const int child = mLevel + 1;
+    SplitCells cells;
+    for (std::uint32_t o = 0; o < 8; ++o) {
+        Aabb box;
+        for (int a = 0; a < 3; ++a) {
+            const std::uint32_t c = 2 * n.cell(a) + ((o >> a) & 1);
+            box.min[a] = mTree.coord(child, c, a);
+            box.max[a] = mTree.coord(child, c + 1, a);
         }
-        // Memory, before this level is allocated: nodes so far and new, leaf slots so far,
-        // this level's lists and masks, the per-object arrays; the lists of the next level and
-        // the new leaves' slots are added once known, below.
-        const std::uint64_t perObject =
-            std::uint64_t(count) * (sizeof(std::uint32_t) + sizeof(OverlapShape));
-        const auto memory = [&](std::uint64_t nodes, std::uint64_t slots, std::uint64_t next) {
-            return nodes * sizeof(OctreeNode) + (nodes / 8 + slots + next) * sizeof(std::uint32_t) +
-                   entries.size() * (sizeof(std::uint32_t) + 1) + perObject;
-        };
-        const auto checkMemory = [&](std::uint64_t bytes) {
-            if (bytes > sp.maxBytes) {
-                detail::refuseIndexMemory(sp, bytes,
-                                          std::to_string(mNodes.size() + 8 * splitCount) +
-                                              " nodes by depth " + std::to_string(level + 1) +
-                                              " and still splitting",
-                                          true);
-            }
-        };
-        checkMemory(memory(mNodes.size() + 8 * splitCount, mSlots.size(), 0));
-        if (mNodes.size() + 8 * splitCount > kMaxNodes) {
-            throw InputError("octree " + sp.toString() + ": more than " +
-                             std::to_string(kMaxNodes) +
-                             " nodes needed (too many overlapping objects for this minimum "
-                             "size); raise MIN or M");
-        }
-        const std::uint64_t slotBase = mSlots.size();
-        // Arrays sized exactly: each level reserves what it adds, so no capacity is left over
-        // (a reallocation per level copies the nodes so far: a geometric sum, cheap).
-        mNodes.reserve(mNodes.size() + 8 * splitCount);
-        mGroupParent.reserve(mGroupParent.size() + splitCount);
-        std::vector<std::uint64_t> leafAt(width, 0);
-        std::uint64_t leafTotal = 0, nextTotal = 0;
-        nextStart.assign(1, 0);
-        for (std::size_t k = 0; k < width; ++k) {
-            const std::uint32_t id = static_cast<std::uint32_t>(levelBegin + k);
-            if (!splits[k]) {
-                OctreeNode& n = mNodes[id];
-                n.makeLeaf(static_cast<std::uint32_t>(slotBase + leafTotal),
-                           static_cast<std::uint32_t>(start[k + 1] - start[k]));
-                leafAt[k] = slotBase + leafTotal;
-                leafTotal += n.slotCount();
-                continue;
-            }
-            const std::uint32_t first = static_cast<std::uint32_t>(mNodes.size());
-            mNodes[id].makeInner(first);
-            const OctreeNode parent = mNodes[id];
-            mGroupParent.push_back(id);
-            for (std::uint32_t o = 0; o < 8; ++o) {
-                OctreeNode c;
-                c.setCell(level + 1, 2 * parent.cell(0) + (o & 1),
-                          2 * parent.cell(1) + ((o >> 1) & 1), 2 * parent.cell(2) + ((o >> 2) & 1));
-                mNodes.push_back(c);
-                nextTotal += childCount[k][o];
-                nextStart.push_back(nextTotal);
-            }
-        }
-        if (slotBase + leafTotal >= std::numeric_limits<std::uint32_t>::max() ||
-            nextTotal >= std::numeric_limits<std::uint32_t>::max()) {
-            throw InputError("octree " + sp.toString() +
-                             ": more than 2^32 object-leaf pairs; raise MIN or M");
-        }
-        checkMemory(memory(mNodes.size(), slotBase + leafTotal, nextTotal));
-        mSlots.reserve(slotBase + leafTotal);
-        mSlots.resize(slotBase + leafTotal);
-        next.resize(nextTotal);
-
-        // 3. In parallel: copy leaf lists out, cut children's lists by the masks.
-        std::vector<std::uint64_t> childBase(width, 0);
-        for (std::size_t k = 0, c = 0; k < width; ++k) {
-            if (splits[k]) {
-                childBase[k] = c;
-                c += 8;
-            }
-        }
-        parallel::forEach(0, width, 16, [&](std::size_t k) {
-            const std::uint64_t b = start[k], e = start[k + 1];
-            if (!splits[k]) { // back to item ids, ascending
-                const auto out = mSlots.begin() + static_cast<std::ptrdiff_t>(leafAt[k]);
-                std::transform(entries.begin() + b, entries.begin() + e, out,
-                               [&](std::uint32_t local) { return slotOf[local]; });
-                std::sort(out, out + static_cast<std::ptrdiff_t>(e - b));
-                return;
-            }
-            const auto cut = [&](std::size_t o) {
-                std::uint64_t out = nextStart[childBase[k] + o];
-                for (std::uint64_t i = b; i < e; ++i) {
-                    if ((masks[i] >> o) & 1) {
-                        next[out++] = entries[i];
-                    }
-                }
-            };
-            if (e - b > kNestedGrain) {
-                parallel::forEach(0, 8, 1, cut);
-            } else {
-                for (std::size_t o = 0; o < 8; ++o) {
-                    cut(o);
-                }
-            }
-        });
-
-        // 4. Neighbour links of the new level, from the level above.
-        const std::uint64_t newBegin = levelEnd, newEnd = mNodes.size();
-        parallel::forEach(newBegin, newEnd, 1024, [&](std::size_t j) {
-            OctreeNode& c = mNodes[j];
-            const OctreeNode& parent = mNodes[mGroupParent[(j - 1) / 8]];
-            const std::uint32_t o = static_cast<std::uint32_t>(j - parent.firstChild());
-            for (int a = 0; a < 3; ++a) {
-                const std::uint32_t bit = 1u << a;
-                for (int positive = 0; positive < 2; ++positive) {
-                    const int face = 2 * a + positive;
-                    if (((o & bit) != 0) != (positive != 0)) { // inner face: a sibling
-                        c.neighbours[face] = parent.firstChild() + (o ^ bit);
-                        continue;
-                    }
-                    const std::uint32_t across = parent.neighbours[face];
-                    if (across == kNoNode || mNodes[across].isLeaf()) {
-                        c.neighbours[face] = across;
-                    } else { // same size as the parent, split: its mirrored child
-                        c.neighbours[face] = mNodes[across].firstChild() + (o ^ bit);
-                    }
-                }
-            }
-        });
-
-        entries.swap(next);
-        start.swap(nextStart);
-        levelBegin = newBegin;
-        levelEnd = newEnd;
+        cells.child[o] = OverlapCell::of(box);
     }
+    cells.whole = OverlapCell::of(mTree.nodeBounds(static_cast<std::uint32_t>(node)));
+    for (int a = 0; a < 3; ++a) {
+        cells.mid[a] = mTree.coord(child, 2 * n.cell(a) + 1, a);
+    }
+    return cells;
+}
+
+// The octant masks of entries [lo, hi) of one node: the octants each AABB reaches (with the
+// parent's tolerance, which is no smaller than any child's), then the full test on those only.
+void OctreeBuilder::classifyObjects(const SplitCells& cells, std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i < hi; ++i) {
+        const OverlapShape& s = mShapes[mEntries[i]];
+        const double tol = overlapTolerance(s, cells.whole);
+        std::uint32_t reach = 0xFF;
+        for (int a = 0; a < 3; ++a) {
+            const std::uint32_t upper = a == 0 ? 0xAA : a == 1 ? 0xCC : 0xF0;
+            if (s.aabb.min[a] > cells.mid[a] + tol) {
+                reach &= upper;
+            } else if (s.aabb.max[a] + tol < cells.mid[a]) {
+                reach &= ~upper;
+            }
+        }
+        std::uint8_t m = 0;
+        for (std::uint32_t o = 0; o < 8; ++o) {
+            if ((reach >> o) & 1) {
+                m |= std::uint8_t(overlaps(s, cells.child[o], mSpec.mode)) << o;
+            }
+        }
+        mMasks[i] = m;
+    }
+}
+
+// Step 2, serially: allocate children (eight siblings together) and leaf runs, refusing a
+// level that would pass the memory limit, the node limit or 32-bit slot offsets.
+void OctreeBuilder::allocateLevel() {
+    std::vector<OctreeNode>& nodes = mTree.mNodes;
+    mSplitCount = 0;
+    for (std::size_t k = 0; k < mWidth; ++k) {
+        mSplitCount += mSplits[k];
+    }
+    refuseAbove(levelBytes(nodes.size() + 8 * mSplitCount, mTree.mSlots.size(), 0));
+    if (nodes.size() + 8 * mSplitCount > Octree::kMaxNodes) {
+        throw InputError("octree " + mSpec.toString() + ": more than " +
+                         std::to_string(Octree::kMaxNodes) +
+                         " nodes needed (too many overlapping objects for this minimum "
+                         "size); raise MIN or M");
+    }
+    mSlotBase = mTree.mSlots.size();
+    // Arrays sized exactly: each level reserves what it adds, so no capacity is left over
+    // (a reallocation per level copies the nodes so far: a geometric sum, cheap).
+    nodes.reserve(nodes.size() + 8 * mSplitCount);
+    mTree.mGroupParent.reserve(mTree.mGroupParent.size() + mSplitCount);
+    mLeafAt.assign(mWidth, 0);
+    std::uint64_t leafTotal = 0, nextTotal = 0;
+    mNextStart.assign(1, 0);
+    for (std::size_t k = 0; k < mWidth; ++k) {
+        placeNode(k, leafTotal, nextTotal);
+    }
+    if (mSlotBase + leafTotal >= std::numeric_limits<std::uint32_t>::max() ||
+        nextTotal >= std::numeric_limits<std::uint32_t>::max()) {
+        throw InputError("octree " + mSpec.toString() +
+                         ": more than 2^32 object-leaf pairs; raise MIN or M");
+    }
+    refuseAbove(levelBytes(nodes.size(), mSlotBase + leafTotal, nextTotal));
+    mTree.mSlots.reserve(mSlotBase + leafTotal);
+    mTree.mSlots.resize(mSlotBase + leafTotal);
+    mNext.resize(nextTotal);
+}
+
+// Memory with this many nodes, leaf slots and next-level entries: those, the parents, this
+// level's lists and masks, and the per-object arrays.
+std::uint64_t OctreeBuilder::levelBytes(std::uint64_t nodes, std::uint64_t slots,
+                                        std::uint64_t next) const {
+    const std::uint64_t perObject =
+        std::uint64_t(mCount) * (sizeof(std::uint32_t) + sizeof(OverlapShape));
+    return nodes * sizeof(OctreeNode) + (nodes / 8 + slots + next) * sizeof(std::uint32_t) +
+           mEntries.size() * (sizeof(std::uint32_t) + 1) + perObject;
+}
+
+// Refuses the build (InputError) when `bytes` passes the spec's memory limit.
+void OctreeBuilder::refuseAbove(std::uint64_t bytes) const {
+    if (bytes > mSpec.maxBytes) {
+        detail::refuseIndexMemory(mSpec, bytes,
+                                  std::to_string(mTree.mNodes.size() + 8 * mSplitCount) +
+                                      " nodes by depth " + std::to_string(mLevel + 1) +
+                                      " and still splitting",
+                                  true);
+    }
+}
+
+// Node k of the level becomes a leaf with the next run of slots, or an inner node whose eight
+// children are appended, their lists' starts added to mNextStart.
+void OctreeBuilder::placeNode(std::size_t k, std::uint64_t& leafTotal, std::uint64_t& nextTotal) {
+    std::vector<OctreeNode>& nodes = mTree.mNodes;
+    const std::uint32_t id = static_cast<std::uint32_t>(mLevelBegin + k);
+    if (!mSplits[k]) {
+        OctreeNode& n = nodes[id];
+        n.makeLeaf(static_cast<std::uint32_t>(mSlotBase + leafTotal),
+                   static_cast<std::uint32_t>(mStart[k + 1] - mStart[k]));
+        mLeafAt[k] = mSlotBase + leafTotal;
+        leafTotal += n.slotCount();
+        return;
+    }
+    const std::uint32_t first = static_cast<std::uint32_t>(nodes.size());
+    nodes[id].makeInner(first);
+    const OctreeNode parent = nodes[id];
+    mTree.mGroupParent.push_back(id);
+    for (std::uint32_t o = 0; o < 8; ++o) {
+        OctreeNode c;
+        c.setCell(mLevel + 1, 2 * parent.cell(0) + (o & 1), 2 * parent.cell(1) + ((o >> 1) & 1),
+                  2 * parent.cell(2) + ((o >> 2) & 1));
+        nodes.push_back(c);
+        nextTotal += mChildCount[k][o];
+        mNextStart.push_back(nextTotal);
+    }
+}
+
+// Step 3, in parallel: copy leaf lists out (back to item ids, ascending), cut children's lists
+// by the masks.
+void OctreeBuilder::fillLists() {
+    std::vector<std::uint64_t> childBase(mWidth, 0);
+    for (std::size_t k = 0, c = 0; k < mWidth; ++k) {
+        if (mSplits[k]) {
+            childBase[k] = c;
+            c += 8;
+        }
+    }
+    parallel::forEach(0, mWidth, 16, [&](std::size_t k) {
+        if (mSplits[k]) {
+            cutChildLists(k, childBase[k]);
+            return;
+        }
+        const std::uint64_t b = mStart[k], e = mStart[k + 1];
+        const auto out = mTree.mSlots.begin() + static_cast<std::ptrdiff_t>(mLeafAt[k]);
+        std::transform(mEntries.begin() + b, mEntries.begin() + e, out,
+                       [&](std::uint32_t local) { return mSlotOf[local]; });
+        std::sort(out, out + static_cast<std::ptrdiff_t>(e - b));
+    });
+}
+
+// The eight children's lists of node k, each cut from its list by the masks (in order, so each
+// stays sorted by local id).
+void OctreeBuilder::cutChildLists(std::size_t k, std::uint64_t childBase) {
+    const std::uint64_t b = mStart[k], e = mStart[k + 1];
+    const auto cut = [&](std::size_t o) {
+        std::uint64_t out = mNextStart[childBase + o];
+        for (std::uint64_t i = b; i < e; ++i) {
+            if ((mMasks[i] >> o) & 1) {
+                mNext[out++] = mEntries[i];
+            }
+        }
+    };
+    if (e - b > kNestedGrain) {
+        parallel::forEach(0, 8, 1, cut);
+    } else {
+        for (std::size_t o = 0; o < 8; ++o) {
+            cut(o);
+        }
+    }
+}
+
+// Step 4, in parallel: neighbour links of the new level's nodes [begin, end), from the level
+// above (a sibling across an inner face; across an outer face the parent's neighbour, or its
+// mirrored child when it split).
+void OctreeBuilder::linkLevel(std::uint64_t begin, std::uint64_t end) {
+    std::vector<OctreeNode>& nodes = mTree.mNodes;
+    parallel::forEach(begin, end, 1024, [&](std::size_t j) {
+        OctreeNode& c = nodes[j];
+        const OctreeNode& parent = nodes[mTree.mGroupParent[(j - 1) / 8]];
+        const std::uint32_t o = static_cast<std::uint32_t>(j - parent.firstChild());
+        for (int a = 0; a < 3; ++a) {
+            const std::uint32_t bit = 1u << a;
+            for (int positive = 0; positive < 2; ++positive) {
+                const int face = 2 * a + positive;
+                if (((o & bit) != 0) != (positive != 0)) { // inner face: a sibling
+                    c.neighbours[face] = parent.firstChild() + (o ^ bit);
+                    continue;
+                }
+                const std::uint32_t across = parent.neighbours[face];
+                if (across == kNoNode || nodes[across].isLeaf()) {
+                    c.neighbours[face] = across;
+                } else { // same size as the parent, split: its mirrored child
+                    c.neighbours[face] = nodes[across].firstChild() + (o ^ bit);
+                }
+            }
+        }
+    });
+}
+
+void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items) {
+    OctreeBuilder(*this, scene, items).run();
 }
 
 } // namespace hapto

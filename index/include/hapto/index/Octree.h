@@ -133,6 +133,7 @@ private:
     LocateResult climb(std::uint32_t leaf, const Vec3& p) const noexcept;
     LocateResult followLinks(std::uint32_t leaf, const Vec3& p) const noexcept;
     void buildNodes(const Scene& scene, std::span<const std::uint32_t> items);
+    friend class OctreeBuilder; // buildNodes' parts (Octree.cpp)
 
     std::array<Vec3, kMaxDepth + 2> mStep{};    // cell size per level (m)
     std::array<Vec3, kMaxDepth + 2> mInvStep{}; // 1 / mStep (1/m)

@@ -44,6 +44,7 @@ private:
     double coord(std::uint32_t i, int axis) const noexcept {
         return bounds().min[axis] + static_cast<double>(i) * mStep[axis];
     }
+    friend class GridBuilder; // build's parts (UniformGrid.cpp)
 
     std::uint32_t mN;
     Vec3 mStep{0.0};
