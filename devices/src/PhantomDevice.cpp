@@ -203,6 +203,14 @@ std::string stringParam(const hd::HdApi& api, hd::HDenum name) {
     return s ? std::string(s) : std::string();
 }
 
+/// Starts the HD scheduler again when open() stopped it to initialise a device (it was running).
+void restartScheduler(hd::HdRuntime& rt, bool wasRunning) {
+    if (wasRunning) {
+        rt.api.startScheduler();
+        rt.schedulerRunning = true;
+    }
+}
+
 /// Reads the static HD properties of the current device (control thread, outside a frame).
 PhantomInfo queryCurrentDevice(const hd::HdApi& api, const std::string& deviceName) {
     PhantomInfo info;
@@ -265,32 +273,40 @@ DeviceStatus PhantomDevice::open() {
         mError = who + why;
         return DeviceStatus::Error;
     }
-    const hd::HdApi& api = rt->api;
-
     // OpenHaptics' examples initialise devices before the scheduler runs; do the same.
     const bool wasRunning = rt->schedulerRunning;
     if (wasRunning) {
-        api.stopScheduler();
+        rt->api.stopScheduler();
         rt->schedulerRunning = false;
     }
-    auto restart = [&] {
-        if (wasRunning) {
-            api.startScheduler();
-            rt->schedulerRunning = true;
-        }
-    };
+    if (!initHdDevice(rt->api, who)) {
+        restartScheduler(*rt, wasRunning);
+        return DeviceStatus::Error;
+    }
+    if (const DeviceStatus s = startServo(*rt, wasRunning, who); s != DeviceStatus::Ok) {
+        return s;
+    }
+    if (const DeviceStatus s = awaitFirstSample(who); s != DeviceStatus::Ok) {
+        return s;
+    }
+    mError.clear();
+    mOpen.store(true, std::memory_order_release);
+    return DeviceStatus::Ok;
+}
 
+// Initialises the configured HD device, takes its model, workspace and force limit, and
+// prepares the link for the callback; false (mError set) when OpenHaptics refuses.
+bool PhantomDevice::initHdDevice(const hd::HdApi& api, const std::string& who) {
     api.takeError(); // forget errors left by someone else on this thread
     const hd::HHD handle =
         api.initDevice(mConfig.deviceName.empty() ? nullptr : mConfig.deviceName.c_str());
-    hd::HDErrorInfo error = api.takeError();
+    const hd::HDErrorInfo error = api.takeError();
     if (error.errorCode != hd::kSuccess || handle == hd::kInvalidHandle) {
         mError = who + "OpenHaptics could not initialise " + hdDeviceLabel() + ": " +
                  api.describe(error) +
                  ". Check that the name matches one in Touch_Setup (empty = the default device) "
                  "and that the device is plugged in and powered.";
-        restart();
-        return DeviceStatus::Error;
+        return false;
     }
 
     api.makeCurrentDevice(handle);
@@ -312,28 +328,35 @@ DeviceStatus PhantomDevice::open() {
     link.handle = handle;
     link.commandClock = mCommandClock;
     link.commandTimeoutNs = mCommandTimeoutNs;
+    return true;
+}
 
+// Enables force output, schedules the callback and starts the scheduler (at the configured
+// rate when this is its first device); on failure undoes what it did.
+DeviceStatus PhantomDevice::startServo(hd::HdRuntime& rt, bool wasRunning, const std::string& who) {
+    const hd::HdApi& api = rt.api;
+    const hd::HHD handle = mLink->handle;
     api.enable(hd::kForceOutput);
     const hd::HDSchedulerHandle scheduled =
-        api.scheduleAsynchronous(&phantomServoCallback, &link, hd::kMaxSchedulerPriority);
-    error = api.takeError();
+        api.scheduleAsynchronous(&phantomServoCallback, mLink.get(), hd::kMaxSchedulerPriority);
+    hd::HDErrorInfo error = api.takeError();
     if (error.errorCode != hd::kSuccess) {
         mError = who + "OpenHaptics could not schedule the servo callback of " + hdDeviceLabel() +
                  ": " + api.describe(error) + ".";
         api.disable(hd::kForceOutput);
         api.disableDevice(handle);
         api.takeError();
-        restart();
+        restartScheduler(rt, wasRunning);
         return DeviceStatus::Error;
     }
     mScheduled = scheduled;
-    ++rt->scheduledDevices;
-    mRuntime = rt;
-    if (!wasRunning && rt->scheduledDevices == 1 && mSchedulerRateHz > 0) {
+    ++rt.scheduledDevices;
+    mRuntime = &rt;
+    if (!wasRunning && rt.scheduledDevices == 1 && mSchedulerRateHz > 0) {
         api.setSchedulerRate(mSchedulerRateHz);
     }
     api.startScheduler();
-    rt->schedulerRunning = true;
+    rt.schedulerRunning = true;
     error = api.takeError();
     if (error.errorCode != hd::kSuccess) {
         mError = who + "OpenHaptics could not start its scheduler: " + api.describe(error) +
@@ -341,8 +364,14 @@ DeviceStatus PhantomDevice::open() {
         releaseLocked();
         return DeviceStatus::Error;
     }
+    return DeviceStatus::Ok;
+}
 
-    // Wait (bounded) for the first sample so read() right after open() has data.
+// Waits (bounded) for the first sample so read() right after open() has data; a fault on the
+// first tick or no sample within kFirstSampleTimeout releases the device.
+DeviceStatus PhantomDevice::awaitFirstSample(const std::string& who) {
+    const PhantomLink& link = *mLink;
+    const hd::HdApi& api = mRuntime->api;
     const auto deadline = std::chrono::steady_clock::now() + kFirstSampleTimeout;
     for (;;) {
         PhantomSample s{};
@@ -351,12 +380,12 @@ DeviceStatus PhantomDevice::open() {
             code != hd::kSuccess) {
             mError = who + "OpenHaptics reported an error on the first servo tick of " +
                      hdDeviceLabel() + ": " +
-                     api.describe({code, link.faultInternal.load(), handle}) + ".";
+                     api.describe({code, link.faultInternal.load(), link.handle}) + ".";
             releaseLocked();
             return statusForHdError(code);
         }
         if (link.sample.read(s, writes) && writes > 0) {
-            break;
+            return DeviceStatus::Ok;
         }
         if (std::chrono::steady_clock::now() > deadline) {
             mError = who + "the OpenHaptics scheduler gave no sample of " + hdDeviceLabel() +
@@ -366,9 +395,6 @@ DeviceStatus PhantomDevice::open() {
         }
         std::this_thread::sleep_for(std::chrono::microseconds(500));
     }
-    mError.clear();
-    mOpen.store(true, std::memory_order_release);
-    return DeviceStatus::Ok;
 }
 
 void PhantomDevice::releaseLocked() {

@@ -50,8 +50,9 @@ namespace detail {
 struct PhantomLink;
 }
 namespace hd {
+struct HdApi;
 struct HdRuntime;
-}
+} // namespace hd
 
 /// What probePhantoms found about one device.
 struct PhantomInfo {
@@ -135,6 +136,12 @@ public:
 
 private:
     std::string hdDeviceLabel() const;
+    /// open()'s parts, under the HD registry lock: initialise the device, read its properties
+    /// and prepare the link; schedule the callback and start the scheduler; wait (bounded) for
+    /// the first sample. Each sets mError and cleans up on failure. [control]
+    bool initHdDevice(const hd::HdApi& api, const std::string& who);
+    DeviceStatus startServo(hd::HdRuntime& rt, bool wasRunning, const std::string& who);
+    DeviceStatus awaitFirstSample(const std::string& who);
     void releaseLocked();
 
     std::string mName;
