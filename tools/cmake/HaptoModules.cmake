@@ -94,8 +94,7 @@ function(hapto_check_module_links)
 endfunction()
 
 # How a package a module found is named on a pkg-config line: a pkg-config module for Requires,
-# or flags for Libs (meshoptimizer has no .pc file in Debian 12), or nothing (Eigen: header-only
-# and private to hapto::devices).
+# or flags for Libs (meshoptimizer has no .pc file in Debian 12).
 set(HAPTO_PC_REQUIRES_glm glm)
 set(HAPTO_PC_REQUIRES_nlohmann_json nlohmann_json)
 set(HAPTO_PC_REQUIRES_TBB tbb)
@@ -122,7 +121,7 @@ function(hapto_write_pkgconfig module)
       list(APPEND requires ${HAPTO_PC_REQUIRES_${name}})
     elseif(DEFINED HAPTO_PC_LIBS_${name})
       list(APPEND libs ${HAPTO_PC_LIBS_${name}})
-    elseif(NOT name STREQUAL "Eigen3")
+    else()
       message(FATAL_ERROR "hapto_write_pkgconfig: how does pkg-config name ${name}?")
     endif()
   endforeach()

@@ -6,11 +6,12 @@
 # (no CMAKE_CXX_STANDARD: C++20 must come from the exported targets) and README shows its
 # CMakeLists.txt exactly; find_package(hapto COMPONENTS index) works where pkg-config finds
 # nothing and the view's and the Falcon's packages are disabled (tools/cmake/consumers/index),
-# and the view's component asked for there fails naming what it needs; an application serving
-# the installed view answers the page and three.js (tools/cmake/consumers/view); hapto-index.pc
-# links the index program with nothing of USB, HTTP or meshes and hapto-view.pc the view's;
-# README's pkg-config line builds tools/cmake/PkgConfigApp.cpp and it runs; the udev rule, the
-# licence and hapto/Version.h are installed.
+# and the view's component asked for there fails naming what it needs (optional, it is absent:
+# tools/cmake/consumers/optional); an application serving the installed view answers the page
+# and three.js (tools/cmake/consumers/view); hapto-index.pc links the index program with nothing
+# of USB, HTTP or meshes and hapto-view.pc the view's; README's pkg-config line builds
+# tools/cmake/PkgConfigApp.cpp and it runs; the udev rule, the licence and hapto/Version.h are
+# installed.
 cmake_minimum_required(VERSION 3.25)
 foreach(var BINARY_DIR SOURCE_DIR WORK_DIR GENERATOR CXX)
   if(NOT DEFINED ${var})
@@ -105,6 +106,11 @@ if(rc EQUAL 0 OR NOT out MATCHES "libusb-1.0|cpp-httplib|meshoptimizer")
   message(FATAL_ERROR "find_package(hapto COMPONENTS view) without libusb-1.0, cpp-httplib "
                       "and meshoptimizer should fail naming one (${rc}):\n${out}")
 endif()
+# There, a component whose packages are missing (or an unknown one) is absent when optional,
+# and asked for as required it fails naming the reason (tools/cmake/consumers/optional).
+run(${without_device_and_view_packages} ${CMAKE_COMMAND}
+    -S ${SOURCE_DIR}/tools/cmake/consumers/optional -B ${WORK_DIR}/optional ${configure_args}
+    ${disabled_packages})
 consumer(view ${SOURCE_DIR}/tools/cmake/consumers/view)
 run(${WORK_DIR}/view/view_consumer)
 
