@@ -1,6 +1,7 @@
-// The session driver (Session.h) in step mode: where it stops (duration, request, the control
-// step's word, the end of every device), what it leaves (zero force, closed or abandoned
-// recordings) and the report it returns. Every count is exact: the clock is the test's.
+// The session driver (Session.h), in step mode but for one [realtime] case on the wall clock: where
+// it stops (duration, request, the control step's word, the end of every device), what it leaves
+// (zero force, closed or abandoned recordings) and the report it returns. In step mode every count
+// is exact: the clock is the test's.
 
 #include "ScriptedDevice.h"
 #include "SteppedRig.h"
@@ -190,4 +191,41 @@ TEST_CASE("session names why it ended") {
     CHECK(sessionEndName(SessionEnd::Requested) == "requested");
     CHECK(sessionEndName(SessionEnd::Finished) == "finished");
     CHECK(sessionEndName(SessionEnd::NoneRunning) == "none running");
+}
+
+TEST_CASE("session, wall clock: it ends at its duration with every device at zero force, and a "
+          "stop request ends an untimed one",
+          "[realtime]") {
+    for (const double durationS : {0.2, 0.0}) {
+        INFO("duration " << durationS);
+        World world(test::cubeScene(), IndexSpec::parse("octree:2:0.005"));
+        std::vector<RuntimeDevice> devices;
+        std::vector<ScriptedDevice*> scripted;
+        for (int i = 0; i < 2; ++i) {
+            auto d = std::make_unique<ScriptedDevice>("d" + std::to_string(i),
+                                                      test::pressIntoCube(0.004 * i - 0.01));
+            scripted.push_back(d.get());
+            devices.push_back({std::move(d), test::scriptedConfig(i, 1000.0), nullptr});
+        }
+        RuntimeOptions threads;
+        threads.realtime = false;
+        Runtime runtime(world, std::move(devices), threads);
+        SessionOptions options;
+        options.durationS = durationS;
+        bool requested = false;
+        options.stopRequested = [&] { return requested; };
+        Session session(runtime, options);
+        REQUIRE(session.start() == 2);
+        const SessionEnd end = session.run([&](double tS) {
+            requested = durationS == 0 && tS >= 0.2;
+            return true;
+        });
+        CHECK(end == (durationS > 0 ? SessionEnd::Duration : SessionEnd::Requested));
+        CHECK(session.timeS() >= 0.2);
+        const RunReport& r = session.stop();
+        for (std::size_t i = 0; i < 2; ++i) {
+            CHECK(scripted[i]->lastForce() == Vec3(0.0));
+            CHECK(r.devices.at(i).ticks > 0);
+        }
+    }
 }
