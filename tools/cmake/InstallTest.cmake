@@ -154,9 +154,14 @@ if(NOT rc EQUAL 0 OR flags MATCHES "usb|httplib|meshoptimizer|hapto_devices|hapt
 endif()
 set(index_app ${WORK_DIR}/pkg-config-index)
 file(MAKE_DIRECTORY ${index_app})
-run(sh -c "cd '${index_app}' && '${CXX}' ${CXX_FLAGS} '${SOURCE_DIR}/tools/cmake/consumers/index/main.cpp' $(${PKG_CONFIG} --cflags --libs hapto-index) -o index ${LINKER_FLAGS}")
+# pkg_config_program(<name> <source> <pkg-config module>): built in index_app with its flags.
+function(pkg_config_program name source module)
+  run(sh -c "cd '${index_app}' && '${CXX}' ${CXX_FLAGS} '${source}' \
+             $(${PKG_CONFIG} --cflags --libs ${module}) -o ${name} ${LINKER_FLAGS}")
+endfunction()
+pkg_config_program(index ${SOURCE_DIR}/tools/cmake/consumers/index/main.cpp hapto-index)
 run(${index_app}/index)
 message(STATUS "hapto-index.pc: ${flags}")
 # And hapto-view.pc links the program serving the view (cpp-httplib through it).
-run(sh -c "cd '${index_app}' && '${CXX}' ${CXX_FLAGS} '${SOURCE_DIR}/tools/cmake/consumers/view/main.cpp' $(${PKG_CONFIG} --cflags --libs hapto-view) -o view ${LINKER_FLAGS}")
+pkg_config_program(view ${SOURCE_DIR}/tools/cmake/consumers/view/main.cpp hapto-view)
 run(${index_app}/view)

@@ -39,7 +39,8 @@ endforeach()
 # Its install holds those libraries' package and nothing that needs the others (the example,
 # the Falcon's udev rule, the hapto command).
 file(READ ${WORK_DIR}/index/cmake_install.cmake install_rules)
-if(NOT install_rules MATCHES "haptoTargets-index\\.cmake" OR install_rules MATCHES "haptoTargets-devices")
+if(NOT install_rules MATCHES "haptoTargets-index\\.cmake"
+   OR install_rules MATCHES "haptoTargets-devices")
   message(FATAL_ERROR "-DHAPTO_MODULES=index does not install exactly core, io, scenes and index")
 endif()
 foreach(needs_more "99-hapto-falcon\\.rules" "hapto/examples" "/bin/hapto")
