@@ -1,9 +1,10 @@
 // Built by the install test (InstallTest.cmake) with README's pkg-config line against an
-// installed hapto, then run. It reaches into every library and so into every dependency a
-// static hapto needs on the link line: a scene file's loader (assimp, simdjson), the octree's
-// build (TBB), the device factory (libusb for the Falcon, the loader of OpenHaptics' libHD),
-// the runtime and the experiments' tables. It runs one simulated hand in step mode for 0.2 s
-// and prints the force it is left with (zero after stop()).
+// installed hapto, then run. It reaches into every library but the view (the install test
+// builds the view's program with hapto-view.pc) and so into every dependency a static hapto
+// needs on the link line: a scene file's loaders, the octree's build (TBB), the device factory
+// (libusb for the Falcon, the loader of OpenHaptics' libHD), the runtime and the experiments'
+// tables. It runs one simulated hand in step mode for 0.2 s and prints the force it is left
+// with (zero after stop()).
 //
 //   PkgConfigApp [SCENE.json]   the grasp scene when no file is given
 
