@@ -38,6 +38,22 @@ LegCoords legCoords(const FalconGeometry& g, int leg, const Vec3& p) {
     return {cp * p.x + sp * p.y - g.r, -sp * p.x + cp * p.y - g.s, p.z, cp, sp};
 }
 
+/// One leg's terms of its closure equation g_i = A^2 + B^2 - L^2 at a tip position and a motor
+/// angle (t, rad), shared by the residual and its partial derivatives; s2 is the squared length
+/// of the parallelogram's projection (L = d + e + sqrt(s2), reachable when s2 >= 0).
+struct LegTerms {
+    LegCoords l;
+    double t, A, B, vf, s2;
+};
+
+LegTerms legTerms(const FalconGeometry& g, int leg, const Vec3& p, double t) {
+    const LegCoords l = legCoords(g, leg, p);
+    const double A = l.u + g.c - g.a * std::cos(t);
+    const double B = l.w - g.a * std::sin(t);
+    const double vf = l.v + g.f;
+    return {l, t, A, B, vf, g.b * g.b - vf * vf};
+}
+
 Eigen::Matrix3d toEigen(const Mat3& m) {
     Eigen::Matrix3d e;
     for (int c = 0; c < 3; ++c) {
@@ -111,14 +127,9 @@ Vec3 FalconKinematics::residual(const Vec3& p, const Angles& angles) const {
     const FalconGeometry& g = mGeometry;
     Vec3 out(0.0);
     for (int i = 0; i < 3; ++i) {
-        const LegCoords l = legCoords(g, i, p);
-        const double t = angles[static_cast<std::size_t>(i)];
-        const double A = l.u + g.c - g.a * std::cos(t);
-        const double B = l.w - g.a * std::sin(t);
-        const double vf = l.v + g.f;
-        const double s = std::sqrt(std::max(0.0, g.b * g.b - vf * vf));
-        const double L = g.d + g.e + s;
-        out[i] = A * A + B * B - L * L;
+        const LegTerms k = legTerms(g, i, p, angles[static_cast<std::size_t>(i)]);
+        const double L = g.d + g.e + std::sqrt(std::max(0.0, k.s2));
+        out[i] = k.A * k.A + k.B * k.B - L * L;
     }
     return out;
 }
@@ -127,25 +138,20 @@ bool FalconKinematics::partials(const Vec3& p, const Angles& angles, Mat3& dgdp,
                                 Vec3& dgdtheta) const {
     const FalconGeometry& g = mGeometry;
     for (int i = 0; i < 3; ++i) {
-        const LegCoords l = legCoords(g, i, p);
-        const double t = angles[static_cast<std::size_t>(i)];
-        const double A = l.u + g.c - g.a * std::cos(t);
-        const double B = l.w - g.a * std::sin(t);
-        const double vf = l.v + g.f;
-        const double s2 = g.b * g.b - vf * vf;
-        if (!(s2 > 0.0)) {
+        const LegTerms k = legTerms(g, i, p, angles[static_cast<std::size_t>(i)]);
+        if (!(k.s2 > 0.0)) {
             return false;
         }
-        const double s = std::sqrt(s2);
+        const double s = std::sqrt(k.s2);
         const double L = g.d + g.e + s;
-        const double dgdu = 2.0 * A;
-        const double dgdv = 2.0 * L * vf / s; // -2L * dS/dv, dS/dv = -vf / s
-        const double dgdw = 2.0 * B;
+        const double dgdu = 2.0 * k.A;
+        const double dgdv = 2.0 * L * k.vf / s; // -2L * dS/dv, dS/dv = -vf / s
+        const double dgdw = 2.0 * k.B;
         // Row i of dg/dp (GLM is column-major: m[col][row]).
-        dgdp[0][i] = dgdu * l.cosPhi - dgdv * l.sinPhi;
-        dgdp[1][i] = dgdu * l.sinPhi + dgdv * l.cosPhi;
+        dgdp[0][i] = dgdu * k.l.cosPhi - dgdv * k.l.sinPhi;
+        dgdp[1][i] = dgdu * k.l.sinPhi + dgdv * k.l.cosPhi;
         dgdp[2][i] = dgdw;
-        dgdtheta[i] = 2.0 * g.a * (A * std::sin(t) - B * std::cos(t));
+        dgdtheta[i] = 2.0 * g.a * (k.A * std::sin(k.t) - k.B * std::cos(k.t));
     }
     return true;
 }

@@ -21,14 +21,8 @@ ForceSafety::ForceSafety(const SafetyConfig& config) : mConfig(config) {
     }
 }
 
-ForceSafety::ForceSafety(const ForceSafety& other) noexcept
-    : mConfig(other.mConfig), mLast(other.mLast) {
-    const SafetyCounters c = other.counters();
-    mFiltered.store(c.filtered, std::memory_order_relaxed);
-    mClamped.store(c.clamped, std::memory_order_relaxed);
-    mRateLimited.store(c.rateLimited, std::memory_order_relaxed);
-    mNonFinite.store(c.nonFinite, std::memory_order_relaxed);
-    mOverflowed.store(c.overflowed, std::memory_order_relaxed);
+ForceSafety::ForceSafety(const ForceSafety& other) noexcept {
+    *this = other;
 }
 
 ForceSafety& ForceSafety::operator=(const ForceSafety& other) noexcept {

@@ -73,16 +73,8 @@ std::vector<ReportDevice> readReport(const std::string& path) {
     return out;
 }
 
-/// An empty panel with its title and axis labels (units in the labels).
-experiments::PlotPanel panel(const std::string& title, const std::string& x, const std::string& y) {
-    experiments::PlotPanel p;
-    p.title = title;
-    p.xLabel = x;
-    p.yLabel = y;
-    return p;
-}
-
 experiments::PlotSpec reportPlot(const std::string& path, const std::vector<ReportDevice>& devs) {
+    using experiments::panel;
     using experiments::PlotPanel;
     using experiments::PlotSeries;
     experiments::PlotSpec spec;

@@ -111,15 +111,6 @@ void printInfo(const std::string& tracePath) {
 /// contact spans still come from every sample).
 constexpr std::size_t kMaxPlotPoints = 4000;
 
-/// An empty panel with its title and axis labels (units in the labels).
-experiments::PlotPanel panel(const std::string& title, const std::string& x, const std::string& y) {
-    experiments::PlotPanel p;
-    p.title = title;
-    p.xLabel = x;
-    p.yLabel = y;
-    return p;
-}
-
 /// The time axis of a sample (s since the session started).
 double seconds(const TraceSample& s) {
     return static_cast<double>(s.timeNs) * 1e-9;
@@ -128,6 +119,7 @@ double seconds(const TraceSample& s) {
 /// A figure of traces: position, proxy, force and tick time against time, one colour per
 /// device, shaded where a device was in contact (version 2 traces: contact count > 0).
 experiments::PlotSpec tracePlot(const std::vector<std::string>& paths) {
+    using experiments::panel;
     using experiments::PlotPanel;
     using experiments::PlotSeries;
     experiments::PlotSpec spec;

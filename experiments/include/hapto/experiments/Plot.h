@@ -37,6 +37,15 @@ struct PlotPanel {
     std::string spanTitle{}; ///< Legend text of the shading (empty: none).
 };
 
+/// An empty panel with its title and axis labels (units in the labels).
+inline PlotPanel panel(std::string title, std::string xLabel, std::string yLabel) {
+    PlotPanel p;
+    p.title = std::move(title);
+    p.xLabel = std::move(xLabel);
+    p.yLabel = std::move(yLabel);
+    return p;
+}
+
 /// A figure: panels side by side, or in a grid of `columns` columns.
 struct PlotSpec {
     std::string name;              ///< File stem: NAME.gp, NAME.png, NAME.svg.
