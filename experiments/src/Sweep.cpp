@@ -42,6 +42,150 @@ struct Key {
     }
 };
 
+/// What a sweep carries from one size to the next, and the rows so far.
+struct SweepState {
+    std::map<Key, bool> active;                   ///< (renderer, rate) pairs still growing.
+    std::map<std::string, double> bytesPerObject; ///< Index memory per object at the last size.
+    std::set<Key> unstableHere; ///< Pairs with an unstable cell at the current size.
+    std::vector<SweepRow> rows; ///< In measurement order.
+};
+
+/// One scene of a step, ready to measure: each condition's start (checked clear) and the
+/// objects near it that the condition's script plans against.
+struct PreparedScene {
+    Scene scene;
+    std::vector<Vec3> starts;      ///< Per condition (m, world).
+    std::vector<Scene> planScenes; ///< Per condition.
+};
+
+/// Generates the scene and its starts; throws std::logic_error when a start is not clear.
+PreparedScene prepareScene(const SweepScene& sc, const SweepStep& step, const SweepOptions& options,
+                           Progress& progress) {
+    progress.show("generating " + std::to_string(step.objects) + " objects");
+    PreparedScene p{sc.make(), {}, {}};
+    for (const Condition c : kConditions) {
+        p.starts.push_back(sc.start(p.scene, c));
+        requireClear(p.scene, p.starts.back(), 0.0, options.experiment + " start");
+        const Vec3 r(kPlanRadiusM);
+        p.planScenes.push_back(sceneNear(p.scene, {p.starts.back() - r, p.starts.back() + r}));
+    }
+    return p;
+}
+
+/// The rates at which `r` is measured at `step`: those at which it still grows, and every rate
+/// when the step names it in mustRun; the cells at the other rates count as done on `progress`.
+std::vector<double> ratesNeeded(SweepState& state, const SweepStep& step, const SweepRenderer& r,
+                                const SweepOptions& options, Progress& progress) {
+    const bool must =
+        std::find(step.mustRun.begin(), step.mustRun.end(), r.name) != step.mustRun.end();
+    std::vector<double> rates;
+    for (const double rate : options.ratesHz) {
+        if (state.active[{r.name, rate}] || must) {
+            rates.push_back(rate);
+        } else {
+            progress.advance(step.scenes.size() * std::size(kConditions), "");
+        }
+    }
+    return rates;
+}
+
+/// Records the three cells of `base`'s renderer at `rate` as skipped for `note` (so unstable).
+void skipCells(SweepState& state, const SweepRow& base, double rate, const std::string& note,
+               Progress& progress) {
+    for (const Condition c : kConditions) {
+        SweepRow row = base;
+        row.rateHz = rate;
+        row.condition = c;
+        row.skipped = true;
+        row.note = note;
+        state.rows.push_back(row);
+    }
+    state.unstableHere.insert({base.renderer, rate});
+    progress.advance(std::size(kConditions), base.renderer);
+}
+
+/// Measures one cell over `world`: `repeats` timed runs of one hand from the condition's start,
+/// concluded into the row. [control]
+void measureCell(SweepState& state, World& world, const PreparedScene& p, const SweepRow& base,
+                 double rate, std::size_t ci, const SweepOptions& options, Progress& progress) {
+    const Condition c = kConditions[ci];
+    SweepRow row = base;
+    row.rateHz = rate;
+    row.condition = c;
+    progress.show(base.renderer + " " + std::to_string(p.scene.size()) + " " +
+                  std::string(conditionName(c)) + " " + rateText(rate));
+    HandPlan hand{simHand("hand", rate, conditionScript(c), 1, p.starts[ci]), &p.planScenes[ci]};
+    for (int k = 0; k < options.servo.repeats; ++k) {
+        const SessionResult s = runSession(world, {hand}, options.servo);
+        row.runs.push_back(figuresOf(s.report.devices.at(0), options.servo.tail));
+        row.reachedPhase = row.reachedPhase && s.reached.at(0);
+    }
+    concludeRow(row);
+    if (!row.stable(options.verdict)) {
+        state.unstableHere.insert({base.renderer, rate});
+    }
+    state.rows.push_back(std::move(row));
+    progress.advance(1, base.renderer);
+}
+
+/// Measures renderer `r` over one prepared scene at `rates`: the memory guard, the index build,
+/// the probe (a rate whose probed tick overruns is skipped), then every condition. [control]
+void measureRenderer(SweepState& state, const PreparedScene& p, const SweepScene& sc,
+                     const SweepStep& step, const SweepRenderer& r,
+                     const std::vector<double>& rates, const SweepOptions& options,
+                     Progress& progress) {
+    const Scene& scene = p.scene;
+    SweepRow base;
+    base.renderer = r.name;
+    base.index = r.spec.toString();
+    base.size = step.size;
+    base.objects = indexedItems(scene);
+    base.seed = sc.seed;
+    const auto skipAll = [&](const std::string& note) {
+        for (const double rate : rates) {
+            skipCells(state, base, rate, note, progress);
+        }
+    };
+    // Memory guard, from the previous size of this renderer.
+    if (const auto it = state.bytesPerObject.find(r.name); it != state.bytesPerObject.end()) {
+        const double mb = it->second * static_cast<double>(scene.size()) / 1e6;
+        if (mb > options.maxIndexMb) {
+            skipAll("index would take about " + fmt(mb, 0) +
+                    " MB (extrapolated), over --max-index-mb");
+            return;
+        }
+    }
+    progress.show("building " + base.index + " over " + std::to_string(scene.size()) + " objects");
+    std::unique_ptr<World> world;
+    try {
+        // The build itself refuses past the limit too (its own estimate).
+        world = std::make_unique<World>(scene, r.spec.withMaxMegabytes(static_cast<std::uint64_t>(
+                                                   std::ceil(options.maxIndexMb))));
+    } catch (const std::exception& e) {
+        skipAll(std::string("index build failed: ") + e.what());
+        return;
+    }
+    const IndexStats& stats = world->current().index->stats();
+    base.buildS = stats.buildSeconds;
+    base.indexMb = static_cast<double>(stats.bytes) / 1e6;
+    state.bytesPerObject[r.name] =
+        static_cast<double>(stats.bytes) / std::max(1.0, double(scene.size()));
+    const double probeS = probeTickSeconds(*world, p.starts[0], kProbeTicks);
+    base.probeTickUs = probeS * 1e6;
+    for (const double rate : rates) {
+        if (probeS * rate > options.skipTickPeriods) {
+            skipCells(state, base, rate,
+                      "probe: one tick takes " + fmt(probeS * 1e6, 0) + " us, " +
+                          fmt(probeS * rate, 1) + " periods",
+                      progress);
+            continue;
+        }
+        for (std::size_t ci = 0; ci < std::size(kConditions); ++ci) {
+            measureCell(state, *world, p, base, rate, ci, options, progress);
+        }
+    }
+}
+
 } // namespace
 
 std::string rateText(double rateHz) {
@@ -57,150 +201,37 @@ std::string rateText(double rateHz) {
 std::vector<SweepRow> runSweep(const std::vector<SweepRenderer>& renderers,
                                const std::vector<SweepStep>& steps, const SweepOptions& options,
                                Progress& progress) {
-    std::vector<SweepRow> rows;
-    std::map<Key, bool> active;
+    SweepState state;
     for (const SweepRenderer& r : renderers) {
         for (const double rate : options.ratesHz) {
-            active[{r.name, rate}] = true;
+            state.active[{r.name, rate}] = true;
         }
     }
-    // Index memory per object at the previous size, to extrapolate.
-    std::map<std::string, double> bytesPerObject;
-    const std::size_t perScene = std::size(kConditions);
     for (const SweepStep& step : steps) {
-        const auto needed = [&](const SweepRenderer& r, double rate) {
-            return active[{r.name, rate}] || std::find(step.mustRun.begin(), step.mustRun.end(),
-                                                       r.name) != step.mustRun.end();
-        };
+        // Per renderer, the rates it is measured at here.
+        std::vector<std::vector<double>> rates;
         bool any = false;
         for (const SweepRenderer& r : renderers) {
-            for (const double rate : options.ratesHz) {
-                if (needed(r, rate)) {
-                    any = true;
-                } else {
-                    progress.advance(step.scenes.size() * perScene, "");
-                }
-            }
+            rates.push_back(ratesNeeded(state, step, r, options, progress));
+            any = any || !rates.back().empty();
         }
         if (!any) {
             continue;
         }
-        std::set<Key> unstableHere;
+        state.unstableHere.clear();
         for (const SweepScene& sc : step.scenes) {
-            progress.show("generating " + std::to_string(step.objects) + " objects");
-            const Scene scene = sc.make();
-            std::vector<Vec3> starts;
-            std::vector<Scene> planScenes;
-            for (const Condition c : kConditions) {
-                starts.push_back(sc.start(scene, c));
-                requireClear(scene, starts.back(), 0.0, options.experiment + " start");
-                const Vec3 r(kPlanRadiusM);
-                planScenes.push_back(sceneNear(scene, {starts.back() - r, starts.back() + r}));
-            }
-            for (const SweepRenderer& r : renderers) {
-                std::vector<double> rates;
-                for (const double rate : options.ratesHz) {
-                    if (needed(r, rate)) {
-                        rates.push_back(rate);
-                    }
-                }
-                if (rates.empty()) {
-                    continue;
-                }
-                SweepRow base;
-                base.renderer = r.name;
-                base.index = r.spec.toString();
-                base.size = step.size;
-                base.objects = indexedItems(scene);
-                base.seed = sc.seed;
-                const auto skipAll = [&](const std::string& note) {
-                    for (const double rate : rates) {
-                        for (const Condition c : kConditions) {
-                            SweepRow row = base;
-                            row.rateHz = rate;
-                            row.condition = c;
-                            row.skipped = true;
-                            row.note = note;
-                            rows.push_back(row);
-                            unstableHere.insert({r.name, rate});
-                        }
-                        progress.advance(perScene, r.name);
-                    }
-                };
-                // Memory guard, from the previous size of this renderer.
-                if (const auto it = bytesPerObject.find(r.name); it != bytesPerObject.end()) {
-                    const double mb = it->second * static_cast<double>(scene.size()) / 1e6;
-                    if (mb > options.maxIndexMb) {
-                        skipAll("index would take about " + fmt(mb, 0) +
-                                " MB (extrapolated), over --max-index-mb");
-                        continue;
-                    }
-                }
-                progress.show("building " + base.index + " over " + std::to_string(scene.size()) +
-                              " objects");
-                std::unique_ptr<World> world;
-                try {
-                    // The build itself refuses past the limit too (its own estimate).
-                    world = std::make_unique<World>(
-                        scene, r.spec.withMaxMegabytes(
-                                   static_cast<std::uint64_t>(std::ceil(options.maxIndexMb))));
-                } catch (const std::exception& e) {
-                    skipAll(std::string("index build failed: ") + e.what());
-                    continue;
-                }
-                const IndexStats& stats = world->current().index->stats();
-                base.buildS = stats.buildSeconds;
-                base.indexMb = static_cast<double>(stats.bytes) / 1e6;
-                bytesPerObject[r.name] =
-                    static_cast<double>(stats.bytes) / std::max(1.0, double(scene.size()));
-                const double probeS = probeTickSeconds(*world, starts[0], kProbeTicks);
-                base.probeTickUs = probeS * 1e6;
-
-                for (const double rate : rates) {
-                    if (probeS * rate > options.skipTickPeriods) {
-                        for (const Condition c : kConditions) {
-                            SweepRow row = base;
-                            row.rateHz = rate;
-                            row.condition = c;
-                            row.skipped = true;
-                            row.note = "probe: one tick takes " + fmt(probeS * 1e6, 0) + " us, " +
-                                       fmt(probeS * rate, 1) + " periods";
-                            rows.push_back(row);
-                        }
-                        unstableHere.insert({r.name, rate});
-                        progress.advance(perScene, r.name);
-                        continue;
-                    }
-                    for (std::size_t ci = 0; ci < perScene; ++ci) {
-                        const Condition c = kConditions[ci];
-                        SweepRow row = base;
-                        row.rateHz = rate;
-                        row.condition = c;
-                        progress.show(r.name + " " + std::to_string(scene.size()) + " " +
-                                      std::string(conditionName(c)) + " " + rateText(rate));
-                        HandPlan hand{simHand("hand", rate, conditionScript(c), 1, starts[ci]),
-                                      &planScenes[ci]};
-                        for (int k = 0; k < options.servo.repeats; ++k) {
-                            const SessionResult s = runSession(*world, {hand}, options.servo);
-                            row.runs.push_back(
-                                figuresOf(s.report.devices.at(0), options.servo.tail));
-                            row.reachedPhase = row.reachedPhase && s.reached.at(0);
-                        }
-                        concludeRow(row);
-                        if (!row.stable(options.verdict)) {
-                            unstableHere.insert({r.name, rate});
-                        }
-                        rows.push_back(std::move(row));
-                        progress.advance(1, r.name);
-                    }
+            const PreparedScene p = prepareScene(sc, step, options, progress);
+            for (std::size_t i = 0; i < renderers.size(); ++i) {
+                if (!rates[i].empty()) {
+                    measureRenderer(state, p, sc, step, renderers[i], rates[i], options, progress);
                 }
             }
         }
-        for (const Key& k : unstableHere) {
-            active[k] = false;
+        for (const Key& k : state.unstableHere) {
+            state.active[k] = false;
         }
     }
-    return rows;
+    return state.rows;
 }
 
 void concludeRow(SweepRow& row) {
