@@ -13,6 +13,7 @@
 #include "hapto/runtime/World.h"
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 
@@ -47,6 +48,18 @@ struct TickOutput {
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
 };
 
+namespace detail {
+/// The leaves a tick's candidate spans list (N at most): the device's, the proxy's, then the
+/// extra ones, in the order their spans were added.
+template <std::size_t N> struct ListedLeaves {
+    std::array<std::uint32_t, N> leaves{};
+    std::size_t count = 0;
+    std::span<const std::uint32_t> known() const noexcept {
+        return std::span<const std::uint32_t>(leaves.data(), count);
+    }
+};
+} // namespace detail
+
 /// One device's haptic tick around a force algorithm (the seam: ForceAlgorithm.h; HapticTick
 /// is the tick around the god-object renderer). Design note: the sequence every caller runs (the
 /// servo threads, the runtime's step mode, `hapto render`, the experiments' warm-up and tick probe)
@@ -76,12 +89,9 @@ public:
     /// Leaves the proxy may slide into in one tick, each solved again with its items
     /// (CandidateSet has a span for each: device, proxy, moving, and these).
     static constexpr std::size_t kExtraLeaves = CandidateSet::kMaxSpans - 3;
-    /// Goals pulled back when the proxy's path crosses more unlisted leaves than kExtraLeaves:
-    /// halving toward the proxy's start three times (the first halves the way to where the straight
-    /// line to the device point leaves the listed leaves, if it does), then kNudgeM from the start
-    /// toward the device point, then the start itself. The proxy moves only toward the pulled-back
-    /// goal; the contacts and the force are taken at the device point (GodObjectRenderer::update
-    /// with a goal), so a pulled-back tick pushes as hard as a full one.
+    /// Goals pulled back when the proxy's path crosses more unlisted leaves than kExtraLeaves
+    /// (pullBack() in HapticTick.cpp): three halvings toward the proxy's start, kNudgeM from it,
+    /// the start itself; contacts and force stay the device point's, as hard as a full tick's.
     static constexpr int kPullBacks = 5;
     /// The last pull-back but one moves the proxy at most this far (m): enough to meet the
     /// surfaces it rests on that the device point is behind, so the tick keeps their contact
@@ -140,15 +150,8 @@ public:
     const ForceSafety& safety() const noexcept { return mSafety; }
 
 private:
-    /// The leaves this tick's candidate spans list: the device's, the proxy's, then the extra
-    /// ones, in the order their spans were added.
-    struct ListedLeaves {
-        std::array<std::uint32_t, 2 + kExtraLeaves> leaves{};
-        std::size_t count = 0;
-        std::span<const std::uint32_t> known() const noexcept {
-            return std::span<const std::uint32_t>(leaves.data(), count);
-        }
-    };
+    /// The leaves this tick's candidate spans list: the device's, the proxy's, the extra ones.
+    using ListedLeaves = detail::ListedLeaves<2 + kExtraLeaves>;
 
     /// Writes the clock as stage `i`'s end when stages are timed. [servo]
     void stamp(std::size_t i) noexcept;
