@@ -3,10 +3,10 @@
 /// state, what it shares with other threads, and the cold record supervision and reports use.
 ///
 /// Design note. A Channel is laid out in four parts, by who touches them how often:
-///   ServoState      hot: everything one tick reads or writes and nothing else (the device
+///   ServoStep       hot: everything one tick reads or writes and nothing else (the device
 ///                   pointer, the frames, the deadline, the sample, the haptic tick with its
-///                   effects and hook). Only the servo thread (or the stepping thread) touches
-///                   it while the servo runs; its size is asserted below.
+///                   effects and hook, pointers to the parts below). Only the servo thread (or
+///                   the stepping thread) touches it while the servo runs (its size: ServoStep.h).
 ///   DeviceMetrics   written every tick by the servo, read by any thread (its own lines).
 ///   three Mailboxes contacts out, external force in, every tick; effects in, when the control
 ///                   thread changes them, with a count the servo checks every tick (their own
@@ -18,6 +18,7 @@
 #include "hapto/runtime/HapticTick.h"
 #include "hapto/runtime/Realtime.h"
 #include "hapto/runtime/Runtime.h"
+#include "hapto/runtime/ServoStep.h"
 
 #include <array>
 #include <atomic>
@@ -32,39 +33,6 @@ namespace hapto {
 
 // What crosses threads through the mailboxes below is plain structs of vectors.
 static_assert(std::is_trivially_copyable_v<ContactReport> && std::is_trivially_copyable_v<Vec3>);
-
-/// The servo's hot state: what a tick reads and writes. [servo] while the servo runs;
-/// [control] (or the supervisor) only while it does not.
-struct alignas(64) ServoState {
-    // Fixed from construction (reader: from open).
-    Device* device = nullptr;
-    TraceRecorder* recorder = nullptr;
-    SnapshotReader* reader = nullptr;
-    WorkspaceTransform transform;
-    Vec3 toolTip{0.0}; ///< The contact point in the stylus frame (m); 0 = the gimbal centre.
-    std::uint64_t periodNs = 1'000'000;
-    std::uint64_t lateNs = 0;    ///< A wake-up later than this is counted late.
-    std::uint64_t starvedNs = 0; ///< One this late (K periods) commands zero.
-    std::uint64_t stallNs = 0;   ///< The watchdog's limit between two ticks.
-    double dtS = 1e-3;           ///< The period (s).
-    int missLimit = 3;           ///< K.
-
-    // Per tick.
-    std::uint64_t deadlineNs = 0;     ///< The next wake-up.
-    std::uint64_t tick = 0;           ///< Ticks completed, over every start of the servo.
-    std::uint64_t effectsApplied = 0; ///< Effect sets published that the haptic tick holds.
-    int consecutiveMisses = 0;        ///< Saturates at missLimit.
-    bool first = true;                ///< The next tick is the first since the servo started.
-    std::atomic<bool> stop{false};
-    Vec3 lastPosition{0.0}; ///< The last device point (m, world).
-    Vec3 lastStep{0.0};     ///< The last tick's move of the device point (m, world).
-    DeviceState sample;     ///< The last reading.
-    HapticTick haptic;
-
-    ServoState(const RendererConfig& renderer, const SafetyConfig& safety)
-        : haptic(renderer, safety) {}
-};
-static_assert(sizeof(ServoState) == 12480, "update the size in the note above");
 
 /// The cold record of a channel.
 struct ChannelRecord {
@@ -94,7 +62,7 @@ struct ChannelRecord {
 };
 
 struct alignas(64) Runtime::Channel {
-    ServoState servo;                ///< Hot.
+    ServoStep servo;                 ///< Hot.
     DeviceMetrics metrics;           ///< Servo -> any thread.
     Mailbox<ContactReport> contacts; ///< Servo -> control, every tick.
     Mailbox<Vec3> externalForce;     ///< Control -> servo, world frame (N).
@@ -115,12 +83,5 @@ struct Runtime::Group {
     std::thread thread;
     std::atomic<bool> stop{false}; ///< The thread leaves its loop (each member at zero force).
 };
-
-/// Stores a vector into three relaxed atomics. [servo]
-inline void storeVec(std::atomic<double> (&dst)[3], const Vec3& v) noexcept {
-    for (int i = 0; i < 3; ++i) {
-        dst[i].store(v[i], std::memory_order_relaxed);
-    }
-}
 
 } // namespace hapto

@@ -7,7 +7,7 @@
 // simulated device never blocks in read() or write(), so for simulated devices only the
 // runtime can put K of them on one thread: the thread sleeps once to the earliest deadline of
 // its running members and then ticks every member due, earliest deadline first, each with the
-// same servoTick() a lone device runs. So every member keeps its own deadline, cursor,
+// same ServoStep a lone device runs. So every member keeps its own deadline, cursor,
 // renderer, effects, safety filter, load record (its wake-up is when its own tick starts, so
 // waiting behind the group's earlier ticks shows as its lateness, and its load is its own
 // work) and faults:
@@ -16,7 +16,7 @@
 //     group's loop at its restart (restartServo), with a deadline one period on;
 //   - a group stalled (in one member's device, or by the host) stops every member's
 //     heartbeat: the watchdog faults each, and each member commands zero at the thread's next
-//     turn (servoTick's own stall check, or the stop flag below);
+//     turn (the step's own stall check, or the stop flag below);
 //   - stop() and emergencyStop() stop the group: each running member commands zero as the
 //     thread leaves.
 // In step mode stepAll() runs each group the same way on the caller's thread: the clock is the
@@ -95,7 +95,7 @@ void Runtime::tickDue(Group& g) noexcept {
     }
     for (std::size_t i = 0; i < due; ++i) {
         Channel& ch = *g.due[i];
-        if (ch.servo.stop.load(std::memory_order_acquire) || !servoTick(ch, now())) {
+        if (ch.servo.stop.load(std::memory_order_acquire) || !ch.servo.run(now())) {
             leaveServo(ch);
         }
     }

@@ -12,6 +12,7 @@
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Realtime.h"
 #include "hapto/runtime/ServoLoop.h"
+#include "hapto/runtime/ServoStep.h"
 #include "hapto/runtime/TickHook.h"
 #include "hapto/runtime/World.h"
 
@@ -33,20 +34,7 @@ namespace hapto {
 
 class TraceRecorder;
 
-/// No object: a ContactReport slot that holds no contact.
-inline constexpr ObjectId kNoObject = 0xFFFFFFFFu;
-
-/// What a servo thread tells the control thread every tick: the force it sent and its contacts
-/// (world frame); Runtime::lastTick() reads the newest.
-struct ContactReport {
-    std::uint64_t tick = 0; ///< The servo tick it describes.
-    Vec3 devicePoint{0.0};  ///< Device point (m).
-    Vec3 proxy{0.0};        ///< God-object proxy (m).
-    Vec3 force{0.0};        ///< Force sent, external force included (N).
-    std::array<ObjectId, 3> objects{kNoObject, kNoObject, kNoObject}; ///< Touched object ids.
-    std::array<Vec3, 3> normals{};  ///< Their outward contact normals.
-    std::uint32_t contactCount = 0; ///< How many of the above are set.
-};
+// ContactReport (what a servo tells the control thread every tick) is in ServoStep.h.
 
 /// How servo threads run.
 struct RuntimeOptions {
@@ -265,7 +253,6 @@ private:
     void requireStepped(const char* what) const;
     // ServoLoop.cpp: the servo, threaded or stepped.
     void startServo(Channel& channel, std::uint64_t nowNs) noexcept;
-    bool servoTick(Channel& channel, std::uint64_t wakeNs) noexcept;
     void leaveServo(Channel& channel) noexcept;
     std::uint64_t warm(Channel& channel) noexcept;
     void startThread(Channel& channel);
