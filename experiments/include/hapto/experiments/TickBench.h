@@ -1,0 +1,145 @@
+#pragma once
+/// The harness behind `hapto bench tick`: the servo's own step (ServoStep) over one scene along
+/// a seeded hand walk, timed stage by stage, each tick started back to back, after a sleep, or
+/// after a sleep with the servo loop's warm-up.
+///
+/// Design note. The bench runs no copy of the tick: each (index, mode) owns a ServoStep set up
+/// as the runtime sets up a device's (1 kHz, the default renderer and safety filter, the
+/// runtime's miss rules) and calls ServoStep::run with a probe, which stamps the clock at
+/// each stage's end. So read, fault checks, frame and tool tip, velocity, effects, hook,
+/// safety, miss rules, write, metrics and contacts all run and are timed as a servo runs them.
+/// Two things differ from a servo thread, both outside the step: the bench sets each tick's
+/// deadline itself (the wake-up when back to back, the end of the sleep otherwise), and it has
+/// no watchdog, since its runs take turns in blocks and a run waits while the others tick.
+/// The device plays the walk (WalkDevice); with `sim` it reads and writes a simulated hand
+/// too, so their cost is timed, but the walk still gives the point.
+
+#include "hapto/core/Geometry.h"
+#include "hapto/devices/Device.h"
+#include "hapto/experiments/HandWalk.h"
+#include "hapto/index/SpatialIndex.h"
+#include "hapto/runtime/ServoLoop.h"
+#include "hapto/runtime/ServoStep.h"
+#include "hapto/runtime/World.h"
+#include "hapto/scenes/Scene.h"
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hapto::experiments {
+
+/// A device that plays a hand walk: read() hands over the walk's next point (device frame =
+/// world frame) without a velocity, write() keeps the force. Over an `inner` device (a
+/// simulated hand) it reads and writes that one too and reports its status, with the walk's
+/// point in place of its position. Kind "scripted": made by a program, never by a device file.
+class WalkDevice final : public Device {
+public:
+    /// A walk over `bounds` (m) from `seed`; `inner` may be null. [control]
+    WalkDevice(const Aabb& bounds, std::uint64_t seed, std::unique_ptr<Device> inner = nullptr);
+    std::string_view name() const override { return "walk"; }
+    DeviceKind kind() const override { return DeviceKind::Scripted; }
+    DeviceCapabilities capabilities() const override { return {}; }
+    DeviceStatus open() override;
+    void close() override;
+    DeviceStatus read(DeviceState& state) noexcept override;
+    DeviceStatus write(const Vec3& forceN) noexcept override;
+    void periodsSkipped(std::uint64_t periods) noexcept override;
+    std::string errorMessage() const override;
+    /// The walk, to hold the hand back. [control]
+    HandWalk& walk() { return mWalk; }
+    /// The last force written (N, device frame). [control]
+    const Vec3& lastForceN() const { return mForceN; }
+
+private:
+    HandWalk mWalk;
+    std::unique_ptr<Device> mInner;
+    Vec3 mForceN{0.0};
+};
+
+/// A hand that feels the force: after a tick it is held back to at most `pushM` (m, > 0) from
+/// the proxy when it is farther (beyond the proxy only where a surface holds it back); 0
+/// leaves it alone. [control]
+void holdHandBack(HandWalk& hand, const Vec3& devicePointM, const Vec3& proxyM, double pushM);
+
+/// How a tick is started: back to back, after a sleep, or after a sleep with the servo loop's
+/// warm-up before the deadline.
+enum class TickMode : std::uint8_t { Hot, Sleep, Warm };
+
+/// The box the walk roams: `bounds`, or with `edgeM` > 0 their part within the cube of that
+/// edge (m) centred on their centre.
+Aabb walkBox(const Aabb& bounds, double edgeM);
+
+/// What to run.
+struct TickBenchSettings {
+    std::vector<IndexSpec> indices; ///< One target each.
+    bool simDevice = false;         ///< Read and write a simulated hand too (--device sim).
+    std::size_t ticks = 5000;       ///< Ticks per mode and index.
+    double sleepUs = 1000;          ///< Sleep before each tick of the sleep modes (us).
+    double warmUs = static_cast<double>(kDefaultWarmUpNs) / 1000.0; ///< Warm-up (us).
+    std::uint64_t seed = 1;                                         ///< The walk's seed.
+    Aabb walkIn{Vec3(0.0), Vec3(0.0)}; ///< The box the walk roams (m; walkBox()).
+    /// After each tick the hand is held back to at most this far from the proxy (mm); 0: it
+    /// ignores the force and walks through everything, leaving the proxy behind.
+    double pushMm = 2.0;
+    std::int32_t wakeLatencyUs = -1; ///< >= 0: also the sleep modes with this request held.
+    /// The modes to run; empty: hot, sleep, sleep+warm (and the held ones with wakeLatencyUs).
+    std::vector<TickMode> modes;
+};
+
+/// One (index, mode) being driven: its device, its step and its per-tick samples.
+struct TickRun {
+    TickMode mode = TickMode::Hot;
+    bool holdLatency = false;     ///< Holds the wake-latency request while it ticks.
+    WalkDevice* device = nullptr; ///< The device `owned` holds.
+    std::unique_ptr<Device> owned;
+    std::unique_ptr<ServoStep> step;
+    std::unique_ptr<ServoStepShared> shared; ///< Its metrics and mailboxes.
+    ServoStepProbe probe;
+    std::array<std::vector<double>, ServoStepProbe::kStages> stageNs; ///< Per stage, per tick.
+    std::vector<double> tickNs; ///< Per tick: wake-up to the end of the metrics stage (ns).
+    std::vector<Vec3> forceN;   ///< Per tick: the force sent (N, world).
+    std::vector<double> gapM;   ///< Per tick: the device point's distance from the proxy (m).
+    std::uint64_t ticks = 0, locateSteps = 0, candidates = 0, contactTicks = 0;
+    std::uint64_t solves = 0, extraLeaves = 0, pullBacks = 0; ///< HapticTick's, summed.
+    std::uint64_t kept = 0;                                   ///< What the warm-up read, kept.
+    /// Warm-ups still running at their deadline: those ticks started late by the overrun,
+    /// which the tick's time (from the wake-up) does not show.
+    std::uint64_t warmOverruns = 0;
+    /// Per tick after a sleep: how long after its deadline it started (ns; 0 if on time): the
+    /// wake-up's lateness, plus a warm-up's overrun. A servo reads its device this late.
+    std::vector<double> startLateNs;
+};
+
+/// One index: its world (scene copy, index, snapshots) and its runs.
+struct TickTarget {
+    IndexSpec spec;
+    std::unique_ptr<World> world;
+    std::vector<std::unique_ptr<TickRun>> runs;
+};
+
+/// "hot", "sleep", "sleep+warm", "sleep+lat", "sleep+warm+lat". [any thread]
+const char* modeName(const TickRun& run);
+
+/// Builds every target over `scene` and runs every (index, mode) for settings.ticks ticks, the
+/// runs taking turns in blocks of kTickBlock ticks (each block starting with another run), so
+/// a slow spell of the machine falls on all of them alike. Throws std::runtime_error when a
+/// device does not open, a wake-latency request cannot be held, or a step faults. [control]
+std::vector<TickTarget> runTickBench(const Scene& scene, const TickBenchSettings& settings);
+/// Ticks a run takes in one turn.
+inline constexpr std::size_t kTickBlock = 256;
+
+/// Nearest-rank quantiles and the mean of some samples.
+struct Quantiles {
+    double p50 = 0, p99 = 0, p999 = 0, mean = 0;
+};
+/// The nearest-rank quantile `q` of `sorted` samples (0 when empty). [any thread]
+double quantileOfSorted(const std::vector<double>& sorted, double q);
+/// The quantiles of `samples` (all zero when empty). [any thread]
+Quantiles quantilesOf(std::vector<double> samples);
+
+} // namespace hapto::experiments

@@ -1,0 +1,135 @@
+// The harness behind `hapto bench tick` (experiments/TickBench.h) runs the servo's own step:
+// along the same walk its forces and metrics are a stepped Runtime's, bit for bit; the
+// experiments' warmed hand is primed by that step too. Behaviour
+// only: nothing here depends on how fast anything runs (the bench's hot mode sets each tick's
+// deadline to its wake-up, so a tick misses only if it takes a whole period, three times in a
+// row before any force changes).
+
+#include "hapto/experiments/ExperimentSupport.h"
+#include "hapto/experiments/TickBench.h"
+#include "hapto/runtime/Runtime.h"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+using namespace hapto;
+using namespace hapto::experiments;
+
+namespace {
+
+/// 27 cubes of 2 cm, 4 cm apart, in a 14 cm box: a walk over it touches several.
+Scene cubeGrid() {
+    std::vector<SceneObject> objects;
+    ObjectId id = 0;
+    for (int x = -1; x <= 1; ++x) {
+        for (int y = -1; y <= 1; ++y) {
+            for (int z = -1; z <= 1; ++z) {
+                objects.push_back(makeBox(id++, 0.04 * Vec3(x, y, z), Vec3(0.01)));
+            }
+        }
+    }
+    return Scene(Aabb{Vec3(-0.07), Vec3(0.07)}, std::move(objects));
+}
+
+} // namespace
+
+TEST_CASE("bench tick runs the servo's step: its forces and metrics are a stepped Runtime's") {
+    const Scene scene = cubeGrid();
+    const IndexSpec spec = IndexSpec::parse("octree:2:0.005");
+    TickBenchSettings s;
+    s.indices = {spec};
+    s.ticks = 1500;
+    s.seed = 11;
+    s.modes = {TickMode::Hot};
+    // Reaching past the index's bounds, so some ticks are outside them (a servo counts those).
+    s.walkIn = Aabb{Vec3(-0.075), Vec3(0.075)};
+    s.pushMm = 2.0;
+    const std::vector<TickTarget> bench = runTickBench(scene, s);
+    REQUIRE(bench.size() == 1);
+    REQUIRE(bench[0].runs.size() == 1);
+    const TickRun& run = *bench[0].runs[0];
+    REQUIRE(run.ticks == s.ticks);
+
+    // The same walk through a stepped Runtime: a 1 kHz device with the default renderer and
+    // safety filter, the hand held back from the proxy the same way after each tick.
+    World world(scene, spec);
+    auto device = std::make_unique<WalkDevice>(s.walkIn, s.seed);
+    WalkDevice& walk = *device;
+    RuntimeDevice rd;
+    rd.device = std::move(device);
+    rd.config.name = "walk";
+    rd.config.rateHz = 1000.0;
+    std::vector<RuntimeDevice> devices;
+    devices.push_back(std::move(rd));
+    RuntimeOptions options;
+    options.realtime = false;
+    Runtime runtime(world, std::move(devices), options);
+    ManualClock clock;
+    const std::uint64_t t0 = clock.nowNs();
+    REQUIRE(runtime.startStepped(clock) == 1);
+    std::size_t differing = 0, pushing = 0;
+    for (std::size_t k = 0; k < s.ticks; ++k) {
+        runtime.runUntil(t0 + (k + 1) * 1'000'000);
+        ContactReport last;
+        REQUIRE(runtime.lastTick(0, last));
+        REQUIRE(last.tick == k);
+        const Vec3& b = run.forceN[k];
+        differing += (b.x != last.force.x || b.y != last.force.y || b.z != last.force.z) ? 1 : 0;
+        pushing += glm::length(last.force) > 0.1 ? 1 : 0;
+        holdHandBack(walk.walk(), last.devicePoint, last.proxy, s.pushMm * 1e-3);
+    }
+    CHECK(differing == 0);
+    CHECK(pushing > 20); // the walk touched the cubes: the forces compared are not all zero
+
+    const DeviceMetrics& a = run.shared->metrics;
+    const DeviceMetrics& b = runtime.metrics(0);
+    CHECK(a.ticks.load() == b.ticks.load());
+    CHECK(a.contactTicks.load() == b.contactTicks.load());
+    CHECK(a.outsideTicks.load() == b.outsideTicks.load());
+    CHECK(a.outsideTicks.load() > 0);
+    CHECK(a.locateStepsSum.load() == b.locateStepsSum.load());
+    CHECK(a.candidatesSum.load() == b.candidatesSum.load());
+    CHECK(a.zeroedForMisses.load() == b.zeroedForMisses.load());
+    runtime.stop();
+}
+
+TEST_CASE("bench tick stamps every stage of the step in order") {
+    TickBenchSettings s;
+    s.indices = {IndexSpec::parse("octree:2:0.005")};
+    s.ticks = 300;
+    s.modes = {TickMode::Hot};
+    const Scene scene = cubeGrid();
+    s.walkIn = walkBox(scene.bounds(), 0.0);
+    const std::vector<TickTarget> bench = runTickBench(scene, s);
+    const TickRun& run = *bench[0].runs[0];
+    for (std::size_t k = 0; k < s.ticks; ++k) {
+        double sum = 0.0;
+        for (const std::vector<double>& stage : run.stageNs) {
+            REQUIRE(stage[k] >= 0.0);
+            sum += stage[k];
+        }
+        REQUIRE(sum == run.tickNs[k]); // the stages tile the tick, wake-up to the metrics' end
+    }
+    CHECK(run.shared->metrics.ticks.load() == s.ticks);
+}
+
+TEST_CASE("a warmed simulated hand is primed by the servo's step and starts on the surface") {
+    const Scene scene = cubeGrid();
+    WarmedSimDevice hand(simHand("h", 1000.0, "touch", 3, Vec3(0.0, 0.0, 0.025)), scene);
+    CHECK(hand.warmUp(0.1) > 0.0);
+    CHECK(hand.reachedPhase());
+    // The first reading is the primed proxy: pressed onto a cube, inside none (1 µm slack).
+    DeviceState s;
+    REQUIRE(hand.read(s) == DeviceStatus::Ok);
+    double nearest = 1.0;
+    for (const SceneObject& o : scene.objects()) {
+        const Vec3 d = glm::abs(s.position - o.aabb().center()); // a cube of half edge 1 cm
+        CHECK(std::max({d.x, d.y, d.z}) > 0.01 - 1e-6);
+        nearest = std::min(nearest, glm::length(glm::max(d - Vec3(0.01), Vec3(0.0))));
+    }
+    CHECK(nearest < 1e-3);
+    hand.close();
+}
