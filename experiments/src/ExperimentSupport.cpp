@@ -7,6 +7,7 @@
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/io/InputError.h"
 #include "hapto/runtime/HapticTick.h"
+#include "hapto/runtime/ServoStep.h"
 #include "hapto/runtime/Session.h"
 
 #include <algorithm>
@@ -99,38 +100,44 @@ double WarmedSimDevice::warmUp(double settleS, double maxS) {
             near.push_back(o);
         }
     }
-    auto local = std::make_shared<const Scene>(region, std::move(near));
     // A mesh that reaches into the region brings all its triangles, most of them outside the
     // region's bounds (kept in the index's outside list, 4 B each); the build's memory estimate
     // counts every item as if placed, so at 10^7 triangles it would pass the default 1 GB
     // limit for an index that is in fact small. The limit here is the machine's, not a guard.
-    const WorldSnapshot snapshot{
-        1, local, buildIndex(*local, IndexSpec::octree(2, 0.005).withMaxMegabytes(1u << 20)), {}};
+    World world(std::make_shared<const Scene>(region, std::move(near)),
+                IndexSpec::octree(2, 0.005).withMaxMegabytes(1u << 20));
 
-    const WorkspaceTransform& xf = mConfig.transform;
-    const double dt = 1.0 / mConfig.rateHz;
-    HapticTick tick; // the servo's own tick
-    DeviceState state;
+    // The servo's own step, on time at every deadline of a clock that moves only here.
+    ManualClock clock;
+    ServoStepShared shared;
+    ServoStep step(RendererConfig{}, SafetyConfig{});
+    const RuntimeOptions runtime;
+    step.setTiming(static_cast<std::uint64_t>(std::llround(1e9 / mConfig.rateHz)),
+                   runtime.missLimit, runtime.lateWakeupFraction, runtime.stallTimeoutNs);
+    step.device = &mSim;
+    step.transform = mConfig.transform; // the gimbal centre (no tool tip): the first reading
+                                        // after warm-up puts the device there, at the proxy
+    step.reader = world.registerReader();
+    step.ports = shared.portsFor(world, &clock);
+    step.start(clock.nowNs());
     double inPhaseS = 0.0, t = 0.0;
-    for (; t < maxS; t += dt) {
-        if (mSim.read(state) != DeviceStatus::Ok) {
+    for (; t < maxS; t += step.dtS) {
+        clock.set(step.deadlineNs);
+        if (!step.run(step.deadlineNs)) {
             throw std::runtime_error("simulated hand '" + mConfig.name +
                                      "' failed during warm-up: " + mSim.errorMessage());
         }
-        const Vec3 p = xf.positionToWorld(state.position);
-        const Vec3 v = xf.velocityToWorld(state.velocity);
-        const TickOutput out = tick.tick(snapshot, p, v, dt, Vec3(0.0));
-        (void)mSim.write(xf.forceToDevice(out.forceN));
         if (mSim.phase() == measured) {
-            inPhaseS += dt;
+            inPhaseS += step.dtS;
             if (inPhaseS >= settleS) {
                 mReached = true;
                 break;
             }
         }
     }
-    mPrimeDevice = xf.positionToDevice(tick.proxy());
+    mPrimeDevice = mConfig.transform.positionToDevice(step.haptic.proxy());
     mPrimePending = true;
+    world.unregisterReader(step.reader);
     return t;
 }
 
