@@ -1,8 +1,8 @@
 // The runtime's set-up and shutdown. Design note: each device owns one Channel (Channel.h), a
 // cache-line-aligned block with its hot servo state apart from its cold record. Threads share
 // only the read-only World snapshots. Everything is sized before a servo starts. The servo
-// tick lives in ServoLoop.cpp, supervision (the watchdog, closing, reopening) in
-// Supervision.cpp, reports in RunReport.cpp; this file opens devices, starts the threads (or
+// step lives in ServoStep.cpp and its loop in ServoLoop.cpp, supervision (the watchdog,
+// closing, reopening) in Supervision.cpp, reports in RunReport.cpp; this file opens devices, starts the threads (or
 // the step mode, which runs the same tick and the same supervision pass on the caller's
 // thread with the caller's clock), and stops them.
 
@@ -55,14 +55,7 @@ Runtime::Channel::Channel(RuntimeDevice d, const RuntimeOptions& o)
     servo.recorder = d.recorder;
     servo.transform = d.config.transform;
     servo.toolTip = d.config.toolTipM;
-    servo.periodNs = period;
-    servo.dtS = static_cast<double>(period) * 1e-9;
-    servo.lateNs = static_cast<std::uint64_t>(o.lateWakeupFraction * static_cast<double>(period));
-    // A wake-up this late means the thread could not run (starved by a CPU hog, or the host)
-    // for K periods while the device held its last force: that tick commands zero.
-    servo.missLimit = std::max(1, o.missLimit);
-    servo.starvedNs = static_cast<std::uint64_t>(servo.missLimit) * period;
-    servo.stallNs = o.stallTimeoutNs;
+    servo.setTiming(period, o.missLimit, o.lateWakeupFraction, o.stallTimeoutNs);
     record.rd = std::move(d);
 }
 
