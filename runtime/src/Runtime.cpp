@@ -2,9 +2,9 @@
 // cache-line-aligned block with its hot servo state apart from its cold record. Threads share
 // only the read-only World snapshots. Everything is sized before a servo starts. The servo
 // step lives in ServoStep.cpp and its loop in ServoLoop.cpp, supervision (the watchdog,
-// closing, reopening) in Supervision.cpp, reports in RunReport.cpp; this file opens devices, starts the threads (or
-// the step mode, which runs the same tick and the same supervision pass on the caller's
-// thread with the caller's clock), and stops them.
+// closing, reopening) in Supervision.cpp, reports in RunReport.cpp; this file opens devices,
+// starts the threads (or the step mode, which runs the same step and the same supervision pass
+// on the caller's thread with the caller's clock), and stops them.
 
 #include "Channel.h"
 
