@@ -5,6 +5,7 @@
 #include "hapto/devices/ReplayDevice.h"
 #include "hapto/devices/TraceReader.h"
 #include "hapto/devices/TraceRecorder.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/runtime/World.h"
@@ -40,7 +41,7 @@ std::vector<std::vector<TraceSample>> runAndRecord(const Scene& scene,
                                                    const std::filesystem::path& dir,
                                                    std::uint64_t runNs = kRunNs) {
     ManualClock clock;
-    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    World world(scene, IndexSpec::parse(kDefaultIndexSpec));
     world.useClock(clock);
     std::vector<std::unique_ptr<TraceRecorder>> recorders;
     std::vector<RuntimeDevice> devices;

@@ -7,6 +7,7 @@
 
 #include "hapto/devices/DeviceFactory.h"
 #include "hapto/devices/SimDevice.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/runtime/World.h"
@@ -44,7 +45,7 @@ std::vector<Vec3> pressedForces(const Scene& scene, double pressN, double second
     sim.pressForceN = pressN;
     c.params = sim;
     ManualClock clock;
-    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    World world(scene, IndexSpec::parse(kDefaultIndexSpec));
     world.useClock(clock);
     std::vector<RuntimeDevice> devices;
     devices.push_back({makeDevice(c, scene), c, nullptr});

@@ -6,6 +6,7 @@
 #include "ScriptedDevice.h"
 
 #include "hapto/index/Cursor.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/index/Overlap.h"
 #include "hapto/runtime/GraspController.h"
 #include "hapto/scenes/Generators.h"
@@ -69,7 +70,7 @@ struct GraspRig {
     std::vector<Vec3> positions; // the object's centre at every control step
 
     GraspRig(Scene scene, Hands hands)
-        : world(std::move(scene), IndexSpec::parse("octree:2:0.005")) {
+        : world(std::move(scene), IndexSpec::parse(kDefaultIndexSpec)) {
         world.useClock(clock);
         world.setRestDelay(std::chrono::milliseconds(50));
         std::vector<RuntimeDevice> rds;

@@ -8,6 +8,7 @@
 #include "SteppedRig.h"
 #include "TestSupport.h"
 
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
 
@@ -190,7 +191,7 @@ TEST_CASE("each member keeps its own load record: a slow member's work is its lo
 TEST_CASE("devices per thread: 0, or a hardware device in a group, is refused") {
     CHECK_THROWS_AS(Rig(2, 0), std::invalid_argument);
     ManualClock clock;
-    World world(cubeScene(), IndexSpec::parse("octree:2:0.005"));
+    World world(cubeScene(), IndexSpec::parse(kDefaultIndexSpec));
     std::vector<RuntimeDevice> rds;
     for (int i = 0; i < 2; ++i) {
         DeviceConfig c;
@@ -212,7 +213,7 @@ TEST_CASE("devices per thread: 0, or a hardware device in a group, is refused") 
 }
 
 TEST_CASE("group threads drive every device and leave each at zero force on stop", "[realtime]") {
-    World world(cubeScene(), IndexSpec::parse("octree:2:0.005"));
+    World world(cubeScene(), IndexSpec::parse(kDefaultIndexSpec));
     std::vector<ScriptedDevice*> devices;
     std::vector<RuntimeDevice> rds;
     for (int i = 0; i < 6; ++i) {

@@ -2,6 +2,7 @@
 
 #include "TestMeshes.h"
 #include "hapto/experiments/HandWalk.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/HapticTick.h"
 #include "hapto/runtime/Realtime.h"
 #include "hapto/scenes/Generators.h"
@@ -41,7 +42,7 @@ TEST_CASE("pressing d into a box face of stiffness k gives k d along the face no
     const double k = GENERATE(200.0, 800.0, 2000.0);
     const double d = GENERATE(0.0005, 0.002);
     INFO("k " << k << " d " << d);
-    World world(boxScene(k), IndexSpec::parse("octree:2:0.005"));
+    World world(boxScene(k), IndexSpec::parse(kDefaultIndexSpec));
     HapticTick tick;
     const TickOutput out = pressTo(tick, world.current(), d);
     const double expected = k * (d + GodObjectRenderer::kSkinM);
@@ -59,7 +60,7 @@ TEST_CASE("pressing d into a box face of stiffness k gives k d along the face no
 
 TEST_CASE("a force above the device's limit is clamped by the safety filter, not in the render "
           "output") {
-    World world(boxScene(5000.0), IndexSpec::parse("octree:2:0.005"));
+    World world(boxScene(5000.0), IndexSpec::parse(kDefaultIndexSpec));
     SafetyConfig safety;
     safety.maxForceN = 3.0;
     HapticTick tick({}, safety);
@@ -86,7 +87,7 @@ TEST_CASE("in free space the force is zero and the proxy is the device point") {
 }
 
 TEST_CASE("the external force is added before the safety filter: clamped and rate-limited") {
-    World world(boxScene(800.0), IndexSpec::parse("octree:2:0.005"));
+    World world(boxScene(800.0), IndexSpec::parse(kDefaultIndexSpec));
     HapticTick tick; // 8.5 N at most, 1 N per tick at most
     const Vec3 p(0.05, 0.05, 0.05);
     for (int i = 1; i <= 12; ++i) {
@@ -97,7 +98,7 @@ TEST_CASE("the external force is added before the safety filter: clamped and rat
 }
 
 TEST_CASE("reset() starts afresh and zeroForce() makes the force grow from zero again") {
-    World world(boxScene(800.0), IndexSpec::parse("octree:2:0.005"));
+    World world(boxScene(800.0), IndexSpec::parse(kDefaultIndexSpec));
     HapticTick tick;
     TickOutput out = pressTo(tick, world.current(), 0.002);
     const double held = 800.0 * (0.002 + GodObjectRenderer::kSkinM);
@@ -121,7 +122,7 @@ TEST_CASE("reset() starts afresh and zeroForce() makes the force grow from zero 
 
 TEST_CASE("a new snapshot re-binds the cursors and is reported once, moving objects are "
           "candidates") {
-    World world(boxScene(800.0), IndexSpec::parse("octree:2:0.005"));
+    World world(boxScene(800.0), IndexSpec::parse(kDefaultIndexSpec));
     HapticTick tick;
     const Vec3 p(0.06, 0.023, 0.0);
     TickOutput out = tick.tick(world.current(), p, Vec3(0.0), 1e-3, Vec3(0.0));
@@ -166,7 +167,7 @@ Vec3 noSampleHook(void* context, const TickHookArgs& a) noexcept {
 
 TEST_CASE("the tick adds its effects and its hook to the render force, each reported apart, "
           "before the safety filter") {
-    World world(boxScene(500.0), IndexSpec::parse("octree:2:0.005"));
+    World world(boxScene(500.0), IndexSpec::parse(kDefaultIndexSpec));
     HapticTick tick;
     const std::vector<ForceEffect> effects = {ForceEffect::constant(Vec3(0.2, 0, 0)),
                                               ForceEffect::damper(3.0)};

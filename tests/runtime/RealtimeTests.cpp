@@ -7,6 +7,7 @@
 #include "CubeScene.h"
 #include "ScriptedDevice.h"
 
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/Realtime.h"
 #include "hapto/runtime/Runtime.h"
 
@@ -45,7 +46,7 @@ bool canHold() {
 /// One scripted hand pressing into the cube, on its own servo thread, under `options`
 /// (normal scheduling).
 struct OneHand {
-    World world{test::cubeScene(), IndexSpec::parse("octree:2:0.005")};
+    World world{test::cubeScene(), IndexSpec::parse(kDefaultIndexSpec)};
     std::unique_ptr<Runtime> runtime;
 
     explicit OneHand(RuntimeOptions options) {

@@ -8,6 +8,7 @@
 #include "ScriptedDevice.h"
 
 #include "hapto/devices/FaultInjectingDevice.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
 
@@ -34,7 +35,7 @@ struct Rig {
 
     Rig(Scene scene, int count, double rateHz, std::function<void(int, ScriptedDevice&)> setup = {},
         RuntimeOptions options = {})
-        : world(std::move(scene), IndexSpec::parse("octree:2:0.005")) {
+        : world(std::move(scene), IndexSpec::parse(kDefaultIndexSpec)) {
         std::vector<RuntimeDevice> rds;
         for (int i = 0; i < count; ++i) {
             auto d = std::make_unique<ScriptedDevice>("d" + std::to_string(i),

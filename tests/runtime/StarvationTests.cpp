@@ -5,6 +5,7 @@
 
 #include "ScriptedDevice.h"
 
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
 
@@ -50,7 +51,7 @@ TEST_CASE("a servo thread starved by a CPU hog gets zero force when it runs agai
     m.stiffness = 500.0;
     World world(Scene(Aabb{Vec3(-0.125), Vec3(0.125)},
                       {makeBox(7, Vec3(0), Vec3(0.025), Quat(1, 0, 0, 0), m)}),
-                IndexSpec::parse("octree:2:0.005"));
+                IndexSpec::parse(kDefaultIndexSpec));
     std::vector<ScriptedDevice*> hands;
     std::vector<RuntimeDevice> rds;
     for (int i = 0; i < 2; ++i) {

@@ -7,6 +7,7 @@
 #include "ScriptedDevice.h"
 
 #include "hapto/devices/TraceRecorder.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/Runtime.h"
 
 #include <cstdint>
@@ -30,7 +31,7 @@ struct SteppedRig {
     SteppedRig(int count, double rateHz, std::function<void(int, ScriptedDevice&)> setup = {},
                RuntimeOptions options = {}, Scene scene = cubeScene(),
                std::vector<TraceRecorder*> recorders = {})
-        : world(std::move(scene), IndexSpec::parse("octree:2:0.005")) {
+        : world(std::move(scene), IndexSpec::parse(kDefaultIndexSpec)) {
         world.useClock(clock);
         std::vector<RuntimeDevice> rds;
         for (int i = 0; i < count; ++i) {

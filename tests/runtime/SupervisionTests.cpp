@@ -6,6 +6,7 @@
 #include "ScriptedDevice.h"
 
 #include "hapto/devices/FaultInjectingDevice.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/Runtime.h"
 
 #include <catch2/catch.hpp>
@@ -68,7 +69,7 @@ private:
 };
 
 struct Rig {
-    World world{cubeScene(), IndexSpec::parse("octree:2:0.005")};
+    World world{cubeScene(), IndexSpec::parse(kDefaultIndexSpec)};
     std::atomic<std::uint64_t> allReads{0};
     std::vector<GatedDevice*> devices;
     std::vector<FaultInjectingDevice*> injectors;

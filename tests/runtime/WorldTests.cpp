@@ -1,4 +1,5 @@
 #include "hapto/index/Cursor.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/World.h"
 #include "hapto/scenes/Generators.h"
@@ -118,7 +119,7 @@ TEST_CASE("8 servo-like threads read while the control thread publishes: version
     RandomOptions opt;
     opt.count = 300;
     opt.seed = 4;
-    World world(makeRandomScene(opt), IndexSpec::parse("octree:2:0.005"));
+    World world(makeRandomScene(opt), IndexSpec::parse(kDefaultIndexSpec));
     world.setRestDelay(std::chrono::milliseconds(1));
     std::atomic<bool> stop{false};
     std::atomic<int> failures{0};

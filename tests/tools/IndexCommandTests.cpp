@@ -1,5 +1,6 @@
 #include "TestSupport.h"
 
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/scenes/SceneFile.h"
 
@@ -131,16 +132,16 @@ TEST_CASE("without --index, query and index-stats build the index every session 
     writeFile(dir / "p.csv", "0,0,0\n-0.08,0.08,0\n0.12,0.12,-0.12\n");
     const std::string args =
         "query --scene " + (dir / "s.json").string() + " --points " + (dir / "p.csv").string();
-    // Boxes and spheres: the paper's octree:2:0.005, as run and demo grasp choose.
+    // Boxes and spheres: the default, the paper's octree, as run and demo grasp choose.
     const CommandResult chosen = runHapto(args);
     INFO(chosen.output);
     REQUIRE(chosen.exitCode == 0);
-    CHECK(chosen.output == runHapto(args + " --index octree:2:0.005").output);
+    CHECK(chosen.output == runHapto(args + " --index " + std::string(kDefaultIndexSpec)).output);
     const CommandResult stats =
         runHapto("index-stats --scene " + (dir / "s.json").string() + " --json");
     INFO(stats.output);
     REQUIRE(stats.exitCode == 0);
-    CHECK(nlohmann::json::parse(stats.output).at("index") == "octree:2:0.005");
+    CHECK(nlohmann::json::parse(stats.output).at("index") == std::string(kDefaultIndexSpec));
     // A bad --index is still refused before the points are read.
     const CommandResult bad = runHapto("query --scene " + (dir / "s.json").string() +
                                        " --index kdtree --points " + (dir / "none.csv").string());

@@ -1,6 +1,6 @@
 // The command line's conventions (tools/src/Options.h), in process: the checks numeric options
 // go through (finiteRange, positiveRange, wholeNumber), the shared options (realtime, the view,
-// renamed ones), the default index, and the help layout (wrapText, HelpFormatter, examples).
+// renamed ones) and the help layout (wrapText, HelpFormatter, examples).
 
 #include "Options.h"
 #include "TestSupport.h"
@@ -272,45 +272,4 @@ TEST_CASE("a number list option takes exactly its count of finite numbers in ran
         std::vector<double> w{0, 0, 0};
         CHECK_THAT(parseList(bad, w), Catch::Contains("--center"));
     }
-}
-
-namespace {
-
-/// A strip of `n` right triangles with legs `leg` (m): each one's longest edge is leg * sqrt 2.
-hapto::SceneObject strip(hapto::ObjectId id, int n, double leg) {
-    std::vector<hapto::Vec3> v;
-    std::vector<hapto::TriangleIndices> t;
-    for (int i = 0; i <= n; ++i) {
-        v.push_back(hapto::Vec3(i * leg, 0, 0));
-        v.push_back(hapto::Vec3(i * leg, leg, 0));
-    }
-    for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(n); ++i) {
-        t.push_back(i % 2 == 0 ? hapto::TriangleIndices{i, i + 2, i + 1}
-                               : hapto::TriangleIndices{i, i + 1, i + 2});
-    }
-    return hapto::makeMesh(id, hapto::Vec3(0.0),
-                           hapto::TriangleMesh::make(std::move(v), std::move(t), {}, "strip"));
-}
-
-} // namespace
-
-TEST_CASE("the default index is the paper's octree over boxes and spheres, and over meshes an "
-          "octree whose smallest leaf is the median triangle's longest edge") {
-    using namespace hapto;
-    const Aabb bounds{Vec3(-1.0), Vec3(1.0)};
-    CHECK(defaultIndexSpec(Scene(bounds, {makeBox(1, Vec3(0.0), Vec3(0.01))})) == "octree:2:0.005");
-    CHECK(defaultIndexSpec(Scene()) == "octree:2:0.005");
-    // Triangles whose longest edge is 0.3 mm x sqrt 2 = 0.424 mm (median of all of them: 40 of
-    // them against 3 of 1 cm legs), with a box beside them.
-    const Scene fine(bounds,
-                     {makeBox(1, Vec3(0.5), Vec3(0.01)), strip(2, 40, 0.0003), strip(3, 3, 0.01)});
-    CHECK(defaultIndexSpec(fine) == "octree:8:0.00042");
-    // Clamped: within 0.1 mm and 5 mm.
-    CHECK(defaultIndexSpec(Scene(bounds, {strip(1, 5, 1e-6)})) == "octree:8:0.0001");
-    CHECK(defaultIndexSpec(Scene(bounds, {strip(1, 5, 0.1)})) == "octree:8:0.005");
-    // A session's index: the given spec, or the default when none is given; with its limit.
-    CHECK(sessionIndexSpec("", fine, 64).toString() == "octree:8:0.00042");
-    CHECK(sessionIndexSpec("grid:4", fine, 64).toString() == "grid:4");
-    CHECK(sessionIndexSpec("", fine, 64).maxBytes == 64u << 20);
-    CHECK_THROWS_AS(sessionIndexSpec("kdtree:3", fine, 64), hapto::InputError);
 }

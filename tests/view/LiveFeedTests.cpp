@@ -4,6 +4,7 @@
 
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/DeviceFactory.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/scenes/Generators.h"
 
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <string_view>
 #include <vector>
 
 using namespace hapto;
@@ -19,7 +21,7 @@ namespace {
 
 /// The two default hands over the default scene in step mode, with a feed (never started).
 struct Session {
-    explicit Session(const char* index)
+    explicit Session(std::string_view index)
         : world(scene, IndexSpec::parse(index)), runtime(makeRuntime()), feed(runtime, server) {}
 
     Runtime makeRuntime() {
@@ -45,7 +47,7 @@ struct Session {
 
 TEST_CASE("a live frame carries each device's ticks, misses, load, point, force and contacts, "
           "and the poses of moved objects") {
-    Session session("octree:2:0.005");
+    Session session(kDefaultIndexSpec);
     const Scene& scene = session.scene;
     ManualClock& clock = session.clock;
     World& world = session.world;
@@ -105,7 +107,7 @@ TEST_CASE("a live frame carries each device's ticks, misses, load, point, force 
 
 TEST_CASE("a live frame gives the run report's late wake-up note for a device unstable by late "
           "wake-ups alone, and none while it is stable") {
-    Session session("octree:2:0.005");
+    Session session(kDefaultIndexSpec);
     ManualClock& clock = session.clock;
     Runtime& runtime = session.runtime;
     const std::uint64_t t0 = clock.nowNs();

@@ -266,7 +266,8 @@ void addScalingCommand(CLI::App* exp) {
     cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
     cmd->add_option("--index", a->index,
                     "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb; "
-                    "the cursor part uses it when it is an octree, else octree:2:0.005")
+                    "the cursor part uses it when it is an octree, else " +
+                        std::string(kDefaultIndexSpec))
         ->capture_default_str();
     cmd->add_option("--max-index-mb", a->maxIndexMb,
                     "Most memory an index build may take (MB); a larger index is refused")

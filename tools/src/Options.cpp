@@ -120,37 +120,11 @@ CLI::App* addRenamedCommand(CLI::App* parent, const std::string& oldName,
 CLI::Option* addIndexOption(CLI::App* cmd, std::string& spec) {
     return cmd->add_option("--index", spec,
                            "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional "
-                           ":aabb. Default: octree:2:0.005; over meshes octree:8:E, E the median "
-                           "triangle's longest edge (m, within 0.0001-0.005)");
-}
-
-std::string defaultIndexSpec(const Scene& scene) {
-    std::vector<double> edges; // each triangle's longest edge (m)
-    for (const SceneObject& o : scene.objects()) {
-        if (o.shape != Shape::Mesh || !o.mesh) {
-            continue;
-        }
-        for (std::uint32_t t = 0; t < o.mesh->triangleCount(); ++t) {
-            const auto [p, q, r] = o.mesh->corners(t);
-            edges.push_back(std::sqrt(std::max(
-                {glm::dot(q - p, q - p), glm::dot(r - q, r - q), glm::dot(p - r, p - r)})));
-        }
-    }
-    if (edges.empty()) {
-        return "octree:2:0.005";
-    }
-    const auto middle = edges.begin() + static_cast<std::ptrdiff_t>(edges.size() / 2);
-    std::nth_element(edges.begin(), middle, edges.end());
-    const double edge = std::clamp(*middle, 1e-4, 5e-3);
-    char spec[64];
-    std::snprintf(spec, sizeof spec, "octree:8:%.2g", edge);
-    return spec;
-}
-
-IndexSpec sessionIndexSpec(const std::string& given, const Scene& scene,
-                           std::uint64_t maxMegabytes) {
-    return IndexSpec::parse(given.empty() ? defaultIndexSpec(scene) : given)
-        .withMaxMegabytes(maxMegabytes);
+                           ":aabb. Default: " +
+                               std::string(kDefaultIndexSpec) +
+                               "; over meshes octree:" + std::to_string(kMeshIndexLeafItems) +
+                               ":E, E the median triangle's longest edge (m, within " +
+                               number(kMeshIndexMinLeafM) + "-" + number(kMeshIndexMaxLeafM) + ")");
 }
 
 CLI::Option* addMaxIndexMbOption(CLI::App* cmd, std::uint64_t& megabytes) {

@@ -2,6 +2,7 @@
 /// The `hapto experiment` runs, as functions of their parsed arguments.
 
 #include "hapto/experiments/ExperimentSupport.h"
+#include "hapto/index/DefaultIndex.h"
 
 #include "hapto/scenes/MeshGenerators.h"
 
@@ -68,7 +69,7 @@ struct DevicesArgs {
     int maxDevices = 8;                          ///< Largest device count (1, 2, 4, ... up to it).
     std::vector<double> ratesHz{1000.0, 4000.0}; ///< Servo rates (Hz).
     std::string scene;                           ///< Scene file; empty = the default scene.
-    std::string index = "octree:2:0.005";        ///< Index spec.
+    std::string index{kDefaultIndexSpec};        ///< Index spec.
     std::uint64_t maxIndexMb = 1024;             ///< Index memory limit (MB).
     std::string script = "walk";                 ///< Hand script: walk or slide.
     std::vector<std::size_t> cursorObjects{100, 1000, 10000, 100000, 1000000}; ///< N values.

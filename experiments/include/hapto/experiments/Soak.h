@@ -2,6 +2,7 @@
 /// `hapto soak` as a library: D simulated hands over a world that keeps changing, with faults
 /// injected on a schedule; drift, misses, memory and fault handling, with a verdict.
 
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Scene.h"
@@ -20,7 +21,7 @@ struct SoakOptions {
     std::string durationOption = "--duration"; ///< The option as given, for messages.
     int devices = 2;                           ///< Simulated hands (D).
     double rateHz = 1000.0;                    ///< Servo rate of every hand (Hz).
-    std::string index = "octree:2:0.005";      ///< Spatial index specification.
+    std::string index{kDefaultIndexSpec};      ///< Spatial index specification.
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes; ///< Index memory limit (MB).
     double faultEveryS = 15.0; ///< A fault every this many seconds, hands in turn.
     double windowS = 60.0;     ///< Report window (s).
