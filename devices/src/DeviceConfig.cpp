@@ -209,131 +209,6 @@ PhantomConfig parsePhantom(const Source& w, const Json& j, const Path& path, dou
     return c;
 }
 
-/// Fails at `path` + the problem's dotted field (`region.sphere.radius_m`), so the message
-/// names the JSON path of the bad value.
-[[noreturn]] void failEffect(const Source& w, const Path& path, const EffectProblem& problem) {
-    std::vector<std::string> parts;
-    for (std::size_t from = 0;;) {
-        const std::size_t dot = problem.field.find('.', from);
-        parts.push_back(problem.field.substr(from, dot - from));
-        if (dot == std::string::npos) {
-            break;
-        }
-        from = dot + 1;
-    }
-    std::vector<Path> chain(parts.size()); // reserved: each level points at the one before
-    const Path* at = &path;
-    for (std::size_t i = 0; i < parts.size(); ++i) {
-        chain[i] = *at / parts[i].c_str();
-        at = &chain[i];
-    }
-    w.fail(*at, problem.message);
-}
-
-EffectRegion parseRegion(const Source& w, const Json& j, const Path& path) {
-    object(w, j, path);
-    checkKeys(w, j, path, {"box", "sphere"});
-    const Json* box = optional(j, "box");
-    const Json* sphere = optional(j, "sphere");
-    if ((box != nullptr) == (sphere != nullptr)) {
-        w.fail(path, "a region is one of {\"box\": {...}} or {\"sphere\": {...}}");
-    }
-    if (box) {
-        const Path at = path / "box";
-        object(w, *box, at);
-        checkKeys(w, *box, at, {"center", "half_extents"});
-        return EffectRegion::box(
-            vec3(w, required(w, *box, at, "center"), at / "center"),
-            vec3(w, required(w, *box, at, "half_extents"), at / "half_extents"));
-    }
-    const Path at = path / "sphere";
-    object(w, *sphere, at);
-    checkKeys(w, *sphere, at, {"center", "radius_m"});
-    return EffectRegion::sphere(vec3(w, required(w, *sphere, at, "center"), at / "center"),
-                                number(w, required(w, *sphere, at, "radius_m"), at / "radius_m"));
-}
-
-/// One object of a device's `effects` list; its type decides which fields it may have.
-ForceEffect parseEffect(const Source& w, const Json& j, const Path& path) {
-    object(w, j, path);
-    const std::string type = string(w, required(w, j, path, "type"), path / "type");
-    ForceEffect e;
-    if (type == "spring") {
-        checkKeys(
-            w, j, path,
-            {"type", "enabled", "anchor", "stiffness_n_per_m", "direction", "normal", "region"});
-        e.type = EffectType::Spring;
-        e.anchorM = vec3(w, required(w, j, path, "anchor"), path / "anchor");
-        e.stiffnessNPerM =
-            number(w, required(w, j, path, "stiffness_n_per_m"), path / "stiffness_n_per_m");
-        const Json* direction = optional(j, "direction");
-        const Json* normal = optional(j, "normal");
-        if (direction && normal) {
-            w.fail(path / "normal", "a spring pulls to a line (\"direction\") or to a plane "
-                                    "(\"normal\"), not both");
-        }
-        if (direction || normal) {
-            const char* field = direction ? "direction" : "normal";
-            const Vec3 axis = vec3(w, direction ? *direction : *normal, path / field);
-            // Scaled by its largest component first: the squares of [1e308, 1e308, 0] overflow
-            // and those of [1e-200, 1e-200, 0] underflow, yet both are directions.
-            const double largest = std::max({std::abs(axis.x), std::abs(axis.y), std::abs(axis.z)});
-            if (!(largest > 0)) {
-                w.fail(path / field, std::string("the ") + field + " must not be zero (got [" +
-                                         show(axis.x) + ", " + show(axis.y) + ", " + show(axis.z) +
-                                         "])");
-            }
-            e.target = direction ? SpringTarget::Line : SpringTarget::Plane;
-            const Vec3 scaled = axis / largest;
-            e.axis = scaled / glm::length(scaled);
-        }
-    } else if (type == "damper") {
-        checkKeys(w, j, path, {"type", "enabled", "damping_n_s_per_m", "region"});
-        e.type = EffectType::Damper;
-        e.dampingNsPerM =
-            number(w, required(w, j, path, "damping_n_s_per_m"), path / "damping_n_s_per_m");
-    } else if (type == "constant") {
-        checkKeys(w, j, path, {"type", "enabled", "force_n", "region"});
-        e.type = EffectType::Constant;
-        e.forceN = vec3(w, required(w, j, path, "force_n"), path / "force_n");
-    } else {
-        w.fail(path / "type", "unknown effect type '" + printable(type) +
-                                  "' (expected spring, damper or constant)");
-    }
-    if (const Json* v = optional(j, "enabled")) {
-        e.enabled = boolean(w, *v, path / "enabled");
-    }
-    if (const Json* v = optional(j, "region")) {
-        e.region = parseRegion(w, *v, path / "region");
-    }
-    if (const std::optional<EffectProblem> problem = checkForceEffect(e)) {
-        failEffect(w, path, *problem);
-    }
-    return e;
-}
-
-std::vector<ForceEffect> parseEffects(const Source& w, const Json& j, const Path& path) {
-    if (!j.is_array()) {
-        w.fail(path, "expected an array of effects, got " + typeName(j));
-    }
-    if (j.size() > kMaxEffectsPerDevice) {
-        w.fail(path, "at most " + std::to_string(kMaxEffectsPerDevice) +
-                         " effects per device (got " + std::to_string(j.size()) + ")");
-    }
-    std::vector<ForceEffect> out;
-    for (std::size_t i = 0; i < j.size(); ++i) {
-        out.push_back(parseEffect(w, j[i], path[i]));
-    }
-    return out;
-}
-
-double parseRenderer(const Source& w, const Json& j, const Path& path) {
-    object(w, j, path);
-    checkKeys(w, j, path, {"damping_n_s_per_m"});
-    return ranged(w, required(w, j, path, "damping_n_s_per_m"), path / "damping_n_s_per_m", 0.0,
-                  kMaxDampingNsPerM, false, "the contact damping (N·s/m)");
-}
-
 bool validName(const std::string& name) {
     if (name.empty() || name.size() > 63) {
         return false;
@@ -344,7 +219,8 @@ bool validName(const std::string& name) {
     });
 }
 
-DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
+DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path, std::size_t index,
+                         const DeviceEntryReader& reader) {
     object(w, j, path);
     checkKeys(w, j, path,
               {"name", "kind", "rate_hz", "max_force_n", "transform", "tool_tip", "effects",
@@ -381,11 +257,8 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
     if (const Json* v = optional(j, "transform")) {
         d.transform = parseTransform(w, *v, path / "transform");
     }
-    if (const Json* v = optional(j, "effects")) {
-        d.effects = parseEffects(w, *v, path / "effects");
-    }
-    if (const Json* v = optional(j, "renderer")) {
-        d.contactDampingNsPerM = parseRenderer(w, *v, path / "renderer");
+    if (reader) { // `effects` and `renderer`: here, so a file's first bad value is the one named
+        reader(index, j, w, path);
     }
     if (const Json* v = optional(j, "tool_tip")) {
         d.toolTipM = vec3(w, *v, path / "tool_tip");
@@ -429,133 +302,12 @@ DeviceConfig parseDevice(const Source& w, const Json& j, const Path& path) {
 
 } // namespace
 
-ForceEffect ForceEffect::springToPoint(const Vec3& anchor, double k) noexcept {
-    ForceEffect e;
-    e.type = EffectType::Spring;
-    e.anchorM = anchor;
-    e.stiffnessNPerM = k;
-    return e;
-}
-
-ForceEffect ForceEffect::springToLine(const Vec3& anchor, const Vec3& direction,
-                                      double k) noexcept {
-    ForceEffect e = springToPoint(anchor, k);
-    e.target = SpringTarget::Line;
-    e.axis = direction / glm::length(direction);
-    return e;
-}
-
-ForceEffect ForceEffect::springToPlane(const Vec3& anchor, const Vec3& normal, double k) noexcept {
-    ForceEffect e = springToPoint(anchor, k);
-    e.target = SpringTarget::Plane;
-    e.axis = normal / glm::length(normal);
-    return e;
-}
-
-ForceEffect ForceEffect::damper(double b, const EffectRegion& region) noexcept {
-    ForceEffect e;
-    e.type = EffectType::Damper;
-    e.dampingNsPerM = b;
-    e.region = region;
-    return e;
-}
-
-ForceEffect ForceEffect::constant(const Vec3& forceN) noexcept {
-    ForceEffect e;
-    e.type = EffectType::Constant;
-    e.forceN = forceN;
-    return e;
-}
-
-std::optional<EffectProblem> checkForceEffect(const ForceEffect& e) {
-    const auto inRange = [](double v, double lo, double hi) {
-        return std::isfinite(v) && v >= lo && v <= hi;
-    };
-    const auto range = [](const char* what, double v, double lo, double hi) {
-        return std::string(what) + " must be in " + show(lo) + ".." + show(hi) + " (got " +
-               show(v) + ")";
-    };
-    // A point within the bound on lengths, every coordinate finite.
-    const auto place = [](const Vec3& p) {
-        return std::abs(p.x) <= kMaxEffectLengthM && std::abs(p.y) <= kMaxEffectLengthM &&
-               std::abs(p.z) <= kMaxEffectLengthM; // false for NaN
-    };
-    const std::string bound = "each coordinate finite and within +-" + show(kMaxEffectLengthM);
-    switch (e.type) {
-    case EffectType::Spring:
-        if (!place(e.anchorM)) {
-            return EffectProblem{"anchor", "the anchor (m) must have " + bound};
-        }
-        if (!inRange(e.stiffnessNPerM, 0.0, kMaxEffectStiffnessNPerM)) {
-            return EffectProblem{"stiffness_n_per_m", range("the stiffness (N/m)", e.stiffnessNPerM,
-                                                            0.0, kMaxEffectStiffnessNPerM) +
-                                                          "; a stiffer spring only oscillates"};
-        }
-        if (e.target != SpringTarget::Point) {
-            const double length = glm::length(e.axis);
-            if (!(std::abs(length - 1.0) <= 1e-6)) {
-                return EffectProblem{e.target == SpringTarget::Line ? "direction" : "normal",
-                                     "must be a unit vector (got length " + show(length) +
-                                         "; ForceEffect::springToLine and springToPlane "
-                                         "normalise)"};
-            }
-        }
-        break;
-    case EffectType::Damper:
-        if (!inRange(e.dampingNsPerM, 0.0, kMaxDampingNsPerM)) {
-            return EffectProblem{"damping_n_s_per_m", range("the damping (N·s/m)", e.dampingNsPerM,
-                                                            0.0, kMaxDampingNsPerM)};
-        }
-        break;
-    case EffectType::Constant: {
-        const double magnitude = glm::length(e.forceN);
-        if (!inRange(magnitude, 0.0, kMaxEffectForceN)) {
-            return EffectProblem{
-                "force_n", range("the force's magnitude (N)", magnitude, 0.0, kMaxEffectForceN)};
-        }
-        break;
-    }
-    default:
-        return EffectProblem{"type", "unknown effect type"};
-    }
-    switch (e.region.shape) {
-    case RegionShape::Everywhere:
-        break;
-    case RegionShape::Box:
-        if (!place(e.region.centerM)) {
-            return EffectProblem{"region.box.center", "the centre (m) must have " + bound};
-        }
-        for (int a = 0; a < 3; ++a) {
-            const double h = e.region.halfExtentsM[a];
-            if (!(std::isfinite(h) && h > 0.0 && h <= kMaxEffectLengthM)) {
-                return EffectProblem{"region.box.half_extents",
-                                     "each half extent (m) must be > 0 and <= " +
-                                         show(kMaxEffectLengthM) + " (got " + show(h) + ")"};
-            }
-        }
-        break;
-    case RegionShape::Sphere:
-        if (!place(e.region.centerM)) {
-            return EffectProblem{"region.sphere.center", "the centre (m) must have " + bound};
-        }
-        if (!(std::isfinite(e.region.radiusM) && e.region.radiusM > 0.0 &&
-              e.region.radiusM <= kMaxEffectLengthM)) {
-            return EffectProblem{"region.sphere.radius_m",
-                                 "the radius (m) must be > 0 and <= " + show(kMaxEffectLengthM) +
-                                     " (got " + show(e.region.radiusM) + ")"};
-        }
-        break;
-    default:
-        return EffectProblem{"region", "unknown region shape"};
-    }
-    return std::nullopt;
-}
-
 double defaultCommandTimeoutMs(double rateHz) {
     return std::min(2.0 * 1000.0 / rateHz, kMaxCommandTimeoutMs);
 }
 
-std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_view sourceName) {
+std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_view sourceName,
+                                            const DeviceEntryReader& reader) {
     const Source w(sourceName);
     const Path top;
     const Json root = parseText(text, w);
@@ -586,7 +338,7 @@ std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_v
     out.reserve(devices.size());
     for (std::size_t i = 0; i < devices.size(); ++i) {
         const Path path = devicesPath[i];
-        out.push_back(parseDevice(w, devices[i], path));
+        out.push_back(parseDevice(w, devices[i], path, i, reader));
         for (std::size_t k = 0; k < i; ++k) {
             if (out[k].name == out[i].name) {
                 w.fail(path / "name", "duplicate name '" + out[i].name + "' (also at devices[" +
@@ -597,9 +349,10 @@ std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_v
     return out;
 }
 
-std::vector<DeviceConfig> loadDeviceConfigFile(const std::filesystem::path& path) {
+std::vector<DeviceConfig> loadDeviceConfigFile(const std::filesystem::path& path,
+                                               const DeviceEntryReader& reader) {
     const std::string text = readFile(path, "device configuration");
-    std::vector<DeviceConfig> configs = parseDeviceConfig(text, path.string());
+    std::vector<DeviceConfig> configs = parseDeviceConfig(text, path.string(), reader);
     const std::filesystem::path base = path.parent_path();
     for (DeviceConfig& c : configs) {
         if (auto* r = std::get_if<ReplayConfig>(&c.params); r && r->trace.is_relative()) {

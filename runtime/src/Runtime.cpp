@@ -26,29 +26,20 @@ SafetyConfig safetyFor(double maxForceN) {
     return c;
 }
 
-/// The runtime's renderer settings with the device's own contact damping, if it has one.
-RendererConfig rendererFor(const RendererConfig& runtime, const DeviceConfig& device) {
-    RendererConfig c = runtime;
-    if (device.contactDampingNsPerM) {
-        c.damping = *device.contactDampingNsPerM;
-    }
-    return c;
-}
-
 /// The device's configured effects, checked; a message names the device.
-EffectSet effectsFor(const DeviceConfig& device) {
+EffectSet effectsFor(const RuntimeDevice& device) {
     try {
-        return EffectSet(device.effects);
+        return EffectSet(device.rendering.effects);
     } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument("runtime: device '" + device.name + "': " + e.what());
+        throw std::invalid_argument("runtime: device '" + device.config.name + "': " + e.what());
     }
 }
 
 } // namespace
 
 Runtime::Channel::Channel(RuntimeDevice d, const RuntimeOptions& o)
-    : servo(rendererFor(o.renderer, d.config), safetyFor(d.config.maxForceN)) {
-    record.effects = effectsFor(d.config);
+    : servo(withDeviceSettings(o.renderer, d.rendering.renderer), safetyFor(d.config.maxForceN)) {
+    record.effects = effectsFor(d);
     servo.haptic.setEffects(record.effects); // before any thread: no publish needed
     const std::uint64_t period = static_cast<std::uint64_t>(std::llround(1e9 / d.config.rateHz));
     servo.device = d.device.get();

@@ -7,6 +7,7 @@
 #include "TestSupport.h"
 
 #include "hapto/core/Finite.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/Effects.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/scenes/Generators.h"
@@ -30,7 +31,14 @@ bool near(const Vec3& a, const Vec3& b, double eps = 1e-12) {
     return glm::length(a - b) <= eps;
 }
 
-/// One scripted device at 1 kHz in step mode over the cube scene; `config` brings its effects,
+/// A rig's device: its configuration (transform, max force) and what the runtime renders for it
+/// (effects, renderer damping).
+struct RigDevice {
+    DeviceConfig config;
+    DeviceRendering rendering;
+};
+
+/// One scripted device at 1 kHz in step mode over the cube scene; `setup` brings its effects,
 /// transform and renderer damping, `hook` is registered before the start.
 struct Rig {
     ManualClock clock;
@@ -39,8 +47,9 @@ struct Rig {
     std::unique_ptr<Runtime> runtime;
     std::uint64_t t0 = 0;
 
-    Rig(ScriptedDevice::Path path, DeviceConfig config = {}, TickHook hook = {})
-        : world(cubeScene(), IndexSpec::parse("octree:2:0.005")) {
+    Rig(ScriptedDevice::Path path, RigDevice setup = {}, TickHook hook = {})
+        : world(cubeScene(), IndexSpec::parse(kDefaultIndexSpec)) {
+        DeviceConfig& config = setup.config;
         world.useClock(clock);
         auto d = std::make_unique<ScriptedDevice>("d", std::move(path));
         d->useClock(&clock);
@@ -52,7 +61,7 @@ struct Rig {
             config.maxForceN = 5.0;
         }
         std::vector<RuntimeDevice> rds;
-        rds.push_back({std::move(d), config, nullptr});
+        rds.push_back({std::move(d), config, nullptr, setup.rendering});
         RuntimeOptions options;
         options.realtime = false;
         runtime = std::make_unique<Runtime>(world, std::move(rds), options);
@@ -84,9 +93,9 @@ ScriptedDevice::Path moving(const Vec3& from, const Vec3& velocity) {
     };
 }
 
-DeviceConfig withEffects(std::vector<ForceEffect> effects) {
-    DeviceConfig c;
-    c.effects = std::move(effects);
+RigDevice withEffects(std::vector<ForceEffect> effects) {
+    RigDevice c;
+    c.rendering.effects = std::move(effects);
     return c;
 }
 
@@ -207,8 +216,8 @@ TEST_CASE("runtime: a device's configured effects act from the first tick, each 
     }
     SECTION("a spring to a plane, through the device transform") {
         // The device frame is the world moved by +0.01 m in x: the effect sees world points.
-        DeviceConfig c = withEffects({ForceEffect::springToPlane(anchor, Vec3(1, 0, 0), 20.0)});
-        c.transform.translation = Vec3(0.01, 0, 0);
+        RigDevice c = withEffects({ForceEffect::springToPlane(anchor, Vec3(1, 0, 0), 20.0)});
+        c.config.transform.translation = Vec3(0.01, 0, 0);
         Rig rig(still(p - Vec3(0.01, 0, 0)), c);
         rig.runTo(1);
         CHECK(near(rig.force(), Vec3(-20.0 * (p.x - anchor.x), 0, 0)));
@@ -318,11 +327,11 @@ TEST_CASE("runtime: a device's renderer damping comes from its configuration") {
     const auto path = [](std::uint64_t t) {
         return Vec3(0.0, 0.03 - 1e-4 * static_cast<double>(t), 0.0); // 0.1 m/s down
     };
-    DeviceConfig damped;
-    damped.contactDampingNsPerM = 20.0;
-    damped.maxForceN = 50.0;
-    DeviceConfig plain;
-    plain.maxForceN = 50.0;
+    RigDevice damped;
+    damped.rendering.renderer.contactDampingNsPerM = 20.0;
+    damped.config.maxForceN = 50.0;
+    RigDevice plain;
+    plain.config.maxForceN = 50.0;
     Rig a(path, damped);
     Rig b(path, plain);
     a.runTo(80); // 8 mm down: 3 mm into the cube, 1.5 N from the spring alone
@@ -364,8 +373,8 @@ TEST_CASE("runtime: the hook is called every tick with the sample, proxy, contac
           "its force is added") {
     HookProbe probe;
     probe.returns = Vec3(0.0, 0.0, 0.4);
-    DeviceConfig c;
-    c.transform.translation = Vec3(0.002, 0, 0); // device frame != world frame
+    RigDevice c;
+    c.config.transform.translation = Vec3(0.002, 0, 0); // device frame != world frame
     Rig rig(test::pressIntoCube(0.0), c, TickHook{&probeHook, &probe});
     rig.runTo(100);
     CHECK(probe.calls == 100);
@@ -469,7 +478,7 @@ TEST_CASE("runtime: effects and the hook pass through the safety filter") {
 TEST_CASE("servo threads: effects set while they run reach them, and the control thread never "
           "waits for a tick",
           "[realtime]") {
-    World world(cubeScene(), IndexSpec::parse("octree:2:0.005"));
+    World world(cubeScene(), IndexSpec::parse(kDefaultIndexSpec));
     std::vector<RuntimeDevice> rds;
     auto d = std::make_unique<ScriptedDevice>("d", still(Vec3(0.08, 0.06, 0.0))); // free space
     DeviceConfig c;

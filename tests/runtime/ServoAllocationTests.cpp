@@ -6,6 +6,7 @@
 
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/DeviceFactory.h"
+#include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/GodObjectRenderer.h"
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Realtime.h"
@@ -80,12 +81,12 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
     std::vector<RuntimeDevice> devices;
     for (DeviceConfig c : defaultDeviceConfigs()) {
         c.rateHz = 2000;
-        c.effects = everyEffect(20.0);
-        c.contactDampingNsPerM = 1.0;
         // A turning stylus with a tool tip: the tip's point and velocity are servo work too.
         c.toolTipM = Vec3(0.0, 0.0, 0.01);
         std::get<SimConfig>(c.params).spinRadPerS = Vec3(0.0, 1.0, 0.0);
-        devices.push_back({makeDevice(c, scene), c, nullptr});
+        DeviceRendering rendering{everyEffect(20.0), {}};
+        rendering.renderer.contactDampingNsPerM = 1.0;
+        devices.push_back({makeDevice(c, scene), c, nullptr, rendering});
     }
     RuntimeOptions opt;
     opt.realtime = false;
@@ -129,13 +130,12 @@ TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (ste
 TEST_CASE("servo threads make no heap allocation while running, across snapshot updates",
           "[realtime]") {
     const Scene scene = makeDefaultScene();
-    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    World world(scene, IndexSpec::parse(kDefaultIndexSpec));
     world.setRestDelay(std::chrono::milliseconds(5));
     std::vector<RuntimeDevice> devices;
     for (DeviceConfig c : defaultDeviceConfigs()) {
         c.rateHz = 2000;
-        c.effects = everyEffect(20.0);
-        devices.push_back({makeDevice(c, scene), c, nullptr});
+        devices.push_back({makeDevice(c, scene), c, nullptr, {everyEffect(20.0), {}}});
     }
     RuntimeOptions opt;
     opt.realtime = false;
@@ -180,7 +180,7 @@ TEST_CASE("servo threads make no heap allocation while running, across snapshot 
 
 namespace {
 
-/// Five simulated hands with every effect (the default pair, then three more walking).
+/// Five simulated hands at 2 kHz (the default pair, then three more walking).
 std::vector<DeviceConfig> fiveHands() {
     std::vector<DeviceConfig> configs = defaultDeviceConfigs();
     for (int i = 0; i < 3; ++i) {
@@ -193,16 +193,15 @@ std::vector<DeviceConfig> fiveHands() {
     }
     for (DeviceConfig& c : configs) {
         c.rateHz = 2000;
-        c.effects = everyEffect(20.0);
     }
     return configs;
 }
 
-/// fiveHands() opened over `scene`, ready for a Runtime.
+/// fiveHands() opened over `scene` with every effect, ready for a Runtime.
 std::vector<RuntimeDevice> fiveHandDevices(const Scene& scene) {
     std::vector<RuntimeDevice> devices;
     for (const DeviceConfig& c : fiveHands()) {
-        devices.push_back({makeDevice(c, scene), c, nullptr});
+        devices.push_back({makeDevice(c, scene), c, nullptr, {everyEffect(20.0), {}}});
     }
     return devices;
 }
@@ -212,7 +211,7 @@ std::vector<RuntimeDevice> fiveHandDevices(const Scene& scene) {
 TEST_CASE("grouped servos make no heap allocation, across snapshot updates (step mode)") {
     const Scene scene = makeDefaultScene();
     ManualClock clock;
-    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    World world(scene, IndexSpec::parse(kDefaultIndexSpec));
     world.useClock(clock);
     world.setRestDelay(std::chrono::milliseconds(5));
     std::vector<RuntimeDevice> devices = fiveHandDevices(scene);
@@ -247,7 +246,7 @@ TEST_CASE("grouped servos make no heap allocation, across snapshot updates (step
 
 TEST_CASE("grouped servo threads make no heap allocation while running", "[realtime]") {
     const Scene scene = makeDefaultScene();
-    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    World world(scene, IndexSpec::parse(kDefaultIndexSpec));
     world.setRestDelay(std::chrono::milliseconds(5));
     std::vector<RuntimeDevice> devices = fiveHandDevices(scene);
     RuntimeOptions opt;
@@ -329,7 +328,7 @@ TEST_CASE("the renderer makes no heap allocation with mesh candidates: triangle 
 TEST_CASE("servo threads make no heap allocation while a viewer follows the live view",
           "[realtime]") {
     const Scene scene = makeDefaultScene();
-    World world(scene, IndexSpec::parse("octree:2:0.005"));
+    World world(scene, IndexSpec::parse(kDefaultIndexSpec));
     world.setRestDelay(std::chrono::milliseconds(5));
     std::vector<RuntimeDevice> devices;
     for (DeviceConfig c : defaultDeviceConfigs()) {

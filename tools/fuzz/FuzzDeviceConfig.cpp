@@ -1,8 +1,9 @@
-// libFuzzer target: the device configuration loader. Any input loads or is refused with an
+// libFuzzer target: the device configuration loader, the runtime's effects and renderer fields
+// included. Any input loads or is refused with an
 // InputError; nothing else may escape, crash, hang or leak.
 
-#include "hapto/devices/DeviceConfig.h"
 #include "hapto/io/InputError.h"
+#include "hapto/runtime/DeviceFile.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -10,9 +11,9 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     try {
-        const auto configs = hapto::parseDeviceConfig(
+        const hapto::DeviceFile file = hapto::parseDeviceFile(
             std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json");
-        for (const hapto::DeviceConfig& c : configs) {
+        for (const hapto::DeviceConfig& c : file.devices) {
             // What loaded is what the runtime relies on.
             if (c.name.empty() || !(c.rateHz >= 100.0 && c.rateHz <= 100000.0) ||
                 !(c.transform.scale > 0.0) || !(c.maxForceN >= 0.0)) {

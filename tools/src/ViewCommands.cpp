@@ -7,6 +7,7 @@
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/TraceReader.h"
 #include "hapto/io/InputError.h"
+#include "hapto/runtime/DeviceFile.h"
 #include "hapto/view/ViewDocuments.h"
 #include "hapto/view/ViewServer.h"
 
@@ -56,8 +57,9 @@ void runView(const ViewCommandArgs& a) {
     const Scene scene = loadSceneOrDefault(a.scene);
     // Each trace is placed in the world by the device of its name (from --devices, or the
     // default two hands); a trace of another name stays in its device frame.
+    // Read whole, so a bad effect is refused here as in `hapto run`.
     const std::vector<DeviceConfig> configs =
-        a.devices.empty() ? defaultDeviceConfigs() : loadDeviceConfigFile(a.devices);
+        a.devices.empty() ? defaultDeviceConfigs() : loadDeviceFile(a.devices).devices;
     std::vector<ViewTrace> traces;
     std::vector<ViewDevice> devices;
     for (const auto& file : traceFiles(a.traces)) {

@@ -1,8 +1,8 @@
 #pragma once
 /// Force effects on the servo path: one effect's force, and a device's fixed-capacity set.
 ///
-/// Design note. An effect is a plain value (ForceEffect, in hapto/devices/DeviceConfig.h so a
-/// device file can carry it); a device's effects are an EffectSet, a fixed array of
+/// Design note. An effect is a plain value (ForceEffect, ForceEffect.h; a device file carries
+/// it, DeviceFile.h); a device's effects are an EffectSet, a fixed array of
 /// kMaxEffectsPerDevice values and a count: trivially copyable, never allocating. The servo
 /// thread owns one EffectSet inside its HapticTick and sums its force every tick after the
 /// renderer and before the safety filter. The control thread never touches that copy: it
@@ -12,7 +12,7 @@
 /// slot in use, a few multiply-adds each.
 
 #include "hapto/core/Geometry.h"
-#include "hapto/devices/DeviceConfig.h"
+#include "hapto/runtime/ForceEffect.h"
 
 #include <array>
 #include <cstddef>

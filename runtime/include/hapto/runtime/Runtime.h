@@ -5,6 +5,7 @@
 #include "hapto/devices/Device.h"
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/index/Cursor.h"
+#include "hapto/runtime/DeviceFile.h"
 #include "hapto/runtime/DeviceMetrics.h"
 #include "hapto/runtime/Effects.h"
 #include "hapto/runtime/ForceSafety.h"
@@ -59,8 +60,8 @@ struct RuntimeOptions {
     std::uint64_t reopenAfterNs =
         1'000'000'000;         ///< After a fault, close the device and try to open it again every
                                ///< this long (ns), then drive it again from zero force; 0 = never.
-    RendererConfig renderer{}; ///< Proxy settings for every device (a device's
-                               ///< DeviceConfig::contactDampingNsPerM overrides the damping).
+    RendererConfig renderer{}; ///< Proxy settings for every device (a device's own
+                               ///< RendererSettings, RuntimeDevice::rendering, are laid over).
     /// Simulated devices only (kind sim or scripted): K > 1 runs devices [0, K), [K, 2K), ...
     /// on one servo thread per group (GroupedServo.cpp). Each device keeps its own deadline,
     /// cursor, renderer, load record, safety and faults; the thread sleeps once to the
@@ -80,8 +81,11 @@ struct RuntimeOptions {
 /// One device as the runtime drives it.
 struct RuntimeDevice {
     std::unique_ptr<Device> device;    ///< The backend, not yet opened.
-    DeviceConfig config;               ///< Name, transform, rate, max force, effects.
+    DeviceConfig config;               ///< Name, transform, rate, max force.
     TraceRecorder* recorder = nullptr; ///< Optional per-tick recording (owned by the caller).
+    /// Its force effects and renderer settings (a device file's, DeviceFile::renderingOf());
+    /// none by default.
+    DeviceRendering rendering{};
 };
 
 /// Summary of one device's run, loads as fractions of its period.
@@ -234,7 +238,7 @@ public:
     /// Turns effect k of device i on or off from its next tick on, as setEffects(). Throws
     /// std::out_of_range when there is no such device or effect. [control]
     void setEffectEnabled(std::size_t i, std::size_t k, bool enabled);
-    /// Device i's effects as last set (its DeviceConfig's, then setEffects() and
+    /// Device i's effects as last set (its RuntimeDevice::rendering's, then setEffects() and
     /// setEffectEnabled()). [control]
     const EffectSet& effects(std::size_t i) const;
     /// Registers device i's per-tick hook (see TickHook.h for what it may do), called on its

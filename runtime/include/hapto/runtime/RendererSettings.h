@@ -1,0 +1,30 @@
+#pragma once
+/// A device's own renderer settings (a device file's `"renderer"`), laid over the runtime's.
+
+#include "hapto/runtime/ForceEffect.h"
+#include "hapto/runtime/RenderOutput.h"
+
+#include <optional>
+
+namespace hapto {
+
+/// What one device changes in the renderer the runtime gives every device
+/// (RuntimeOptions::renderer). JSON `"renderer": {"damping_n_s_per_m": b}`.
+struct RendererSettings {
+    /// The renderer's contact damping b (N·s/m), 0..kMaxDampingNsPerM; none = the runtime's
+    /// RuntimeOptions::renderer.damping.
+    std::optional<double> contactDampingNsPerM;
+};
+
+/// `runtime` (the settings every device gets) with one device's own `settings` applied.
+/// [control]
+inline RendererConfig withDeviceSettings(const RendererConfig& runtime,
+                                         const RendererSettings& settings) {
+    RendererConfig c = runtime;
+    if (settings.contactDampingNsPerM) {
+        c.damping = *settings.contactDampingNsPerM;
+    }
+    return c;
+}
+
+} // namespace hapto
