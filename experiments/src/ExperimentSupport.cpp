@@ -6,7 +6,6 @@
 
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/io/InputError.h"
-#include "hapto/runtime/HapticTick.h"
 #include "hapto/runtime/ServoStep.h"
 #include "hapto/runtime/Session.h"
 
@@ -308,18 +307,60 @@ SessionResult runSession(World& world, const std::vector<HandPlan>& hands,
     return result;
 }
 
-double probeTickSeconds(const World& world, const Vec3& point, int runs) {
-    const WorldSnapshot& s = world.current();
-    HapticTick tick; // the servo's own tick
+namespace {
+
+/// The tick probe's device: held at one point (with a 10 µm jitter over three readings, so the
+/// tick is not the same every time) at rest; the force is dropped.
+class ProbePointDevice final : public Device {
+public:
+    explicit ProbePointDevice(const Vec3& point) : mPoint(point) {}
+    std::string_view name() const override { return "probe"; }
+    DeviceKind kind() const override { return DeviceKind::Scripted; }
+    DeviceCapabilities capabilities() const override { return {}; }
+    DeviceStatus open() override { return DeviceStatus::Ok; }
+    void close() override {}
+    DeviceStatus read(DeviceState& state) noexcept override {
+        const int i = mReads++;
+        state.position = mPoint + Vec3(1e-5 * (i % 3), 1e-5 * ((i + 1) % 3), 0.0);
+        state.velocity = Vec3(0.0);
+        state.hasVelocity = true;
+        return DeviceStatus::Ok;
+    }
+    DeviceStatus write(const Vec3&) noexcept override { return DeviceStatus::Ok; }
+    std::string errorMessage() const override { return {}; }
+
+private:
+    Vec3 mPoint;
+    int mReads = 0;
+};
+
+} // namespace
+
+double probeTickSeconds(World& world, const Vec3& point, int runs) {
+    // The servo's own step at 1 kHz, on time at every deadline of a clock that moves only here.
+    ProbePointDevice device(point);
+    ManualClock clock;
+    ServoStepShared shared;
+    ServoStep step(RendererConfig{}, SafetyConfig{});
+    const RuntimeOptions runtime;
+    step.setTiming(1'000'000, runtime.missLimit, runtime.lateWakeupFraction,
+                   runtime.stallTimeoutNs);
+    step.device = &device;
+    step.reader = world.registerReader();
+    step.ports = shared.portsFor(world, &clock);
+    step.start(clock.nowNs());
     std::vector<double> seconds;
     for (int i = 0; i < runs; ++i) {
-        const Vec3 p = point + Vec3(1e-5 * (i % 3), 1e-5 * ((i + 1) % 3), 0.0);
+        clock.set(step.deadlineNs);
         const auto t0 = std::chrono::steady_clock::now();
-        const TickOutput out = tick.tick(s, p, Vec3(0.0), 1e-3, Vec3(0.0));
+        const bool ticked = step.run(step.deadlineNs);
         const auto t1 = std::chrono::steady_clock::now();
-        asm volatile("" : : "g"(&out) : "memory");
+        if (!ticked) {
+            break; // a non-finite point: what ran is the probe
+        }
         seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
     }
+    world.unregisterReader(step.reader);
     return median(std::move(seconds));
 }
 

@@ -133,3 +133,13 @@ TEST_CASE("a warmed simulated hand is primed by the servo's step and starts on t
     CHECK(nearest < 1e-3);
     hand.close();
 }
+
+TEST_CASE("the experiments' tick probe runs the servo's step and gives its reader back") {
+    World world(cubeGrid(), IndexSpec::parse("octree:2:0.005"));
+    const std::size_t readers = world.readerCount();
+    // On a cube's face, so the probe renders a contact.
+    CHECK(probeTickSeconds(world, Vec3(0.0, 0.0, 0.0105), 25) > 0.0);
+    SnapshotReader* again = world.registerReader(); // the probe's slot, free again
+    CHECK(world.readerCount() == std::max<std::size_t>(readers, 1));
+    world.unregisterReader(again);
+}

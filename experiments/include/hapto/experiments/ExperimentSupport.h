@@ -201,10 +201,10 @@ SessionResult runSession(World& world, const std::vector<HandPlan>& hands,
 DeviceConfig simHand(const std::string& name, double rateHz, std::string_view script,
                      std::uint64_t seed, const Vec3& start);
 
-/// Median seconds of `runs` renderer ticks at `point` with the index of `world`, as the servo
-/// loop does them (two cursors, candidate set, proxy update), untimed by the Runtime: a probe
-/// to skip sizes whose tick obviously overruns. [control]
-double probeTickSeconds(const World& world, const Vec3& point, int runs);
+/// Median seconds of `runs` servo steps (ServoStep: read, the haptic tick, write, metrics) of a
+/// 1 kHz device held at `point` over `world`, outside any Runtime: a probe to skip sizes whose
+/// tick obviously overruns. [control]
+double probeTickSeconds(World& world, const Vec3& point, int runs);
 
 /// Output folder: created; throws InputError when it cannot be. [control]
 std::filesystem::path prepareOutDir(const std::string& dir);

@@ -62,8 +62,8 @@ template <std::size_t N> struct ListedLeaves {
 
 /// One device's haptic tick around a force algorithm (the seam: ForceAlgorithm.h; HapticTick
 /// is the tick around the god-object renderer). Design note: the sequence every caller runs (the
-/// servo threads, the runtime's step mode, `hapto render`, the experiments' warm-up and tick probe)
-/// lives here and nowhere else:
+/// servo step, ServoStep.h, which servo threads, the step mode, `hapto bench tick` and the
+/// experiments run; and `hapto render`) lives here and nowhere else:
 ///   1. locate: the device point's cursor and the proxy's cursor each find their leaf (they
 ///      differ while the tool presses into a surface, the proxy resting on it);
 ///   2. candidates: the two leaves' object slots (the proxy's only when its leaf differs) and
