@@ -122,6 +122,24 @@ void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
     }
 }
 
+// The recorder of device `c` for --record `folder`: `<folder>/<name>.trace`, its header the
+// device's configuration and the wall-clock time now.
+std::unique_ptr<TraceRecorder> recorderFor(const DeviceConfig& c, const std::string& folder) {
+    TraceHeader header;
+    header.rateHz = c.rateHz;
+    header.kind = std::string(name(c.kind));
+    header.name = c.name;
+    header.transform = c.transform;
+    header.toolTipM = c.toolTipM;
+    header.maxForceN = c.maxForceN;
+    header.startUnixNs =
+        static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                       std::chrono::system_clock::now().time_since_epoch())
+                                       .count());
+    return std::make_unique<TraceRecorder>(std::filesystem::path(folder) / (c.name + ".trace"),
+                                           header);
+}
+
 int runSession(const RunArgs& a) {
     // First, before any thread starts (the index build's TBB workers included), so that every
     // thread inherits the blocked stop signals and only the signal thread takes them.
@@ -152,19 +170,7 @@ int runSession(const RunArgs& a) {
         const DeviceConfig& c = configs[i];
         RuntimeDevice rd{makeDevice(c, scene), c, nullptr, file.renderingOf(i)};
         if (!a.record.empty()) {
-            TraceHeader header;
-            header.rateHz = c.rateHz;
-            header.kind = std::string(name(c.kind));
-            header.name = c.name;
-            header.transform = c.transform;
-            header.toolTipM = c.toolTipM;
-            header.maxForceN = c.maxForceN;
-            header.startUnixNs =
-                static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                               std::chrono::system_clock::now().time_since_epoch())
-                                               .count());
-            recorders.push_back(std::make_unique<TraceRecorder>(
-                std::filesystem::path(a.record) / (c.name + ".trace"), header));
+            recorders.push_back(recorderFor(c, a.record));
             rd.recorder = recorders.back().get();
         }
         devices.push_back(std::move(rd));
