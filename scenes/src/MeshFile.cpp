@@ -1,29 +1,20 @@
-// Model files through assimp. Design note: the file is opened once through InputFile (a
-// regular file of bounded size, never a FIFO or a folder) and read whole; its bytes are checked
-// for what assimp misses (MeshFileChecks.cpp) and then handed to assimp from memory, so the
-// bytes checked are the bytes read. assimp runs with the least post-processing that gives
-// triangles: Triangulate (polygons to triangles) and ValidateDataStructure (a last net for
-// indices out of range). Its meshes are then gathered through the node tree (with the node
-// transforms) into one mesh, and vertices at exactly the same position are merged (weld(): one
-// sort), so triangles that share an edge share its vertex indices, as the renderer needs.
-// assimp's own JoinIdenticalVertices is not used: it merges only within one of its meshes and
-// only corners whose normals and texture coordinates agree too (so weld() is needed anyway),
-// and on a 10^6-triangle binary STL it took 2.2 s of a 3 s load and 450 MB of its 720 MB peak
-// (assimp 5.2.5, this machine; see docs/DESIGN.md).
+// Model files read by hapto's own readers. Design note: the file is opened once through
+// InputFile (a regular file of bounded size, never a FIFO or a folder), its first bytes and size
+// checked (checkHead) before it is read whole, then read by the reader of its format
+// (ObjReader.cpp, StlReader.cpp, PlyReader.cpp: one pass each, the first bad thing refused with
+// its place) into positions and faces; the faces are cut into triangles
+// (PolygonTriangulation.cpp), the positions scaled, and vertices at exactly the same position
+// merged (weld(): one sort), so triangles that share an edge share its vertex indices, as the
+// renderer needs. hapto once handed the checked bytes to assimp 5.2.5; the readers give the
+// same meshes (MeshFileTests compares them with figures assimp gave) from one parse.
 
 #include "hapto/scenes/MeshFile.h"
 
-#include "MeshFileChecks.h"
+#include "MeshReading.h"
 
 #include "hapto/core/Finite.h"
 #include "hapto/io/InputError.h"
 #include "hapto/io/InputFile.h"
-
-#include <assimp/IOStream.hpp>
-#include <assimp/IOSystem.hpp>
-#include <assimp/Importer.hpp>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 
 #include <algorithm>
 #include <cctype>
@@ -51,31 +42,6 @@ std::optional<detail::MeshFormat> formatOf(const std::filesystem::path& path) {
     return std::nullopt;
 }
 
-const char* hintOf(detail::MeshFormat f) {
-    switch (f) {
-    case detail::MeshFormat::Obj:
-        return "obj";
-    case detail::MeshFormat::Stl:
-        return "stl";
-    case detail::MeshFormat::Ply:
-        return "ply";
-    }
-    return "";
-}
-
-/// The files assimp may open while it reads a model from memory: none. An OBJ may name material
-/// libraries (`mtllib`), which assimp's default IOSystem opens from disk by those names: a FIFO
-/// blocks the load forever, a device or any other file is read as a material and can get the
-/// model refused. hapto reads geometry only, so to assimp every other file is missing (it notes
-/// that and goes on without materials).
-class NoOtherFiles final : public Assimp::IOSystem {
-public:
-    bool Exists(const char*) const override { return false; }
-    char getOsSeparator() const override { return '/'; }
-    Assimp::IOStream* Open(const char*, const char*) override { return nullptr; }
-    void Close(Assimp::IOStream* stream) override { delete stream; }
-};
-
 /// How much of a model file checkHead looks at before the file is read whole (bytes).
 constexpr std::size_t kHeadBytes = 4096;
 
@@ -95,33 +61,59 @@ detail::MeshFormat knownFormat(const std::filesystem::path& path) {
     return *format;
 }
 
+/// Refuses a model file from its first bytes and its size, before it is read whole: an STL
+/// that is neither ASCII nor binary of its header's size (checkStlHead); an OBJ with a NUL byte
+/// in `head`; a PLY with a NUL byte before its header ends.
+void checkHead(detail::MeshFormat format, std::string_view head, std::uint64_t size,
+               const std::string& name) {
+    if (size == 0) {
+        return; // empty, or a file that reports no size (/proc): the whole file's check decides
+    }
+    switch (format) {
+    case detail::MeshFormat::Obj:
+        detail::refuseNul(head, name, "an OBJ text file");
+        break;
+    case detail::MeshFormat::Stl:
+        detail::checkStlHead(head, size, name);
+        break;
+    case detail::MeshFormat::Ply:
+        detail::refuseNul(head.substr(0, head.find("end_header")), name,
+                          "a PLY file (its header is text)");
+        break;
+    }
+}
+
+/// The model's vertices and triangles, as hapto keeps them before scaling.
 struct Gathered {
     std::vector<Vec3> vertices;
     std::vector<TriangleIndices> triangles;
 };
 
-/// Appends every triangle of the node's meshes and its children's, placed by the accumulated
-/// node transform; points and lines (faces of 1 or 2 indices) are skipped.
-void gather(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent, Gathered& out) {
-    const aiMatrix4x4 transform = parent * node.mTransformation;
-    for (unsigned m = 0; m < node.mNumMeshes; ++m) {
-        const aiMesh& mesh = *scene.mMeshes[node.mMeshes[m]];
-        const auto base = static_cast<std::uint32_t>(out.vertices.size());
-        for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-            const aiVector3D p = transform * mesh.mVertices[v];
-            out.vertices.emplace_back(p.x, p.y, p.z);
+/// Reads `bytes` with the reader of `format`, and cuts the faces into triangles.
+Gathered read(detail::MeshFormat format, std::string& bytes, const std::string& name,
+              double scale) {
+    detail::ModelFaces model;
+    detail::NgonRotation rotation = detail::NgonRotation::None;
+    switch (format) {
+    case detail::MeshFormat::Obj:
+        if (bytes.starts_with("\xEF\xBB\xBF")) {
+            bytes.erase(0, 3); // a UTF-8 byte order mark
         }
-        for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-            const aiFace& face = mesh.mFaces[f];
-            if (face.mNumIndices == 3) {
-                out.triangles.push_back(
-                    {base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
-            }
-        }
+        detail::blankObjComments(bytes);
+        model = detail::readObj(bytes, name, scale);
+        rotation = detail::NgonRotation::WithinFace;
+        break;
+    case detail::MeshFormat::Stl:
+        model = detail::readStl(bytes, name, scale);
+        break;
+    case detail::MeshFormat::Ply:
+        model = detail::readPly(bytes, name, scale);
+        rotation = detail::NgonRotation::AcrossFaces;
+        break;
     }
-    for (unsigned c = 0; c < node.mNumChildren; ++c) {
-        gather(scene, *node.mChildren[c], transform, out);
-    }
+    std::string().swap(bytes); // read: the model holds what is needed
+    std::vector<TriangleIndices> triangles = detail::triangulate(model, rotation);
+    return {std::move(model.vertices), std::move(triangles)};
 }
 
 /// Merges vertices at exactly the same position; rewrites the triangles' indices.
@@ -164,7 +156,7 @@ std::shared_ptr<const TriangleMesh> loadMeshFile(const std::filesystem::path& pa
     // Opened first, so a folder or a FIFO is named as such whatever its name.
     InputFile file(path, "model file");
     // A file its first bytes and size refuse (a 2 GB STL of zeros) is never read whole.
-    detail::checkHead(knownFormat(path), file.readHead(kHeadBytes), file.size(), name);
+    checkHead(knownFormat(path), file.readHead(kHeadBytes), file.size(), name);
     return parseMeshFile(file.readAll(), path, std::move(source));
 }
 
@@ -176,36 +168,8 @@ parseMeshFile(std::string bytes, const std::filesystem::path& path, MeshSource s
     if (bytes.empty()) {
         throw InputError(name + ": the model file is empty");
     }
-    switch (format) {
-    case detail::MeshFormat::Obj:
-        if (bytes.starts_with("\xEF\xBB\xBF")) {
-            bytes.erase(0, 3); // a UTF-8 byte order mark: assimp 5.2.5 would lose the first line
-        }
-        detail::blankObjComments(bytes);
-        detail::checkObj(bytes, name, source.scale);
-        break;
-    case detail::MeshFormat::Stl:
-        detail::checkStl(bytes, name, source.scale);
-        break;
-    case detail::MeshFormat::Ply:
-        detail::checkPly(bytes, name, source.scale);
-        break;
-    }
 
-    Assimp::Importer importer;
-    importer.SetIOHandler(new NoOtherFiles); // owned by the importer
-    const aiScene* scene = importer.ReadFileFromMemory(
-        bytes.data(), bytes.size(), aiProcess_Triangulate | aiProcess_ValidateDataStructure,
-        hintOf(format));
-    if (!scene || !scene->mRootNode) {
-        throw InputError(name + ": the " + hintOf(format) +
-                         " reader (assimp) refuses it: " + importer.GetErrorString());
-    }
-    std::string().swap(bytes); // assimp has its own copy now
-
-    Gathered g;
-    gather(*scene, *scene->mRootNode, aiMatrix4x4(), g);
-    importer.FreeScene();
+    Gathered g = read(format, bytes, name, source.scale);
     for (Vec3& v : g.vertices) {
         const Vec3 scaled = v * source.scale;
         if (!finite(scaled)) {
