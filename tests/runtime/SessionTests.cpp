@@ -133,7 +133,7 @@ TEST_CASE("session, step mode: when no device is driven any more (a fault, no re
 }
 
 TEST_CASE("session, step mode: recorders are drained while it runs and closed once the devices "
-          "are stopped; a session whose devices all fail to open leaves an older trace alone") {
+          "are stopped, and a session whose devices all fail to open leaves an older trace alone") {
     test::TempDir dir;
     TraceHeader header;
     header.rateHz = 1000.0;
