@@ -497,87 +497,107 @@ void refuseNulInJson(std::string_view text, std::string_view sourceName) {
                      "); a scene file is JSON text or a binary hapto scene (HAPTOSCN)");
 }
 
-} // namespace
+/// Converts a scene file's objects while the parser reads it, so a large file is never held as
+/// one JSON tree. Depth 0 is the top-level object; its keys are reported at depth 1, and
+/// elements of the "objects" array end at depth 2: each is converted as soon as it is complete,
+/// then dropped. Inside an element of "objects", its keys are reported at depth 3, and the
+/// elements of its "vertices" or "triangles" array end at depth 4: each is converted into the
+/// context and dropped too (`mObjectKey` names the element's array being read, "" outside one).
+class ObjectStream {
+public:
+    ObjectStream(const Source& w, const Path& objectsPath, LoadContext& context,
+                 std::vector<SceneObject>& objects)
+        : mW(w), mObjectsPath(objectsPath), mContext(context), mObjects(objects) {}
 
-Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
-                        const std::filesystem::path& baseDir) {
-    refuseNulInJson(text, sourceName);
-    const Source w(sourceName);
-    const Path top;
-    const Path objectsPath = top / "objects";
-    std::vector<SceneObject> objects;
-    std::string topKey;
-    bool inObjects = false;
-    LoadContext context;
-    context.baseDir = baseDir;
-
-    // Depth 0 is the top-level object; its keys are reported at depth 1, and elements of the
-    // "objects" array end at depth 2: each is converted as soon as it is complete, then dropped.
-    // Inside an element of "objects", its keys are reported at depth 3, and the elements of
-    // its "vertices" or "triangles" array end at depth 4: each is converted into the context
-    // and dropped too (`objectKey` names the element's array being read, "" outside one).
-    std::string objectKey;
-    bool inMeshArray = false;
-    auto callback = [&](int depth, Json::parse_event_t event, Json& parsed) -> bool {
+    /// The parser's callback: false drops what was just read (it has been converted).
+    bool event(int depth, Json::parse_event_t event, Json& parsed) {
         switch (event) {
         case Json::parse_event_t::key:
-            if (depth == 1) {
-                topKey = parsed.get<std::string>();
-            } else if (depth == 3 && inObjects) {
-                objectKey = parsed.get<std::string>();
-            }
+            onKey(depth, parsed);
             return true;
         case Json::parse_event_t::object_start:
-            if (inObjects && depth == 2) {
-                context.startObject();
-                objectKey.clear();
+            if (mInObjects && depth == 2) {
+                startObject();
             }
             return true;
         case Json::parse_event_t::array_start:
-            if (depth == 1 && topKey == "objects") {
-                inObjects = true;
-            } else if (inObjects && depth == 2) {
-                context.startObject();
-                objectKey.clear();
-            } else if (inObjects && depth == 3) {
-                inMeshArray = objectKey == "vertices" || objectKey == "triangles";
-            }
+            onArrayStart(depth);
             return true;
         case Json::parse_event_t::array_end:
-            if (depth == 1) {
-                inObjects = false;
-                return true;
-            }
-            if (depth == 3) {
-                inMeshArray = false;
+            if (depth == 1 || depth == 3) {
+                (depth == 1 ? mInObjects : mInMeshArray) = false;
                 return true;
             }
             [[fallthrough]]; // an array as an element of "objects": refused by parseObject
         case Json::parse_event_t::object_end:
         case Json::parse_event_t::value:
-            if (inObjects && depth == 4 && inMeshArray) {
-                const Path element = objectsPath[objects.size()];
-                if (objectKey == "vertices") {
-                    streamVertex(w, parsed, element / "vertices", context);
-                } else {
-                    streamTriangle(w, parsed, element / "triangles", context);
-                }
-                return false;
-            }
-            if (inObjects && depth == 2) {
-                objects.push_back(parseObject(w, parsed, objectsPath[objects.size()], context));
-                return false;
-            }
-            if (depth == 1 && topKey == "version" && parsed.is_number_integer()) {
-                context.version = parsed.get<std::int64_t>(); // checked below, used by meshes
-            }
-            return true;
+            return onComplete(depth, parsed);
         default:
             return true;
         }
-    };
-    const Json root = parseText(text, w, callback);
+    }
 
+private:
+    void onKey(int depth, const Json& parsed) {
+        if (depth == 1) {
+            mTopKey = parsed.get<std::string>();
+        } else if (depth == 3 && mInObjects) {
+            mObjectKey = parsed.get<std::string>();
+        }
+    }
+
+    void startObject() {
+        mContext.startObject();
+        mObjectKey.clear();
+    }
+
+    void onArrayStart(int depth) {
+        if (depth == 1 && mTopKey == "objects") {
+            mInObjects = true;
+        } else if (mInObjects && depth == 2) {
+            startObject();
+        } else if (mInObjects && depth == 3) {
+            mInMeshArray = mObjectKey == "vertices" || mObjectKey == "triangles";
+        }
+    }
+
+    /// A value, object or array is complete: a mesh element or an object is converted.
+    bool onComplete(int depth, const Json& parsed) {
+        if (mInObjects && depth == 4 && mInMeshArray) {
+            const Path element = mObjectsPath[mObjects.size()];
+            if (mObjectKey == "vertices") {
+                streamVertex(mW, parsed, element / "vertices", mContext);
+            } else {
+                streamTriangle(mW, parsed, element / "triangles", mContext);
+            }
+            return false;
+        }
+        if (mInObjects && depth == 2) {
+            mObjects.push_back(parseObject(mW, parsed, mObjectsPath[mObjects.size()], mContext));
+            return false;
+        }
+        if (depth == 1 && mTopKey == "version" && parsed.is_number_integer()) {
+            mContext.version = parsed.get<std::int64_t>(); // checked later, used by meshes
+        }
+        return true;
+    }
+
+    const Source& mW;
+    const Path& mObjectsPath;
+    LoadContext& mContext;
+    std::vector<SceneObject>& mObjects;
+    std::string mTopKey;
+    std::string mObjectKey;
+    bool mInObjects = false;
+    bool mInMeshArray = false;
+};
+
+/// The top level of a parsed scene file: its keys, "format", "version" (and no mesh in a
+/// version 1 file: "version" may follow "objects", so meshes read before it are refused here)
+/// and "objects" as an array.
+void checkTopLevel(const Source& w, const Json& root, const std::vector<SceneObject>& objects,
+                   const Path& objectsPath) {
+    const Path top;
     if (!root.is_object()) {
         w.fail(top,
                "expected a JSON object with \"format\": \"hapto-scene\", got " + typeName(root));
@@ -595,7 +615,6 @@ Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
                                     describe(version));
     }
     if (version.get<std::int64_t>() == 1) {
-        // "version" may follow "objects" in the file: meshes read before it are refused here.
         for (std::size_t i = 0; i < objects.size(); ++i) {
             if (objects[i].shape == Shape::Mesh) {
                 refuseMeshInVersion1(w, objectsPath[i] / "shape");
@@ -609,7 +628,25 @@ Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
     if (!objectsJson->is_array()) {
         w.fail(objectsPath, "expected an array, got " + typeName(*objectsJson));
     }
+}
 
+} // namespace
+
+Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
+                        const std::filesystem::path& baseDir) {
+    refuseNulInJson(text, sourceName);
+    const Source w(sourceName);
+    const Path top;
+    const Path objectsPath = top / "objects";
+    std::vector<SceneObject> objects;
+    LoadContext context;
+    context.baseDir = baseDir;
+    ObjectStream stream(w, objectsPath, context, objects);
+    const Json root =
+        parseText(text, w, [&stream](int depth, Json::parse_event_t event, Json& parsed) {
+            return stream.event(depth, event, parsed);
+        });
+    checkTopLevel(w, root, objects, objectsPath);
     checkUniqueIds(w, objects, objectsPath);
     const Json* boundsJson = optional(root, "bounds");
     std::optional<Aabb> bounds;
