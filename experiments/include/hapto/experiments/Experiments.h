@@ -24,7 +24,7 @@ struct CommonArgs {
 
 /// `hapto experiment paper1`: the paper's experiment 1 (lattices of K^3 cubes).
 struct Paper1Args {
-    CommonArgs common;
+    CommonArgs common;                   ///< Options every experiment takes (--out, --quick, ...).
     std::vector<double> ratesHz{1000.0}; ///< Servo rates (Hz).
     int maxPerSide = 100;                ///< Largest K.
     double maxIndexMb = 3000.0;          ///< Largest index the sweep builds (MB).
@@ -35,7 +35,7 @@ int runPaper1(const Paper1Args& args);
 
 /// `hapto experiment paper2`: the paper's experiment 2 (random scenes, several seeds).
 struct Paper2Args {
-    CommonArgs common;
+    CommonArgs common; ///< Options every experiment takes (--out, --quick, ...).
     std::vector<std::size_t> counts{10, 20, 50, 100, 200, 500}; ///< Objects per scene.
     int seeds = 5;                       ///< Scenes per count (seeds 1..seeds).
     std::vector<double> ratesHz{1000.0}; ///< Servo rates (Hz).
@@ -48,7 +48,7 @@ int runPaper2(const Paper2Args& args);
 
 /// `hapto experiment meshes`: load against the triangle count of one generated closed mesh.
 struct MeshesArgs {
-    CommonArgs common;
+    CommonArgs common;                    ///< Options every experiment takes (--out, --quick, ...).
     std::vector<double> ratesHz{1000.0};  ///< Servo rates (Hz).
     MeshShape shape = MeshShape::Sphere;  ///< Sphere or torus (closed: the hands press into it).
     double sizeM = 0.2;                   ///< The mesh's extent along x (m).
@@ -65,8 +65,8 @@ int runMeshes(const MeshesArgs& args);
 
 /// `hapto experiment scaling`: load against device count, and cursor steps against N.
 struct DevicesArgs {
-    CommonArgs common;
-    int maxDevices = 8;                          ///< Largest device count (1, 2, 4, ... up to it).
+    CommonArgs common;  ///< Options every experiment takes (--out, --quick, ...).
+    int maxDevices = 8; ///< Largest device count (1, 2, 4, ... up to it).
     std::vector<double> ratesHz{1000.0, 4000.0}; ///< Servo rates (Hz).
     std::string scene;                           ///< Scene file; empty = the default scene.
     std::string index{kDefaultIndexSpec};        ///< Index spec.

@@ -45,7 +45,7 @@ struct SweepScene {
 struct SweepStep {
     std::size_t objects = 0; ///< Objects in each scene.
     int size = 0;            ///< K (paper1) or the count (paper2).
-    std::vector<SweepScene> scenes;
+    std::vector<SweepScene> scenes;   ///< One per seed (paper2) or one (paper1).
     std::vector<std::string> mustRun; ///< Renderers measured here even once unstable.
 };
 
@@ -83,7 +83,7 @@ struct SweepRow {
     int size = 0;            ///< K or count.
     std::size_t objects = 0; ///< Items the index holds: boxes, spheres and mesh triangles.
     std::uint64_t seed = 0;  ///< Scene seed (paper2).
-    Condition condition = Condition::NoTouch;
+    Condition condition = Condition::NoTouch; ///< No touch, touch or sliding.
     LoadFigures median;            ///< Medians over the repeats.
     std::vector<LoadFigures> runs; ///< Each repeat.
     bool skipped = false;          ///< Not run (probe, memory or build failure); see note.
@@ -103,8 +103,8 @@ struct SweepRow {
 
 /// Per renderer and rate: how far it went.
 struct SweepLimit {
-    std::string renderer;
-    double rateHz = 0;
+    std::string renderer; ///< Paper name.
+    double rateHz = 0;    ///< Servo rate (Hz).
     std::optional<std::size_t> maxStableObjects;     ///< Largest size with every cell stable.
     std::optional<int> maxStableSize;                ///< Its K or count.
     std::optional<std::size_t> firstUnstableObjects; ///< The first size with an unstable cell.

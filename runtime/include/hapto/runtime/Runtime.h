@@ -90,15 +90,21 @@ struct RuntimeDevice {
 
 /// Summary of one device's run, loads as fractions of its period.
 struct DeviceReport {
-    std::string name, kind;
-    double rateHz = 0;
-    std::uint64_t ticks = 0;
+    std::string name;       ///< The device's configured name.
+    std::string kind;       ///< sim, replay, falcon or phantom.
+    double rateHz = 0;      ///< Servo rate (Hz).
+    std::uint64_t ticks = 0; ///< Ticks run.
     HistogramSummary loadFraction; ///< (wake-up to force written) / period.
     HistogramSummary latenessNs;   ///< Wake-up lateness (ns).
     HistogramSummary ioNs;         ///< Device I/O per tick (ns).
-    std::uint64_t lateWakeups = 0, missedDeadlines = 0, zeroedForMisses = 0;
-    double locateStepsMean = 0, candidatesMean = 0;
-    std::uint64_t outsideTicks = 0, contactTicks = 0, snapshotsSeen = 0;
+    std::uint64_t lateWakeups = 0;     ///< Wake-ups later than 10 % of the period.
+    std::uint64_t missedDeadlines = 0; ///< Forces written after the next deadline.
+    std::uint64_t zeroedForMisses = 0; ///< Ticks at zero force after K misses in a row.
+    double locateStepsMean = 0;        ///< Cursor steps per tick, both cursors, mean.
+    double candidatesMean = 0;         ///< Candidates handed to the renderer per tick, mean.
+    std::uint64_t outsideTicks = 0;    ///< Ticks with the device point outside the bounds.
+    std::uint64_t contactTicks = 0;    ///< Ticks in contact.
+    std::uint64_t snapshotsSeen = 0;   ///< Distinct world versions picked up.
     SafetyCounters safety{};         ///< Clamps, rate limits, non-finite forces.
     std::uint64_t hookNonFinite = 0; ///< Ticks whose hook returned a non-finite force (zeroed).
     std::string fault;               ///< Empty, or what faulted the device and keeps it down now.
@@ -114,7 +120,7 @@ struct DeviceReport {
 
 /// The whole run.
 struct RunReport {
-    std::vector<DeviceReport> devices;
+    std::vector<DeviceReport> devices; ///< One per device, in configuration order.
     double loadSum = 0;       ///< Sum of the devices' mean loads (CPU cores' worth of servo work).
     double loadPerCore = 0;   ///< loadSum / cores.
     int cores = 1;            ///< Hardware threads.
@@ -126,7 +132,7 @@ struct RunReport {
     /// The warm-up before each deadline the per-device servo threads ran (ns; 0: none), and
     /// whether the runtime chose it (RuntimeOptions::warmUpNs unset).
     std::uint64_t warmUpNs = 0;
-    bool warmUpAutomatic = false;
+    bool warmUpAutomatic = false; ///< The runtime chose warmUpNs (see above).
 };
 
 /// Runs D servo threads (or D / K, RuntimeOptions::devicesPerThread) and a supervisor. Construct,
@@ -147,6 +153,8 @@ public:
     /// Events kept per device in the report; later ones are only counted.
     static constexpr std::size_t kMaxEvents = 64;
 
+    /// Takes the devices (not yet opened) over `world`, which must outlive the runtime; nothing
+    /// runs until start() or startStepped(). [control]
     Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOptions options = {});
     ~Runtime();
     Runtime(const Runtime&) = delete;
