@@ -101,8 +101,8 @@ std::string floatProblem(double v) {
         return "is not finite";
     }
     if (std::abs(v) > std::numeric_limits<float>::max()) {
-        return "is beyond the largest 32-bit float, 3.4e+38 (assimp reads coordinates as floats "
-               "and would make it infinite)";
+        return "is beyond the largest 32-bit float, 3.4e+38 (model coordinates are kept as "
+               "32-bit floats)";
     }
     return "";
 }
@@ -129,7 +129,7 @@ std::string coordinateProblem(double v, double scale) {
 void checkFaceSize(std::uint64_t vertices, const std::string& place, const char* what) {
     if (vertices > kMaxFaceVertices) {
         fail(place + "a " + what + " of " + std::to_string(vertices) +
-             " vertices; assimp reads at most " + std::to_string(kMaxFaceVertices) +
+             " vertices; hapto reads at most " + std::to_string(kMaxFaceVertices) +
              " (split it into smaller polygons)");
     }
 }

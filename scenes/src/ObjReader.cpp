@@ -97,8 +97,8 @@ void refuseAssimpMisreads(std::string_view line, std::string_view key, const Pla
     if (key.data() != line.data()) {
         if (geometry) {
             fail(place() + "an indented '" + std::string(key) +
-                 "' statement (assimp skips a line that does not begin with its statement, "
-                 "which would lose it): remove the indentation");
+                 "' statement (other readers, assimp among them, skip a line that does "
+                 "not begin with its statement, which would lose it): remove the indentation");
         }
         return;
     }
@@ -106,8 +106,8 @@ void refuseAssimpMisreads(std::string_view line, std::string_view key, const Pla
         (key[0] == 'f' || key[0] == 'l' || key[0] == 'p' || key.starts_with("vt") ||
          key.starts_with("vn"))) {
         fail(place() + quoted(key) +
-             " is not an OBJ geometry statement, but assimp would read it as one (a word "
-             "beginning with f, l, p, vt or vn)");
+             " is not an OBJ geometry statement, but other readers (assimp) would read it as one "
+             "(a word beginning with f, l, p, vt or vn)");
     }
     if (key == "v" && line.size() > 1 && line[1] != ' ' && line[1] != '\t') {
         fail(place() + "'v' must be followed by a space or a tab");
@@ -160,12 +160,14 @@ void checkObjCharacters(std::string_view text, const std::string& name) {
         if (text[i] != '\r' || (i + 1 < text.size() && text[i + 1] != '\n')) {
             const auto line = 1 + std::count(text.begin(), text.begin() + i, '\n');
             fail(atLine(name, static_cast<std::size_t>(line)) +
-                 (text[i] == '\v'   ? "a vertical tab (assimp would not read it as a space but "
-                                      "as part of a word; separate values with spaces or tabs)"
-                  : text[i] == '\f' ? "a form feed inside a line (assimp would end the line "
-                                      "there; lines end with \\n or \\r\\n)"
-                                    : "a carriage return inside a line (assimp would end the "
-                                      "line there; lines end with \\n or \\r\\n)"));
+                 (text[i] == '\v'
+                      ? "a vertical tab (other readers (assimp) would not read it as a space but "
+                        "as part of a word; separate values with spaces or tabs)"
+                  : text[i] == '\f'
+                      ? "a form feed inside a line (other readers (assimp) would end the line "
+                        "there; lines end with \\n or \\r\\n)"
+                      : "a carriage return inside a line (other readers (assimp) would end the "
+                        "line there; lines end with \\n or \\r\\n)"));
         }
     }
 }
@@ -248,8 +250,8 @@ private:
             if (mTok[0] != "vn" && std::isfinite(*v) && (c < '0' || c > '9') && c != '+' &&
                 c != '-') {
                 fail(atLine(mName, mLine) + quoted(mTok[k]) +
-                     " does not begin with a digit or a sign (assimp would not count it; "
-                     "write 0.5 for .5)");
+                     " does not begin with a digit or a sign (other readers (assimp) would not "
+                     "count it; write 0.5 for .5)");
             }
         }
     }

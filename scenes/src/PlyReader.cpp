@@ -247,8 +247,8 @@ PlyHeader readPlyHeader(std::string_view bytes, const std::string& name) {
             continue;
         }
         if (tok.empty()) {
-            fail(place() + "a blank line in the PLY header (the format has none, and assimp 5.2.5 "
-                           "misreads some: remove it)");
+            fail(place() + "a blank line in the PLY header (the format has none, and other readers "
+                           "(assimp) misread some: remove it)");
         }
         if (tok[0] == "comment" || tok[0] == "obj_info") {
             continue;

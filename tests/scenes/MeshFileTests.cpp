@@ -315,7 +315,8 @@ TEST_CASE("bad model files are refused with the file and the place") {
         // fuzz_mesh_file: it lost the line, or threw and leaked).
         {"indented.obj", "v 0 0 0\n  v 1 0 0\nv 0 1 0\nf 1 2 3\n", ":2: an indented 'v' statement"},
         {"word.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nfo 1 2 3\nf 1 2 3\n",
-         ":4: 'fo' is not an OBJ geometry statement, but assimp would read it as one"},
+         ":4: 'fo' is not an OBJ geometry statement, but other readers (assimp) would read it as "
+         "one"},
         {"five.obj", "v 0 0 0\nv 1 0 0 0 0\nv 0 1 0\nf 1 2 3\n",
          ":2: 'v' takes x y z, x y z w or x y z r g b, got 5 numbers"},
         {"uv.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 1\nf 1 2 3\n",
@@ -399,9 +400,9 @@ TEST_CASE("bad model files are refused with the file and the place") {
          ":4: relative vertex index -9223372036854775808 is out of range"},
         {"vtab.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1\v2 3\n", ":4: a vertical tab"},
         {"huge-face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf" + hugeFace + "\n",
-         ":4: a face of 40000 vertices; assimp reads at most 32767"},
+         ":4: a face of 40000 vertices; hapto reads at most 32767"},
         {"huge-face.ply", plyHeader("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n" + hugePlyFace,
-         ":14: face element 0: a face of 40000 vertices; assimp reads at most 32767"},
+         ":14: face element 0: a face of 40000 vertices; hapto reads at most 32767"},
         // A blank header line: assimp 5.2.5 refused this one ("Missing format specification").
         {"blank.ply",
          "ply\n \r\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float "

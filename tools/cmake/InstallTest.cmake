@@ -78,13 +78,12 @@ if(LINKER_FLAGS)
   list(APPEND configure_args "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}")
 endif()
 # No package a consumer of the index alone may need: pkg-config searches an empty folder (no
-# libusb-1.0, no cpp-httplib) and the other packages of the Falcon and the view, and assimp
-# (no mesh-file library either), are disabled.
+# libusb-1.0, no cpp-httplib) and the other packages of the Falcon and the view are disabled.
 file(MAKE_DIRECTORY ${WORK_DIR}/no-pkgconfig)
 set(without_device_and_view_packages ${CMAKE_COMMAND} -E env
     PKG_CONFIG_LIBDIR=${WORK_DIR}/no-pkgconfig --unset=PKG_CONFIG_PATH)
 set(disabled_packages -DCMAKE_DISABLE_FIND_PACKAGE_meshoptimizer=ON
-    -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON)
+    -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON)
 # consumer(<name> <source> [ENV <command prefix>...] [ARGS <configure args>...]): builds it in
 # WORK_DIR/<name>.
 function(consumer name source)

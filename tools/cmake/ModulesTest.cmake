@@ -1,7 +1,7 @@
 # ctest "install: -DHAPTO_MODULES=index configures with no USB, HTTP or mesh library".
 # Run as: cmake -DSOURCE_DIR=... -DWORK_DIR=... -DGENERATOR=... -P ModulesTest.cmake
 # Configures hapto's sources for the index alone where pkg-config finds nothing (no libusb-1.0,
-# no cpp-httplib) and meshoptimizer, assimp and Eigen are disabled, and checks that the build
+# no cpp-httplib) and meshoptimizer and Eigen are disabled, and checks that the build
 # holds the index and what it needs and nothing above it (built or installed); then that the same
 # environment does hide the view's needs (configuring for the view fails, naming one).
 # Configures only: nothing is built.
@@ -17,7 +17,7 @@ file(MAKE_DIRECTORY ${WORK_DIR}/no-pkgconfig)
 set(hidden ${CMAKE_COMMAND} -E env PKG_CONFIG_LIBDIR=${WORK_DIR}/no-pkgconfig
     --unset=PKG_CONFIG_PATH)
 set(args -G ${GENERATOR} --no-warn-unused-cli -DCMAKE_DISABLE_FIND_PACKAGE_meshoptimizer=ON
-    -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON)
+    -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON)
 
 execute_process(COMMAND ${hidden} ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/index
                         ${args} -DHAPTO_MODULES=index

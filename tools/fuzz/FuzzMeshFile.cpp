@@ -1,4 +1,4 @@
-// libFuzzer target: the model file reader (OBJ, STL, PLY: our checks, then assimp). The first
+// libFuzzer target: the model file reader (OBJ, STL, PLY: hapto's own readers). The first
 // byte picks the format (its value mod 3: .obj, .stl, .ply), the rest is the file. Any input
 // either loads or is refused with an InputError; nothing else may escape, crash, hang or leak.
 // A mesh that loaded is one the renderer can use: at least one and at most kMaxTriangles

@@ -138,9 +138,9 @@ PageMesh simplifiedMesh(const TriangleMesh& mesh, std::uint64_t budget) {
 
 // The misses of a trace, as the runtime counted them. A trace whose header has
 // kTraceHeaderMarksMisses marks each tick that missed its deadline, and those marks are counted
-// as they are. Older traces do not: over them the runtime's missed-deadline rule (ServoLoop.cpp,
-// the end of servoTick) is replayed. Such a trace records each tick's wake-up (timeNs, since the
-// session started) and its wake-up-to-force-written time (computeNs), not its deadline, so the
+// as they are. Older traces do not: over them the runtime's missed-deadline rule (ServoStep.cpp,
+// ServoStep::advanceDeadline) is replayed. Such a trace records each tick's wake-up (timeNs, since
+// the session started) and its wake-up-to-force-written time (computeNs), not its deadline, so the
 // deadlines are rebuilt the way the servo moves them: one period on after each tick and, when the
 // force came after that (a miss), to the first slot after the force. The servo's first deadline is
 // one period after its thread started (about 2 ms into the session) and its slots keep that phase,
