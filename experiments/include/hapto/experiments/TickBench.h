@@ -93,20 +93,25 @@ struct TickBenchSettings {
 
 /// One (index, mode) being driven: its device, its step and its per-tick samples.
 struct TickRun {
-    TickMode mode = TickMode::Hot;
-    bool holdLatency = false;     ///< Holds the wake-latency request while it ticks.
-    WalkDevice* device = nullptr; ///< The device `owned` holds.
-    std::unique_ptr<Device> owned;
-    std::unique_ptr<ServoStep> step;
+    TickMode mode = TickMode::Hot;           ///< How its ticks are started.
+    bool holdLatency = false;                ///< Holds the wake-latency request while it ticks.
+    WalkDevice* device = nullptr;            ///< The device `owned` holds.
+    std::unique_ptr<Device> owned;           ///< Owns the device (a WalkDevice).
+    std::unique_ptr<ServoStep> step;         ///< The servo step it times.
     std::unique_ptr<ServoStepShared> shared; ///< Its metrics and mailboxes.
-    ServoStepProbe probe;
+    ServoStepProbe probe;                    ///< The last tick's stage ends and what it computed.
     std::array<std::vector<double>, ServoStepProbe::kStages> stageNs; ///< Per stage, per tick.
     std::vector<double> tickNs; ///< Per tick: wake-up to the end of the metrics stage (ns).
     std::vector<Vec3> forceN;   ///< Per tick: the force sent (N, world).
     std::vector<double> gapM;   ///< Per tick: the device point's distance from the proxy (m).
-    std::uint64_t ticks = 0, locateSteps = 0, candidates = 0, contactTicks = 0;
-    std::uint64_t solves = 0, extraLeaves = 0, pullBacks = 0; ///< HapticTick's, summed.
-    std::uint64_t kept = 0;                                   ///< What the warm-up read, kept.
+    std::uint64_t ticks = 0,    ///< Ticks run.
+        locateSteps = 0,        ///< Cursor steps, both cursors, summed.
+        candidates = 0,         ///< Candidate slots the renderer examined, summed.
+        contactTicks = 0;       ///< Ticks with at least one contact.
+    std::uint64_t solves = 0,   ///< Renderer solves, summed.
+        extraLeaves = 0,        ///< Extra leaves listed, summed.
+        pullBacks = 0;          ///< Pull-backs, summed.
+    std::uint64_t kept = 0;     ///< What the warm-up read, kept.
     /// Warm-ups still running at their deadline: those ticks started late by the overrun,
     /// which the tick's time (from the wake-up) does not show.
     std::uint64_t warmOverruns = 0;
@@ -117,9 +122,9 @@ struct TickRun {
 
 /// One index: its world (scene copy, index, snapshots) and its runs.
 struct TickTarget {
-    IndexSpec spec;
-    std::unique_ptr<World> world;
-    std::vector<std::unique_ptr<TickRun>> runs;
+    IndexSpec spec;                             ///< The index it builds.
+    std::unique_ptr<World> world;               ///< The scene's copy, indexed by `spec`.
+    std::vector<std::unique_ptr<TickRun>> runs; ///< One per mode it runs.
 };
 
 /// "hot", "sleep", "sleep+warm", "sleep+lat", "sleep+warm+lat". [any thread]
@@ -135,7 +140,10 @@ inline constexpr std::size_t kTickBlock = 256;
 
 /// Nearest-rank quantiles and the mean of some samples.
 struct Quantiles {
-    double p50 = 0, p99 = 0, p999 = 0, mean = 0;
+    double p50 = 0, ///< The median (the samples' unit).
+        p99 = 0,    ///< The 99th percentile.
+        p999 = 0,   ///< The 99.9th percentile.
+        mean = 0;   ///< The mean.
 };
 /// The nearest-rank quantile `q` of `sorted` samples (0 when empty). [any thread]
 double quantileOfSorted(const std::vector<double>& sorted, double q);

@@ -37,8 +37,8 @@ enum class RegionShape : std::uint8_t {
 /// sphere, the boundary included. JSON `"region": {"box": {"center": [x, y, z],
 /// "half_extents": [hx, hy, hz]}}` or `{"sphere": {"center": [x, y, z], "radius_m": r}}`.
 struct EffectRegion {
-    RegionShape shape = RegionShape::Everywhere;
-    Vec3 centerM{0.0};      ///< Box or sphere centre (m).
+    RegionShape shape = RegionShape::Everywhere; ///< Everywhere, a box or a sphere.
+    Vec3 centerM{0.0};                           ///< Box or sphere centre (m).
     Vec3 halfExtentsM{0.0}; ///< Box: half its size along x, y, z (m), each > 0.
     double radiusM = 0.0;   ///< Sphere: its radius (m), > 0.
 
@@ -121,8 +121,8 @@ struct ForceEffect {
 /// What is wrong with an effect: the JSON field (as in a device file, e.g.
 /// `stiffness_n_per_m`, `region.sphere.radius_m`) and what to do.
 struct EffectProblem {
-    std::string field;
-    std::string message;
+    std::string field;   ///< The JSON field at fault, e.g. `region.sphere.radius_m`.
+    std::string message; ///< What is wrong and what to do.
 };
 /// The first problem of `effect` (a gain, force or length out of its documented range, a
 /// non-finite value, an axis that is not of unit length), or none. The one home of the

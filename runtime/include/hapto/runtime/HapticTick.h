@@ -52,8 +52,9 @@ namespace detail {
 /// The leaves a tick's candidate spans list (N at most): the device's, the proxy's, then the
 /// extra ones, in the order their spans were added.
 template <std::size_t N> struct ListedLeaves {
-    std::array<std::uint32_t, N> leaves{};
-    std::size_t count = 0;
+    std::array<std::uint32_t, N> leaves{}; ///< The leaves listed; the first `count` are set.
+    std::size_t count = 0;                 ///< How many leaves are listed.
+    /// The leaves listed so far. [servo]
     std::span<const std::uint32_t> known() const noexcept {
         return std::span<const std::uint32_t>(leaves.data(), count);
     }

@@ -74,11 +74,11 @@ struct ServoStepPorts {
 /// bench, the experiments): nobody else reads the metrics or publishes effects, but the step
 /// runs exactly as in a Runtime's channel.
 struct ServoStepShared {
-    DeviceMetrics metrics;
-    Mailbox<ContactReport> contacts;
-    Mailbox<Vec3> externalForce;
-    Mailbox<EffectSet> effects;
-    std::atomic<std::uint64_t> effectsPublished{0};
+    DeviceMetrics metrics;                          ///< The step's metrics.
+    Mailbox<ContactReport> contacts;                ///< The step's contact reports.
+    Mailbox<Vec3> externalForce;                    ///< External force for the step (N, world).
+    Mailbox<EffectSet> effects;                     ///< Effect sets for the step.
+    std::atomic<std::uint64_t> effectsPublished{0}; ///< Sets published to `effects`.
 
     /// Ports to these, snapshots from `world`, time from `clock` (null: CLOCK_MONOTONIC).
     /// [control]
@@ -94,7 +94,7 @@ struct ServoStepProbe {
     static constexpr std::array<const char*, 9> kStageNames{"read",       "snapshot", "locate",
                                                             "candidates", "render",   "effects",
                                                             "safety",     "write",    "metrics"};
-    static constexpr std::size_t kStages = kStageNames.size();
+    static constexpr std::size_t kStages = kStageNames.size(); ///< How many stages: 9.
     /// The steady clock (ns, rt::nowNs; the step's clock for read and write) at the end of
     /// each stage: read (the device's read()), snapshot (the fault checks, the claim, the
     /// frame, the tool tip, the velocity, new effects), the five of HapticTick::tick, write
@@ -115,18 +115,18 @@ struct ServoStepProbe {
 /// the HapticTick.
 struct alignas(64) ServoStep {
     // Fixed from construction (reader: from open).
-    Device* device = nullptr;
-    TraceRecorder* recorder = nullptr;
-    SnapshotReader* reader = nullptr;
-    WorkspaceTransform transform;
+    Device* device = nullptr;          ///< The device it reads and writes (not owned).
+    TraceRecorder* recorder = nullptr; ///< Records every step when set; null: no recording.
+    SnapshotReader* reader = nullptr;  ///< Its reader of the world's snapshots.
+    WorkspaceTransform transform;      ///< Device frame -> world frame.
     Vec3 toolTip{0.0}; ///< The contact point in the stylus frame (m); 0 = the gimbal centre.
-    std::uint64_t periodNs = 1'000'000;
-    std::uint64_t lateNs = 0;    ///< A wake-up later than this is counted late.
-    std::uint64_t starvedNs = 0; ///< One this late (K periods) commands zero.
-    std::uint64_t stallNs = 0;   ///< The watchdog's limit between two steps.
-    double dtS = 1e-3;           ///< The period (s).
-    int missLimit = 3;           ///< K.
-    ServoStepPorts ports;
+    std::uint64_t periodNs = 1'000'000; ///< The servo period (ns); set by setTiming().
+    std::uint64_t lateNs = 0;           ///< A wake-up later than this is counted late.
+    std::uint64_t starvedNs = 0;        ///< One this late (K periods) commands zero.
+    std::uint64_t stallNs = 0;          ///< The watchdog's limit between two steps.
+    double dtS = 1e-3;                  ///< The period (s).
+    int missLimit = 3;                  ///< K.
+    ServoStepPorts ports;               ///< What it shares with other threads, and its clock.
 
     // Per step.
     std::uint64_t deadlineNs = 0;     ///< The next wake-up.
@@ -134,11 +134,12 @@ struct alignas(64) ServoStep {
     std::uint64_t effectsApplied = 0; ///< Effect sets published that the haptic tick holds.
     int consecutiveMisses = 0;        ///< Saturates at missLimit.
     bool first = true;                ///< The next step is the first since the servo started.
+    /// Raised by another thread to end the servo (run() returns false); start() lowers it.
     std::atomic<bool> stop{false};
     Vec3 lastPosition{0.0}; ///< The last device point (m, world).
     Vec3 lastStep{0.0};     ///< The last step's move of the device point (m, world).
     DeviceState sample;     ///< The last reading.
-    HapticTick haptic;
+    HapticTick haptic;      ///< The haptic tick: cursors, renderer, effects, safety filter.
 
     /// Checks both configurations (std::invalid_argument). [control]
     ServoStep(const RendererConfig& renderer, const SafetyConfig& safety)
