@@ -440,15 +440,19 @@ void PhantomDevice::close() {
     }
 }
 
-DeviceStatus PhantomDevice::read(DeviceState& state) noexcept {
+DeviceStatus PhantomDevice::linkStatus() const noexcept {
     if (!mOpen.load(std::memory_order_acquire)) {
         return DeviceStatus::NotOpen;
     }
-    PhantomLink& link = *mLink;
-    if (const std::uint32_t code = link.faultCode.load(std::memory_order_acquire);
-        code != hd::kSuccess) {
-        return statusForHdError(code);
+    const std::uint32_t code = mLink->faultCode.load(std::memory_order_acquire);
+    return code == hd::kSuccess ? DeviceStatus::Ok : statusForHdError(code);
+}
+
+DeviceStatus PhantomDevice::read(DeviceState& state) noexcept {
+    if (const DeviceStatus status = linkStatus(); status != DeviceStatus::Ok) {
+        return status;
     }
+    PhantomLink& link = *mLink;
     PhantomSample s{};
     std::uint64_t writes = 0;
     if (link.sample.read(s, writes) && writes > 0) {
@@ -487,14 +491,10 @@ DeviceStatus PhantomDevice::read(DeviceState& state) noexcept {
 }
 
 DeviceStatus PhantomDevice::write(const Vec3& forceN) noexcept {
-    if (!mOpen.load(std::memory_order_acquire)) {
-        return DeviceStatus::NotOpen;
+    if (const DeviceStatus status = linkStatus(); status != DeviceStatus::Ok) {
+        return status;
     }
     PhantomLink& link = *mLink;
-    if (const std::uint32_t code = link.faultCode.load(std::memory_order_acquire);
-        code != hd::kSuccess) {
-        return statusForHdError(code);
-    }
     if (!finite(forceN)) {
         link.force.publish(detail::PhantomForce{Vec3(0.0), mCommandClock()});
         return DeviceStatus::BadData;

@@ -94,14 +94,7 @@ DeviceStatus ReplayDevice::read(DeviceState& state) noexcept {
     ++mPlayed;
     ++mReads;
     const TraceSample& s = mSamples[mCursor];
-    state.position = s.positionM;
-    state.velocity = s.velocityMps;
-    state.hasVelocity = s.hasVelocity;
-    state.orientation = s.orientation;
-    state.hasOrientation = s.hasOrientation;
-    state.angularVelocity = s.angularVelocity;
-    state.hasAngularVelocity = s.hasAngularVelocity;
-    state.buttons = s.buttons;
+    sampleToState(s, state);
     state.sequence = mReads;
     return s.status;
 }

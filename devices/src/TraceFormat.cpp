@@ -155,4 +155,26 @@ TraceSample decodeTraceSample(const unsigned char* in, std::uint32_t version) no
     return s;
 }
 
+void stateToSample(const DeviceState& state, TraceSample& sample) noexcept {
+    sample.positionM = state.position;
+    sample.velocityMps = state.velocity;
+    sample.hasVelocity = state.hasVelocity;
+    sample.orientation = state.orientation;
+    sample.hasOrientation = state.hasOrientation;
+    sample.angularVelocity = state.angularVelocity;
+    sample.hasAngularVelocity = state.hasAngularVelocity;
+    sample.buttons = state.buttons;
+}
+
+void sampleToState(const TraceSample& sample, DeviceState& state) noexcept {
+    state.position = sample.positionM;
+    state.velocity = sample.velocityMps;
+    state.hasVelocity = sample.hasVelocity;
+    state.orientation = sample.orientation;
+    state.hasOrientation = sample.hasOrientation;
+    state.angularVelocity = sample.angularVelocity;
+    state.hasAngularVelocity = sample.hasAngularVelocity;
+    state.buttons = sample.buttons;
+}
+
 } // namespace hapto

@@ -143,6 +143,9 @@ private:
     DeviceStatus startServo(hd::HdRuntime& rt, bool wasRunning, const std::string& who);
     DeviceStatus awaitFirstSample(const std::string& who);
     void releaseLocked();
+    /// NotOpen, Disconnected or Error after an HD error, else Ok: what read() and write()
+    /// check first. [servo]
+    DeviceStatus linkStatus() const noexcept;
 
     std::string mName;
     PhantomConfig mConfig;

@@ -122,6 +122,13 @@ struct TraceSample {
     bool operator==(const TraceSample&) const = default;
 };
 
+/// A reading's motion into a sample: position, velocity, orientation and angular velocity (each
+/// with its flag) and buttons; the rest of the sample is the recorder's. [any thread]
+void stateToSample(const DeviceState& state, TraceSample& sample) noexcept;
+/// A sample's motion as a reading (the same fields; sequence and gimbal angles untouched).
+/// [any thread]
+void sampleToState(const TraceSample& sample, DeviceState& state) noexcept;
+
 /// What a trace says about itself.
 struct TraceHeader {
     std::uint32_t version = kTraceVersion; ///< Format version.
