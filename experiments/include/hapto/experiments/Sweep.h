@@ -43,8 +43,8 @@ struct SweepScene {
 
 /// One size of a sweep: the scenes of that size.
 struct SweepStep {
-    std::size_t objects = 0; ///< Objects in each scene.
-    int size = 0;            ///< K (paper1) or the count (paper2).
+    std::size_t objects = 0;          ///< Objects in each scene.
+    int size = 0;                     ///< K (paper1) or the count (paper2).
     std::vector<SweepScene> scenes;   ///< One per seed (paper2) or one (paper1).
     std::vector<std::string> mustRun; ///< Renderers measured here even once unstable.
 };
@@ -84,14 +84,14 @@ struct SweepRow {
     std::size_t objects = 0; ///< Items the index holds: boxes, spheres and mesh triangles.
     std::uint64_t seed = 0;  ///< Scene seed (paper2).
     Condition condition = Condition::NoTouch; ///< No touch, touch or sliding.
-    LoadFigures median;            ///< Medians over the repeats.
-    std::vector<LoadFigures> runs; ///< Each repeat.
-    bool skipped = false;          ///< Not run (probe, memory or build failure); see note.
-    bool reachedPhase = true;      ///< Touch/slide hands were holding/sliding when timed.
-    double buildS = 0;             ///< Index build time (s).
-    double indexMb = 0;            ///< Index memory (MB).
-    double probeTickUs = 0;        ///< Offline probe: median tick (us).
-    std::string note;              ///< Why skipped, or anything odd.
+    LoadFigures median;                       ///< Medians over the repeats.
+    std::vector<LoadFigures> runs;            ///< Each repeat.
+    bool skipped = false;     ///< Not run (probe, memory or build failure); see note.
+    bool reachedPhase = true; ///< Touch/slide hands were holding/sliding when timed.
+    double buildS = 0;        ///< Index build time (s).
+    double indexMb = 0;       ///< Index memory (MB).
+    double probeTickUs = 0;   ///< Offline probe: median tick (us).
+    std::string note;         ///< Why skipped, or anything odd.
 
     /// DESIGN.md's verdict on the medians; a skipped cell is not stable. [any thread]
     bool stable() const { return !skipped && median.stable(); }
@@ -103,8 +103,8 @@ struct SweepRow {
 
 /// Per renderer and rate: how far it went.
 struct SweepLimit {
-    std::string renderer; ///< Paper name.
-    double rateHz = 0;    ///< Servo rate (Hz).
+    std::string renderer;                            ///< Paper name.
+    double rateHz = 0;                               ///< Servo rate (Hz).
     std::optional<std::size_t> maxStableObjects;     ///< Largest size with every cell stable.
     std::optional<int> maxStableSize;                ///< Its K or count.
     std::optional<std::size_t> firstUnstableObjects; ///< The first size with an unstable cell.

@@ -90,13 +90,13 @@ struct RuntimeDevice {
 
 /// Summary of one device's run, loads as fractions of its period.
 struct DeviceReport {
-    std::string name;       ///< The device's configured name.
-    std::string kind;       ///< sim, replay, falcon or phantom.
-    double rateHz = 0;      ///< Servo rate (Hz).
-    std::uint64_t ticks = 0; ///< Ticks run.
-    HistogramSummary loadFraction; ///< (wake-up to force written) / period.
-    HistogramSummary latenessNs;   ///< Wake-up lateness (ns).
-    HistogramSummary ioNs;         ///< Device I/O per tick (ns).
+    std::string name;                  ///< The device's configured name.
+    std::string kind;                  ///< sim, replay, falcon or phantom.
+    double rateHz = 0;                 ///< Servo rate (Hz).
+    std::uint64_t ticks = 0;           ///< Ticks run.
+    HistogramSummary loadFraction;     ///< (wake-up to force written) / period.
+    HistogramSummary latenessNs;       ///< Wake-up lateness (ns).
+    HistogramSummary ioNs;             ///< Device I/O per tick (ns).
     std::uint64_t lateWakeups = 0;     ///< Wake-ups later than 10 % of the period.
     std::uint64_t missedDeadlines = 0; ///< Forces written after the next deadline.
     std::uint64_t zeroedForMisses = 0; ///< Ticks at zero force after K misses in a row.
@@ -105,11 +105,11 @@ struct DeviceReport {
     std::uint64_t outsideTicks = 0;    ///< Ticks with the device point outside the bounds.
     std::uint64_t contactTicks = 0;    ///< Ticks in contact.
     std::uint64_t snapshotsSeen = 0;   ///< Distinct world versions picked up.
-    SafetyCounters safety{};         ///< Clamps, rate limits, non-finite forces.
-    std::uint64_t hookNonFinite = 0; ///< Ticks whose hook returned a non-finite force (zeroed).
-    std::string fault;               ///< Empty, or what faulted the device and keeps it down now.
-    std::uint64_t faults = 0;        ///< Faults while running (each zeroed the device at once).
-    std::uint64_t reopens = 0;       ///< Times the device was opened again after a fault.
+    SafetyCounters safety{};           ///< Clamps, rate limits, non-finite forces.
+    std::uint64_t hookNonFinite = 0;   ///< Ticks whose hook returned a non-finite force (zeroed).
+    std::string fault;                 ///< Empty, or what faulted the device and keeps it down now.
+    std::uint64_t faults = 0;          ///< Faults while running (each zeroed the device at once).
+    std::uint64_t reopens = 0;         ///< Times the device was opened again after a fault.
     /// Time from each fault to its reopen, summed, the current outage included (s).
     double downS = 0;
     std::vector<std::string> events; ///< "12.345 s: read-failed: disconnected", oldest first
