@@ -19,21 +19,6 @@ using namespace hapto;
 
 namespace {
 
-// The n-th ```json block of the user guide's "Device configuration files" section
-// (docs/guide/devices.md).
-std::string readmeExample(int n) {
-    const std::string text =
-        test::readFile(std::filesystem::path(HAPTO_SOURCE_DIR) / "docs" / "guide" / "devices.md");
-    std::size_t at = text.find("## Device configuration files");
-    REQUIRE(at != std::string::npos);
-    for (int i = 0; i <= n; ++i) {
-        at = text.find("```json\n", at);
-        REQUIRE(at != std::string::npos);
-        at += 8;
-    }
-    return text.substr(at, text.find("```", at) - at);
-}
-
 std::string errorOf(const std::string& text) {
     try {
         parseDeviceConfig(text, "bad.json");
@@ -43,16 +28,11 @@ std::string errorOf(const std::string& text) {
     return "(no error)";
 }
 
-// One valid sim device with `extra` spliced into its object.
-std::string withDevice(const std::string& extra) {
-    return R"({"format": "hapto-devices", "version": 1, "devices": [{"name": "a", "kind": "sim")" +
-           (extra.empty() ? "" : ", " + extra) + "}]}";
-}
-
 } // namespace
 
 TEST_CASE("the README dual-device example loads with its values") {
-    const auto configs = parseDeviceConfig(readmeExample(0), "example.json");
+    const auto configs = parseDeviceConfig(
+        test::guideJsonBlock("devices.md", "## Device configuration files", 0), "example.json");
     REQUIRE(configs.size() == 2);
     CHECK(configs[0].name == "left");
     CHECK(configs[1].name == "right");
@@ -72,7 +52,8 @@ TEST_CASE("the README dual-device example loads with its values") {
 
 TEST_CASE("the README hardware example loads, relative traces resolve against the file") {
     test::TempDir dir;
-    test::writeFile(dir / "d.json", readmeExample(1));
+    test::writeFile(dir / "d.json",
+                    test::guideJsonBlock("devices.md", "## Device configuration files", 1));
     const auto configs = loadDeviceConfigFile(dir / "d.json");
     REQUIRE(configs.size() == 3);
     const auto& falcon = std::get<FalconConfig>(configs[0].params);
@@ -88,7 +69,8 @@ TEST_CASE("the README hardware example loads, relative traces resolve against th
 }
 
 TEST_CASE("a device entry's effects and renderer go to the reader given, unread without one") {
-    const std::string text = withDevice(R"("effects": [{"type": "magnet"}], "renderer": 7)");
+    const std::string text =
+        test::deviceFileWith(R"("effects": [{"type": "magnet"}], "renderer": 7)");
     // They are the runtime's to read (hapto/runtime/DeviceFile.h): without a reader a program
     // that only places devices passes over them.
     CHECK(parseDeviceConfig(text, "r.json").size() == 1);
@@ -111,7 +93,7 @@ TEST_CASE("a device entry's effects and renderer go to the reader given, unread 
 }
 
 TEST_CASE("defaults apply to a minimal device") {
-    const auto configs = parseDeviceConfig(withDevice(""), "min.json");
+    const auto configs = parseDeviceConfig(test::deviceFileWith(""), "min.json");
     REQUIRE(configs.size() == 1);
     const DeviceConfig& c = configs[0];
     CHECK(c.rateHz == 1000.0);
@@ -126,7 +108,7 @@ TEST_CASE("defaults apply to a minimal device") {
 
 TEST_CASE("every sim field parses") {
     const auto configs = parseDeviceConfig(
-        withDevice(
+        test::deviceFileWith(
             R"("sim": {"script": "slide", "seed": 18446744073709551615, "start": [0.01, 0, 0],
           "object": 7, "near": [0, 0.1, 0], "press_n": 2, "max_speed_m_per_s": 0.3,
           "lift": [0, 0.04, 0], "carry": [0, 0, 0.1], "hand_mass_kg": 0.2,
@@ -377,7 +359,7 @@ TEST_CASE("device kinds and hand scripts: parsed once, printed back the same") {
 }
 
 TEST_CASE("tool_tip, a sim stylus and the replay's own settings parse, bad ones name their path") {
-    const auto configs = parseDeviceConfig(withDevice(R"("tool_tip": [0, 0, -0.04],
+    const auto configs = parseDeviceConfig(test::deviceFileWith(R"("tool_tip": [0, 0, -0.04],
                       "sim": {"orientation": [0, 1, 0, 0], "spin_rad_per_s": [0, 0.5, 0]})"),
                                            "tip.json");
     CHECK(configs[0].toolTipM == Vec3(0.0, 0.0, -0.04));
@@ -385,7 +367,7 @@ TEST_CASE("tool_tip, a sim stylus and the replay's own settings parse, bad ones 
     REQUIRE(s.orientation.has_value());
     CHECK(*s.orientation == Quat{0, 1, 0, 0});
     CHECK(s.spinRadPerS == Vec3(0.0, 0.5, 0.0));
-    CHECK(parseDeviceConfig(withDevice(""), "min.json")[0].toolTipM == Vec3(0.0));
+    CHECK(parseDeviceConfig(test::deviceFileWith(""), "min.json")[0].toolTipM == Vec3(0.0));
 
     const std::string replay = R"({"format": "hapto-devices", "version": 1, "devices": [)";
     const auto own = parseDeviceConfig(
@@ -398,30 +380,31 @@ TEST_CASE("tool_tip, a sim stylus and the replay's own settings parse, bad ones 
     CHECK_FALSE(r.ownTransform);
     CHECK_FALSE(r.ownMaxForce);
 
-    CHECK_THAT(errorOf(withDevice(R"("tool_tip": [0, 0.6, 0])")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("tool_tip": [0, 0.6, 0])")),
                Catch::Contains("bad.json: devices[0].tool_tip[1]: a tool tip component is at "
                                "most 0.5 m (got 0.6)"));
-    CHECK_THAT(errorOf(withDevice(R"("tool_tip": [0, 0])")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("tool_tip": [0, 0])")),
                Catch::Contains("bad.json: devices[0].tool_tip"));
-    CHECK_THAT(errorOf(withDevice(R"("sim": {"orientation": [2, 0, 0, 0]})")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("sim": {"orientation": [2, 0, 0, 0]})")),
                Catch::Contains("bad.json: devices[0].sim.orientation"));
-    CHECK_THAT(errorOf(withDevice(R"("sim": {"spin_rad_per_s": [0, 0, 1000]})")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("sim": {"spin_rad_per_s": [0, 0, 1000]})")),
                Catch::Contains("bad.json: devices[0].sim.spin_rad_per_s[2]"));
 }
 
 TEST_CASE("a value just past a limit is shown with the digits that put it past the limit") {
-    CHECK_THAT(errorOf(withDevice(R"("tool_tip": [0, 0.5000001, 0])")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("tool_tip": [0, 0.5000001, 0])")),
                Catch::Contains("bad.json: devices[0].tool_tip[1]: a tool tip component is at "
                                "most 0.5 m (got 0.5000001)"));
-    CHECK_THAT(errorOf(withDevice(R"("sim": {"hand_damping_ratio": 100.00000000000001})")),
-               Catch::Contains("the damping ratio must be <= 100 (got 100.00000000000001)"));
+    CHECK_THAT(
+        errorOf(test::deviceFileWith(R"("sim": {"hand_damping_ratio": 100.00000000000001})")),
+        Catch::Contains("the damping ratio must be <= 100 (got 100.00000000000001)"));
     // Round values stay short.
-    CHECK_THAT(errorOf(withDevice(R"("rate_hz": 1e9)")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("rate_hz": 1e9)")),
                Catch::Contains("the rate (Hz) must be <= 100000 (got 1e+09)"));
 }
 
 TEST_CASE("a device file in UTF-16, or with a NUL or a stray byte, is named as such, escaped") {
-    const std::string json = withDevice("");
+    const std::string json = test::deviceFileWith("");
     std::string utf16 = "\xFF\xFE";
     for (const char c : json) {
         utf16 += c;
@@ -440,17 +423,17 @@ TEST_CASE("a device file in UTF-16, or with a NUL or a stray byte, is named as s
 }
 
 TEST_CASE("a device name with control characters is shown escaped in its message") {
-    const std::string e = errorOf(
-        withDevice("").replace(withDevice("").find("\"a\""), 3, R"("a\nb\u0000c\u001b[2J")"));
+    const std::string e = errorOf(test::deviceFileWith("").replace(
+        test::deviceFileWith("").find("\"a\""), 3, R"("a\nb\u0000c\u001b[2J")"));
     CHECK_THAT(e, Catch::Contains("bad.json: devices[0].name: a device name is 1 to 63 letters"));
     CHECK_THAT(e, Catch::Contains(R"((got "a\nb\u0000c\u001b[2J"))"));
     CHECK(std::none_of(e.begin(), e.end(), [](char c) { return c >= 0 && c < 0x20; }));
     // So are an unknown field, kind and script.
-    CHECK_THAT(errorOf(withDevice(R"("\u001b[2J": 1)")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("\u001b[2J": 1)")),
                Catch::Contains(R"(bad.json: devices[0]: unknown field '\x1B[2J')"));
-    CHECK_THAT(errorOf(withDevice(R"("sim": {"script": "a\nb"})")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("sim": {"script": "a\nb"})")),
                Catch::Contains(R"(devices[0].sim.script: unknown script 'a\nb')"));
-    std::string badKind = withDevice("");
+    std::string badKind = test::deviceFileWith("");
     badKind.replace(badKind.find(R"("sim")"), 5, R"("s\u0000m")");
     CHECK_THAT(errorOf(badKind), Catch::Contains(R"(devices[0].kind: unknown kind 's\x00m')"));
 }

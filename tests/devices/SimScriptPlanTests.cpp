@@ -4,6 +4,7 @@
 // refactor of the planner must leave them unchanged.
 
 #include "TestMeshes.h"
+#include "TestSupport.h"
 
 #include "hapto/devices/SimScript.h"
 #include "hapto/scenes/Generators.h"
@@ -15,27 +16,9 @@
 #include <string>
 
 using namespace hapto;
+using test::Fnv;
 
 namespace {
-
-struct Fnv {
-    std::uint64_t h = 1469598103934665603ull;
-    void add(std::uint64_t v) {
-        for (int i = 0; i < 8; ++i) {
-            h = (h ^ ((v >> (8 * i)) & 0xFF)) * 1099511628211ull;
-        }
-    }
-    void add(double v) {
-        std::uint64_t bits = 0;
-        std::memcpy(&bits, &v, sizeof bits);
-        add(bits);
-    }
-    void add(const Vec3& v) {
-        add(v.x);
-        add(v.y);
-        add(v.z);
-    }
-};
 
 std::string planLine(const SimConfig& config, const Scene& scene, const Vec3& start) {
     const SimScript s = SimScript::plan(config, scene, start);

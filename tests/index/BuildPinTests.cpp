@@ -4,6 +4,7 @@
 // before they were split into parts; a refactor of the builds must leave them unchanged.
 
 #include "IndexTestScenes.h"
+#include "TestSupport.h"
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/UniformGrid.h"
@@ -18,26 +19,6 @@ using namespace hapto;
 using namespace hapto::test;
 
 namespace {
-
-struct Fnv {
-    std::uint64_t h = 1469598103934665603ull;
-    void add(std::uint64_t v) {
-        for (int i = 0; i < 8; ++i) {
-            h = (h ^ ((v >> (8 * i)) & 0xFF)) * 1099511628211ull;
-        }
-    }
-    void add(double v) {
-        std::uint64_t bits = 0;
-        std::memcpy(&bits, &v, sizeof bits);
-        add(bits);
-    }
-    void add(std::span<const std::uint32_t> values) {
-        add(std::uint64_t(values.size()));
-        for (const std::uint32_t v : values) {
-            add(std::uint64_t(v));
-        }
-    }
-};
 
 void addStats(Fnv& f, const SpatialIndex& index) {
     const IndexStats& st = index.stats();

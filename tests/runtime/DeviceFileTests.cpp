@@ -17,21 +17,6 @@ using namespace hapto;
 
 namespace {
 
-// The n-th ```json block of the user guide's "Device configuration files" section
-// (docs/guide/devices.md).
-std::string readmeExample(int n) {
-    const std::string text =
-        test::readFile(std::filesystem::path(HAPTO_SOURCE_DIR) / "docs" / "guide" / "devices.md");
-    std::size_t at = text.find("## Device configuration files");
-    REQUIRE(at != std::string::npos);
-    for (int i = 0; i <= n; ++i) {
-        at = text.find("```json\n", at);
-        REQUIRE(at != std::string::npos);
-        at += 8;
-    }
-    return text.substr(at, text.find("```", at) - at);
-}
-
 std::string errorOf(const std::string& text) {
     try {
         parseDeviceFile(text, "bad.json");
@@ -41,17 +26,12 @@ std::string errorOf(const std::string& text) {
     return "(no error)";
 }
 
-// One valid sim device with `extra` spliced into its object.
-std::string withDevice(const std::string& extra) {
-    return R"({"format": "hapto-devices", "version": 1, "devices": [{"name": "a", "kind": "sim")" +
-           (extra.empty() ? "" : ", " + extra) + "}]}";
-}
-
 } // namespace
 
 TEST_CASE("the user guide's effects example loads: springs to a plane and a line, a damper in a "
           "sphere, a constant force that is off, and the contact damping") {
-    const DeviceFile file = parseDeviceFile(readmeExample(2), "effects.json");
+    const DeviceFile file = parseDeviceFile(
+        test::guideJsonBlock("devices.md", "## Device configuration files", 2), "effects.json");
     REQUIRE(file.devices.size() == 1);
     REQUIRE(file.rendering.size() == 1);
     const DeviceRendering& c = file.rendering[0];
@@ -83,7 +63,7 @@ TEST_CASE("the user guide's effects example loads: springs to a plane and a line
 }
 
 TEST_CASE("effects: a spring to a point, a box region, a normalised axis, and none by default") {
-    const DeviceFile file = parseDeviceFile(withDevice(R"("effects": [
+    const DeviceFile file = parseDeviceFile(test::deviceFileWith(R"("effects": [
         {"type": "spring", "anchor": [0.1, 0.2, 0.3], "stiffness_n_per_m": 0},
         {"type": "spring", "anchor": [0, 0, 0], "stiffness_n_per_m": 10000, "direction": [0, 3, 4]},
         {"type": "damper", "damping_n_s_per_m": 100, "enabled": true,
@@ -108,10 +88,13 @@ TEST_CASE("effects: a spring to a point, a box region, a normalised axis, and no
         CHECK_FALSE(checkForceEffect(effect).has_value());
     }
 
-    const DeviceRendering plain = parseDeviceFile(withDevice(""), "p.json").renderingOf(0);
+    const DeviceRendering plain =
+        parseDeviceFile(test::deviceFileWith(""), "p.json").renderingOf(0);
     CHECK(plain.effects.empty());
     CHECK_FALSE(plain.renderer.contactDampingNsPerM.has_value());
-    CHECK(parseDeviceFile(withDevice(R"("effects": [])"), "p.json").renderingOf(0).effects.empty());
+    CHECK(parseDeviceFile(test::deviceFileWith(R"("effects": [])"), "p.json")
+              .renderingOf(0)
+              .effects.empty());
 }
 
 TEST_CASE("every bad effect or renderer setting names the file and its JSON path") {
@@ -210,7 +193,7 @@ TEST_CASE("every bad effect or renderer setting names the file and its JSON path
 }
 
 TEST_CASE("an effect value just past a limit is shown with the digits that put it past") {
-    CHECK_THAT(errorOf(withDevice(R"("effects": [{"type": "damper",
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("effects": [{"type": "damper",
                                                   "damping_n_s_per_m": 100.0000001}])")),
                Catch::Contains("effects[0].damping_n_s_per_m: the damping (N·s/m) must be in "
                                "0..100 (got 100.0000001)"));
@@ -218,9 +201,9 @@ TEST_CASE("an effect value just past a limit is shown with the digits that put i
 
 TEST_CASE("a spring's direction may have any length but zero, and a zero one is shown") {
     const auto spring = [](const std::string& axis) {
-        return withDevice(R"("effects": [{"type": "spring", "anchor": [0, 0, 0],
+        return test::deviceFileWith(R"("effects": [{"type": "spring", "anchor": [0, 0, 0],
                                           "stiffness_n_per_m": 100, "direction": )" +
-                          axis + "}]");
+                                    axis + "}]");
     };
     // Its squares overflow (or underflow), yet it is a direction.
     const ForceEffect huge =
@@ -238,7 +221,7 @@ TEST_CASE("a spring's direction may have any length but zero, and a zero one is 
 }
 
 TEST_CASE("an effect type with control characters is shown escaped in its message") {
-    CHECK_THAT(errorOf(withDevice(R"("effects": [{"type": "\r"}])")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("effects": [{"type": "\r"}])")),
                Catch::Contains(R"(devices[0].effects[0].type: unknown effect type '\r')"));
 }
 
@@ -249,13 +232,14 @@ TEST_CASE("a device file's first bad value is the one named, whichever module re
                                  {"name": "", "kind": "sim"}]})"),
                Catch::StartsWith("bad.json: devices[0].effects[0].type: unknown effect type"));
     // ...and within a device they come after its transform, before its tool tip and settings.
-    CHECK_THAT(errorOf(withDevice(R"("transform": {"scale": 0}, "effects": [3])")),
+    CHECK_THAT(errorOf(test::deviceFileWith(R"("transform": {"scale": 0}, "effects": [3])")),
                Catch::StartsWith("bad.json: devices[0].transform.scale:"));
+    CHECK_THAT(errorOf(test::deviceFileWith(
+                   R"("effects": [3], "tool_tip": [1, 0, 0], "sim": {"script": "dance"})")),
+               Catch::StartsWith("bad.json: devices[0].effects[0]: expected an object"));
     CHECK_THAT(
-        errorOf(withDevice(R"("effects": [3], "tool_tip": [1, 0, 0], "sim": {"script": "dance"})")),
-        Catch::StartsWith("bad.json: devices[0].effects[0]: expected an object"));
-    CHECK_THAT(errorOf(withDevice(R"("renderer": {"damping": 1}, "tool_tip": [1, 0, 0])")),
-               Catch::StartsWith("bad.json: devices[0].renderer: unknown field 'damping'"));
+        errorOf(test::deviceFileWith(R"("renderer": {"damping": 1}, "tool_tip": [1, 0, 0])")),
+        Catch::StartsWith("bad.json: devices[0].renderer: unknown field 'damping'"));
 }
 
 TEST_CASE("each device's effects and renderer settings are its own, none when it gives none") {

@@ -3,11 +3,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <ranges>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <sys/wait.h>
 #include <thread>
@@ -135,6 +139,60 @@ public:
 
 private:
     std::filesystem::path mOld;
+};
+
+/// The n-th (from 0) ```json block after the heading `section` in a user-guide page
+/// (docs/guide/<page>), so a test loads exactly what the guide shows.
+inline std::string guideJsonBlock(const std::string& page, const std::string& section, int n) {
+    const std::string text =
+        readFile(std::filesystem::path(HAPTO_SOURCE_DIR) / "docs" / "guide" / page);
+    std::size_t at = text.find(section);
+    for (int i = 0; i <= n && at != std::string::npos; ++i) {
+        at = text.find("```json\n", at);
+        at = at == std::string::npos ? at : at + 8;
+    }
+    if (at == std::string::npos) {
+        throw std::runtime_error("docs/guide/" + page + ": no json block " + std::to_string(n) +
+                                 " after '" + section + "'");
+    }
+    return text.substr(at, text.find("```", at) - at);
+}
+
+/// A device file of one valid simulated device with `extra` spliced into its object.
+inline std::string deviceFileWith(const std::string& extra) {
+    return R"({"format": "hapto-devices", "version": 1, "devices": [{"name": "a", "kind": "sim")" +
+           (extra.empty() ? "" : ", " + extra) + "}]}";
+}
+
+/// FNV-1a over 64-bit words, fed field by field: pins a structure to the hash an earlier
+/// version of the code gave.
+struct Fnv {
+    std::uint64_t h = 1469598103934665603ull; ///< The hash so far.
+    void add(std::uint64_t v) {
+        for (int i = 0; i < 8; ++i) {
+            h = (h ^ ((v >> (8 * i)) & 0xFF)) * 1099511628211ull;
+        }
+    }
+    void add(double v) {
+        std::uint64_t bits = 0;
+        std::memcpy(&bits, &v, sizeof bits);
+        add(bits);
+    }
+    /// A vector's x, y and z.
+    template <class V>
+    requires requires(const V& v) { v.x + v.y + v.z; }
+    void add(const V& v) {
+        add(double(v.x));
+        add(double(v.y));
+        add(double(v.z));
+    }
+    /// A range of integers: its size, then each.
+    template <std::ranges::sized_range R> void add(const R& values) {
+        add(std::uint64_t(std::ranges::size(values)));
+        for (const auto v : values) {
+            add(std::uint64_t(v));
+        }
+    }
 };
 
 } // namespace hapto::test
