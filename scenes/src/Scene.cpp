@@ -61,6 +61,11 @@ Scene::Scene(Aabb bounds, std::vector<SceneObject> objects)
     }
 }
 
+bool Scene::hasDynamicBodies() const {
+    return std::any_of(mObjects.begin(), mObjects.end(),
+                       [](const SceneObject& o) { return o.body.dynamic; });
+}
+
 std::optional<std::uint32_t> Scene::slotOf(ObjectId id) const {
     const auto it = std::lower_bound(mSlotById.begin(), mSlotById.end(),
                                      std::pair<ObjectId, std::uint32_t>(id, 0));

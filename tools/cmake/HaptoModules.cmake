@@ -4,11 +4,12 @@
 
 # The libraries in build order (an arrow never points back up: docs/DESIGN.md), each with the
 # ones it links directly.
-set(HAPTO_ALL_MODULES core io scenes index devices runtime experiments view)
+set(HAPTO_ALL_MODULES core io scenes index dynamics devices runtime experiments view)
 set(HAPTO_MODULE_NEEDS_core "")
 set(HAPTO_MODULE_NEEDS_io core)
 set(HAPTO_MODULE_NEEDS_scenes core io)
 set(HAPTO_MODULE_NEEDS_index core scenes)
+set(HAPTO_MODULE_NEEDS_dynamics core index scenes)
 set(HAPTO_MODULE_NEEDS_devices core io scenes)
 set(HAPTO_MODULE_NEEDS_runtime core index devices scenes)
 set(HAPTO_MODULE_NEEDS_experiments runtime index devices scenes)

@@ -27,6 +27,7 @@
 #include "hapto/core/Mailbox.h"
 #include "hapto/devices/Device.h"
 #include "hapto/devices/DeviceConfig.h"
+#include "hapto/runtime/BodyPoses.h"
 #include "hapto/runtime/DeviceMetrics.h"
 #include "hapto/runtime/Effects.h"
 #include "hapto/runtime/HapticTick.h"
@@ -68,6 +69,9 @@ struct ServoStepPorts {
     const std::atomic<std::uint64_t>* effectsPublished{}; ///< Sets published to `effects`.
     ManualClock* clock = nullptr; ///< The step mode's clock; null: CLOCK_MONOTONIC.
     std::uint64_t startNs = 0;    ///< The session's start: a recorded sample's time is from it.
+    /// The dynamic bodies' poses and the impulses handed back to them; null: the scene has no
+    /// dynamic body (or no dynamics runs).
+    BodyPoseTable* bodies = nullptr;
 };
 
 /// The parts a step shares, owned together, for a step that runs outside a Runtime (the
@@ -83,7 +87,8 @@ struct ServoStepShared {
     /// Ports to these, snapshots from `world`, time from `clock` (null: CLOCK_MONOTONIC).
     /// [control]
     ServoStepPorts portsFor(World& world, ManualClock* clock = nullptr) noexcept {
-        return {&world, &metrics, &contacts, &externalForce, &effects, &effectsPublished, clock, 0};
+        return {&world, &metrics, &contacts, &externalForce, &effects, &effectsPublished,
+                clock,  0,        nullptr};
     }
 };
 

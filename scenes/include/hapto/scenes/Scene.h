@@ -61,6 +61,21 @@ struct WorldFace {
     double offset = 0.0; ///< (m).
 };
 
+/// How the scene's dynamic bodies are simulated (scene format version 3: "gravity" and
+/// "dynamics": {"rate_hz": ...}). Ignored by a scene without dynamic bodies.
+struct ScenePhysics {
+    /// Largest |gravity| a scene may give (m/s^2): 100, ten g.
+    static constexpr double kMaxGravity = 100.0;
+    /// The dynamics step rates a scene may ask for (Hz).
+    static constexpr double kMinRateHz = 100.0, kMaxRateHz = 10'000.0;
+
+    Vec3 gravity{0.0, -9.81, 0.0}; ///< Acceleration of gravity (m/s^2, world; y is up).
+    double rateHz = 1000.0;        ///< Dynamics steps per second (Hz).
+
+    /// Every field equal.
+    bool operator==(const ScenePhysics&) const = default;
+};
+
 /// Bounds and objects. Objects are addressed by a dense 32-bit slot (their position in
 /// `objects()`) and named by their `ObjectId` in every output.
 ///
@@ -137,10 +152,17 @@ public:
     /// the 25 cm cube around the origin when there are no objects. [any thread]
     static Aabb defaultBounds(std::span<const SceneObject> objects);
 
-    /// The same objects in the same order and the same bounds.
+    /// Gravity and the dynamics rate. [any thread]
+    const ScenePhysics& physics() const { return mPhysics; }
+    /// Sets gravity and the dynamics rate (unchecked: the scene file's reader checks). [control]
+    void setPhysics(const ScenePhysics& physics) { mPhysics = physics; }
+    /// True when some object is dynamic (BodyProperties::dynamic). [any thread]
+    bool hasDynamicBodies() const;
+
+    /// The same objects in the same order, the same bounds and the same physics.
     bool operator==(const Scene& o) const {
         return mObjects == o.mObjects && mBounds.min == o.mBounds.min &&
-               mBounds.max == o.mBounds.max;
+               mBounds.max == o.mBounds.max && mPhysics == o.mPhysics;
     }
 
 private:
@@ -151,6 +173,7 @@ private:
     };
 
     Aabb mBounds;
+    ScenePhysics mPhysics;
     std::vector<SceneObject> mObjects;
     std::vector<RenderBody> mBodies; // by slot: the render copy
     std::vector<MeshRange> mMeshes;  // by firstTriangle, ascending

@@ -2,6 +2,7 @@
 /// One rigid object of a scene: an oriented box, a sphere or a triangle mesh, with an id and a
 /// material.
 
+#include "hapto/core/ConvexHull.h"
 #include "hapto/core/Geometry.h"
 #include "hapto/scenes/TriangleMesh.h"
 
@@ -43,6 +44,29 @@ struct Material {
     bool operator==(const Material&) const = default;
 };
 
+/// What makes an object a rigid body with mass (scene format version 3). A static object (the
+/// default) has none of it: it never moves unless the application moves it.
+///
+/// The body's reference point is its centre of mass: `centerOfMassLocal` places it in the
+/// object's own frame (a box's and a sphere's is 0; a mesh's is its volume centroid), and its
+/// inertia is about that point, in the object's own axes.
+struct BodyProperties {
+    bool dynamic = false;        ///< Simulated by the dynamics thread (scene key "dynamic").
+    double massKg = 0.0;         ///< Mass (kg), > 0 when dynamic.
+    Mat3 inertia{0.0};           ///< Inertia tensor about the centre of mass, own axes
+                                 ///< (kg m^2): symmetric positive definite when dynamic.
+    Vec3 centerOfMassLocal{0.0}; ///< Centre of mass in the object's own frame (m).
+    double restitution = 0.0;    ///< Coefficient of restitution e in [0, 1] (pair: the larger).
+    Vec3 velocity{0.0};          ///< Initial linear velocity of the centre of mass (m/s, world).
+    Vec3 angularVelocity{0.0};   ///< Initial angular velocity (rad/s, world).
+    /// A dynamic mesh's convex hull (own frame): what it collides as. Null for a box, a
+    /// sphere or a static object.
+    std::shared_ptr<const ConvexHull> hull;
+
+    /// Every field equal.
+    bool operator==(const BodyProperties&) const = default;
+};
+
 /// An oriented box, a sphere or a triangle mesh, in world coordinates (m).
 ///
 /// A mesh is placed like a box: a world point x of the mesh is center + rotation * v for a
@@ -57,6 +81,7 @@ struct SceneObject {
     Quat rotation{1, 0, 0, 0}; ///< Orientation, unit quaternion (w, x, y, z).
     Material material{};       ///< Stiffness and friction.
     std::shared_ptr<const TriangleMesh> mesh; ///< Mesh only: its triangles, local frame.
+    BodyProperties body{}; ///< Mass and initial motion; `body.dynamic` false: a static object.
 
     /// Sphere radius (m); for a box, the radius of its bounding sphere; for a mesh, of its
     /// bounding sphere about `center`. [any thread]
