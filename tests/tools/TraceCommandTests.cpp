@@ -23,6 +23,17 @@ void writeSmallTrace(const std::filesystem::path& p) {
         s.ioNs = 678;
         s.status = t == 2 ? DeviceStatus::Stalled : DeviceStatus::Ok;
         s.buttons = 1;
+        // Version 2's fields, each a different number so a swapped column shows; a field
+        // without its flag is stored as its default (identity orientation, zero spin).
+        s.proxyM = Vec3(0.5, -0.125, 0.0);
+        s.velocityMps = Vec3(0.25, 0.0, -2.0);
+        s.orientation = Quat(0.0, 1.0, 0.0, 0.0);
+        s.angularVelocity = Vec3(3.0, -4.0, 0.75);
+        s.contactCount = static_cast<std::uint32_t>(t);
+        s.hasVelocity = true;
+        s.hasOrientation = t != 0;
+        s.hasAngularVelocity = t == 2;
+        s.missedDeadline = t == 1;
         rec.push(s);
     }
     rec.close();
@@ -30,7 +41,7 @@ void writeSmallTrace(const std::filesystem::path& p) {
 
 } // namespace
 
-TEST_CASE("hapto trace export writes one CSV row per sample") {
+TEST_CASE("hapto trace export writes one CSV row per sample, every column of version 2") {
     test::TempDir dir;
     writeSmallTrace(dir / "left.trace");
     const auto r = test::runHapto("trace export " + (dir / "left.trace").string() + " -o " +
@@ -38,10 +49,29 @@ TEST_CASE("hapto trace export writes one CSV row per sample") {
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
     CHECK(test::readFile(dir / "left.csv") ==
-          "tick,time_ns,x_m,y_m,z_m,fx_n,fy_n,fz_n,compute_ns,io_ns,status,buttons\n"
-          "100,0,0,-0.25,1e-07,0,1.5,0,12345,678,ok,1\n"
-          "101,1000000,0.1,-0.25,1e-07,0,1.5,0,12345,678,ok,1\n"
-          "102,2000000,0.2,-0.25,1e-07,0,1.5,0,12345,678,stalled,1\n");
+          "tick,time_ns,x_m,y_m,z_m,fx_n,fy_n,fz_n,compute_ns,io_ns,status,buttons,"
+          "proxy_x_m,proxy_y_m,proxy_z_m,vx_mps,vy_mps,vz_mps,qw,qx,qy,qz,"
+          "wx_radps,wy_radps,wz_radps,contacts,"
+          "has_velocity,has_orientation,has_angular_velocity,missed_deadline\n"
+          "100,0,0,-0.25,1e-07,0,1.5,0,12345,678,ok,1,"
+          "0.5,-0.125,0,0.25,0,-2,1,0,0,0,0,0,0,0,1,0,0,0\n"
+          "101,1000000,0.1,-0.25,1e-07,0,1.5,0,12345,678,ok,1,"
+          "0.5,-0.125,0,0.25,0,-2,0,1,0,0,0,0,0,1,1,1,0,1\n"
+          "102,2000000,0.2,-0.25,1e-07,0,1.5,0,12345,678,stalled,1,"
+          "0.5,-0.125,0,0.25,0,-2,0,1,0,0,3,-4,0.75,2,1,1,1,0\n");
+}
+
+TEST_CASE("hapto trace export writes a version 1 trace's columns, no more") {
+    // Written by the version 1 recorder (a fuzz corpus entry): three ticks of "left" (sim).
+    const std::filesystem::path v1 =
+        std::filesystem::path(HAPTO_SOURCE_DIR) / "tools/fuzz/corpus/trace_file/three-ticks.trace";
+    const auto r = test::runHapto("trace export " + v1.string());
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(r.output == "tick,time_ns,x_m,y_m,z_m,fx_n,fy_n,fz_n,compute_ns,io_ns,status,buttons\n"
+                      "0,0,0,0,-0.02,0,1,0,3000,500,ok,1\n"
+                      "1,1000000,0.01,0,-0.02,0,1,0,3000,500,ok,1\n"
+                      "2,2000000,0.02,0,-0.02,0,1,0,3000,500,ok,1\n");
 }
 
 TEST_CASE("hapto trace export writes to standard output without -o") {

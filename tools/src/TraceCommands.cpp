@@ -3,6 +3,7 @@
 #include "Commands.h"
 #include "Options.h"
 
+#include "hapto/devices/TraceColumns.h"
 #include "hapto/devices/TraceReader.h"
 #include "hapto/experiments/Plot.h"
 #include "hapto/io/InputError.h"
@@ -18,13 +19,9 @@
 namespace hapto::cli {
 namespace {
 
-void appendNumber(std::string& out, double v) {
-    char buf[32];
-    const auto res = std::to_chars(buf, buf + sizeof buf, v);
-    out.append(buf, res.ptr);
-}
-
-// Writes the CSV: one header row, one row per sample; numbers round-trip exactly.
+// Writes the CSV: one header row (the columns of the trace's version, TraceColumns.h), one row
+// per sample; numbers round-trip exactly. Another kind of trace gets its own writer beside this
+// one, dispatched in the export command's callback.
 void exportCsv(const std::string& tracePath, const std::string& outPath) {
     const bool toFile = !outPath.empty() && outPath != "-";
     if (toFile) {
@@ -32,32 +29,14 @@ void exportCsv(const std::string& tracePath, const std::string& outPath) {
         checkOutputFile(outPath, "-o");
     }
     TraceReader reader(tracePath);
+    const std::uint32_t version = reader.header().version;
     TextOutput csv(toFile ? outPath : std::string());
     std::string& out = csv.text();
-    out = "tick,time_ns,x_m,y_m,z_m,fx_n,fy_n,fz_n,compute_ns,io_ns,status,buttons\n";
+    out = traceCsvHeader(version);
     TraceSample s;
     std::uint64_t rows = 0;
     while (reader.next(s)) {
-        out += std::to_string(s.tick);
-        out += ',';
-        out += std::to_string(s.timeNs);
-        for (int i = 0; i < 3; ++i) {
-            out += ',';
-            appendNumber(out, s.positionM[i]);
-        }
-        for (int i = 0; i < 3; ++i) {
-            out += ',';
-            appendNumber(out, s.forceN[i]);
-        }
-        out += ',';
-        out += std::to_string(s.computeNs);
-        out += ',';
-        out += std::to_string(s.ioNs);
-        out += ',';
-        out += statusName(s.status);
-        out += ',';
-        out += std::to_string(s.buttons);
-        out += '\n';
+        appendTraceCsvRow(s, version, out);
         ++rows;
         csv.afterRow();
     }
@@ -262,8 +241,11 @@ void addTraceCommands(CLI::App& app) {
                         "hapto trace plot traces/*.trace -o traces.png"});
     {
         auto* cmd = trace->add_subcommand(
-            "export", "Write a trace as CSV: tick, time_ns, position (m, device frame), force "
-                      "(N), compute_ns, io_ns, status, buttons");
+            "export",
+            "Write a trace as CSV, every column it holds: tick, time_ns, position (m, device "
+            "frame), force (N), compute_ns, io_ns, status, buttons; version 2 traces also the "
+            "proxy (m), velocity (m/s), orientation (quaternion), angular velocity (rad/s), "
+            "contact count and the sample flags (0/1)");
         auto path = std::make_shared<std::string>();
         auto out = std::make_shared<std::string>();
         cmd->add_option("trace", *path, "The trace file")->required();
