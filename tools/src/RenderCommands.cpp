@@ -2,20 +2,20 @@
 // tick every servo thread and the runtime's step mode run), one CSV line per tick. How a user
 // checks what a scene feels like, and how tests pin the renderer's behaviour.
 //
-// The point is the device point in the world frame: no device, no transform, no threads, no
-// clock. Each line's force is the renderer's, before the force effects and the safety filter
-// (what the scene asks for; a device gets it clamped and rate-limited). Numbers are written as
-// the shortest decimal that reads back as the same double (std::to_chars), with -0 written 0:
-// nothing is lost, and the same input gives the same bytes.
+// The ticks are experiments::renderPath's (RenderPath.h: the point in the world frame, no
+// device, the renderer's force before effects and safety), the same that Python's
+// hapto.render returns; this file only checks the arguments and writes the CSV. Numbers are
+// written as the shortest decimal that reads back as the same double (std::to_chars), with -0
+// written 0: nothing is lost, and the same input gives the same bytes.
 
 #include "Commands.h"
 #include "Options.h"
 
+#include "hapto/experiments/RenderPath.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/io/InputError.h"
 #include "hapto/io/OutputFile.h"
-#include "hapto/runtime/HapticTick.h"
 #include "hapto/runtime/World.h"
 
 #include <charconv>
@@ -77,21 +77,21 @@ void runRender(const RenderArgs& a) {
 
     TextOutput out(a.output);
     std::string& text = out.text();
-    text = "tick,x,y,z,proxy_x,proxy_y,proxy_z,fx,fy,fz,contacts\n";
-    HapticTick tick;
-    const double dtS = 1.0 / a.rateHz;
-    Vec3 last = path.front();
-    for (std::size_t i = 0; i < path.size(); ++i) {
-        const Vec3& p = path[i];
-        const Vec3 velocity = (p - last) / dtS; // as a servo estimates it for a device without one
-        last = p;
-        const TickOutput t = tick.tick(snapshot, p, velocity, dtS, Vec3(0.0));
+    for (const std::string_view column : experiments::renderPathColumns()) {
+        text += text.empty() ? "" : ",";
+        text += column;
+    }
+    text += '\n';
+    const std::vector<experiments::PathTick> ticks =
+        experiments::renderPath(snapshot, path, a.rateHz);
+    for (std::size_t i = 0; i < ticks.size(); ++i) {
+        const experiments::PathTick& t = ticks[i];
         text += std::to_string(i);
-        appendVec(text, p);
-        appendVec(text, t.render.proxy);
-        appendVec(text, t.render.force);
+        appendVec(text, t.pointM);
+        appendVec(text, t.proxyM);
+        appendVec(text, t.forceN);
         text += ',';
-        text += std::to_string(t.render.contactCount);
+        text += std::to_string(t.contacts);
         text += '\n';
         out.afterRow();
     }
