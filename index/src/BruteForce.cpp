@@ -45,4 +45,9 @@ Aabb BruteForce::leafBounds(std::uint32_t) const noexcept {
     return bounds();
 }
 
+bool BruteForce::visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept {
+    // Every item is a candidate everywhere, inside the bounds or not (as locate says).
+    return !isQueryBox(box) || visit(context, 0);
+}
+
 } // namespace hapto

@@ -76,6 +76,34 @@ Aabb Octree::nodeBounds(std::uint32_t node) const noexcept {
     return b;
 }
 
+bool Octree::visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept {
+    if (!isQueryBox(box) || !box.overlaps(bounds()) || mNodes.empty()) {
+        return true;
+    }
+    // Depth-first: a node on the stack overlaps the box; an inner node pushes its overlapping
+    // children (at most 8 per level below the root, so 8 * kMaxDepth + 1 entries suffice).
+    std::array<std::uint32_t, 8 * kMaxDepth + 1> stack;
+    std::size_t top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const std::uint32_t node = stack[--top];
+        const OctreeNode& n = mNodes[node];
+        if (n.isLeaf()) {
+            if (!visit(context, node)) {
+                return false;
+            }
+            continue;
+        }
+        for (std::uint32_t octant = 8; octant-- > 0;) { // pushed 7..0: visited 0..7
+            const std::uint32_t child = n.firstChild() + octant;
+            if (nodeBounds(child).overlaps(box)) {
+                stack[top++] = child;
+            }
+        }
+    }
+    return true;
+}
+
 bool Octree::holds(std::uint32_t node, const Vec3& p) const noexcept {
     const OctreeNode& n = mNodes[node];
     const int l = n.level();

@@ -30,6 +30,10 @@ bool SpatialIndex::inBounds(const Vec3& p) const noexcept {
            p.y <= mBounds.max.y && p.z >= mBounds.min.z && p.z <= mBounds.max.z;
 }
 
+bool SpatialIndex::reachesOutside(const Aabb& box) const noexcept {
+    return isQueryBox(box) && !(inBounds(box.min) && inBounds(box.max));
+}
+
 Aabb partitionBounds(const Aabb& sceneBounds) {
     Aabb b = sceneBounds;
     for (int a = 0; a < 3; ++a) {

@@ -292,4 +292,27 @@ Aabb UniformGrid::leafBounds(std::uint32_t cell) const noexcept {
             {coord(x + 1, 0), coord(y + 1, 1), coord(z + 1, 2)}};
 }
 
+bool UniformGrid::visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept {
+    if (!isQueryBox(box) || !box.overlaps(bounds())) {
+        return true;
+    }
+    // cellIndex clamps into 0..n-1 and settles on the cell boxes' own formula.
+    std::uint32_t lo[3];
+    std::uint32_t hi[3];
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = cellIndex(box.min[a], a);
+        hi[a] = cellIndex(box.max[a], a);
+    }
+    for (std::uint32_t z = lo[2]; z <= hi[2]; ++z) {
+        for (std::uint32_t y = lo[1]; y <= hi[1]; ++y) {
+            for (std::uint32_t x = lo[0]; x <= hi[0]; ++x) {
+                if (!visit(context, cellId(x, y, z))) {
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
 } // namespace hapto

@@ -23,6 +23,8 @@ public:
     std::span<const std::uint32_t> leafObjects(std::uint32_t leaf) const noexcept override;
     /// The bounds (leaf 0). [servo]
     Aabb leafBounds(std::uint32_t leaf) const noexcept override;
+    /// Its one leaf, for any non-empty box. [servo]
+    bool visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept override;
 
 private:
     BruteForce(const IndexSpec& spec, const Scene& scene, std::vector<std::uint32_t> items);

@@ -99,6 +99,9 @@ public:
     std::span<const std::uint32_t> leafObjects(std::uint32_t node) const noexcept override;
     /// The closed box of any node (m). [servo]
     Aabb leafBounds(std::uint32_t node) const noexcept override { return nodeBounds(node); }
+    /// Every leaf whose closed box overlaps `box`, depth-first from the root with a fixed-size
+    /// stack (the depth is bounded by kMaxDepth). [servo]
+    bool visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept override;
 
     /// The closed box of a node (m). [any thread]
     Aabb nodeBounds(std::uint32_t node) const noexcept;

@@ -84,6 +84,26 @@ public:
     /// ties on shared faces going to the upper leaf. [servo]
     virtual Aabb leafBounds(std::uint32_t leaf) const noexcept = 0;
 
+    /// Called by visitLeaves with the caller's context and a leaf; returns false to stop.
+    using LeafVisitor = bool (*)(void* context, std::uint32_t leaf);
+    /// The box query (the dynamics' broad phase): calls `visit` once for every leaf whose
+    /// closed box overlaps the closed `box` (m), so every item whose shape reaches into the
+    /// part of `box` inside the bounds is among those leaves' leafObjects() (an item may come
+    /// in several leaves: callers that need each once deduplicate). The part outside the
+    /// bounds is answered by outsideObjects() when reachesOutside(box). Octree: depth-first
+    /// from the root with a fixed stack; grid: the cell range, x fastest; brute force: its one
+    /// leaf for any non-empty box. Returns false when `visit` stopped the walk. An empty or
+    /// NaN box visits nothing. Allocates nothing. [servo]
+    virtual bool visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept = 0;
+    /// The same with a callable `bool f(std::uint32_t leaf)` (return false to stop). [servo]
+    template <class F> bool visitLeavesWith(const Aabb& box, F& f) const noexcept {
+        return visitLeaves(
+            box, [](void* c, std::uint32_t leaf) { return (*static_cast<F*>(c))(leaf); }, &f);
+    }
+    /// True when the closed `box` reaches outside the closed bounds: the items found there
+    /// are outsideObjects(). False for an empty or NaN box. [servo]
+    bool reachesOutside(const Aabb& box) const noexcept;
+
 protected:
     /// Sets the spec, the bounds and the item count. [control]
     SpatialIndex(const IndexSpec& spec, const Aabb& bounds, std::uint32_t itemCount);
@@ -91,6 +111,10 @@ protected:
     /// Fills outsideObjects() from the scene's indexed items (ascending), after the bounds
     /// are final. [control]
     void recordOutsideObjects(const Scene& scene, std::span<const std::uint32_t> items);
+    /// True when min <= max on every axis (false for an empty box or a NaN). [servo]
+    static bool isQueryBox(const Aabb& box) noexcept {
+        return box.min.x <= box.max.x && box.min.y <= box.max.y && box.min.z <= box.max.z;
+    }
     /// The answer for a point outside the bounds: outsideObjects(), no leaf. [servo]
     LocateResult outsideResult() const noexcept { return {mOutside, kNoLeaf, 0, true}; }
 

@@ -27,6 +27,8 @@ public:
     std::span<const std::uint32_t> leafObjects(std::uint32_t cell) const noexcept override;
     /// The closed box of a cell (m). [servo]
     Aabb leafBounds(std::uint32_t cell) const noexcept override;
+    /// Every cell of the range `box` covers inside the bounds, x fastest. [servo]
+    bool visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept override;
 
     /// n, cells per side. [any thread]
     int cellsPerSide() const noexcept { return mN; }
