@@ -9,6 +9,7 @@
 
 #include "hapto/io/InputError.h"
 #include "hapto/io/JsonInput.h"
+#include "hapto/scenes/SceneFile.h"
 
 #include "SceneFileChecks.h"
 
@@ -318,6 +319,11 @@ Scene parseBinaryScene(std::string_view bytes, std::string_view sourceName,
 }
 
 void writeBinaryScene(const Scene& scene, std::ostream& os) {
+    if (sceneFormatVersionOf(scene) >= 3) {
+        throw InputError("the scene has dynamic bodies, restitution or non-default physics (scene "
+                         "format version 3), which the binary format does not carry: write it "
+                         "as JSON (-o F.json)");
+    }
     std::string out;
     out.reserve(1 << 21);
     const auto flush = [&] {

@@ -234,6 +234,11 @@ struct LoadContext {
     std::vector<Vec3> vertices;
     std::vector<TriangleIndices> triangles;
     std::optional<std::tuple<std::size_t, std::size_t, std::int64_t>> farIndex;
+    /// The place of the object being read in "objects", and the first object that gave a
+    /// version-3 field (its place and the field's key), for the version check when "version"
+    /// follows "objects".
+    std::size_t objectIndex = 0;
+    std::optional<std::pair<std::size_t, const char*>> firstBodyField;
     static constexpr std::uint32_t kFarIndex = 0xFFFFFFFFu; // > TriangleMesh::kMaxVertices
 
     void startObject() {
@@ -329,6 +334,72 @@ std::shared_ptr<const TriangleMesh> parseFileMesh(const Source& w, const Json& j
     }
 }
 
+/// "inertia": 3 principal moments [Ixx, Iyy, Izz] or a 3x3 tensor [[...], [...], [...]] (kg m^2).
+void readInertia(const Source& w, const Json& j, const Path& path, BodyFields& f) {
+    const char* expected = "expected 3 principal moments [Ixx, Iyy, Izz] or a 3x3 tensor "
+                           "[[Ixx, Ixy, Ixz], [Iyx, Iyy, Iyz], [Izx, Izy, Izz]] (kg m^2), got ";
+    if (!j.is_array() || j.size() != 3) {
+        w.fail(path,
+               expected + (j.is_array() ? "an array of " + std::to_string(j.size()) : typeName(j)));
+    }
+    std::array<double, 9> m{};
+    f.inertiaPrincipal = !j[0].is_array();
+    for (std::size_t r = 0; r < 3; ++r) {
+        if (j[r].is_array() == f.inertiaPrincipal) {
+            w.fail(path[r], std::string(expected) + "a mix of numbers and arrays");
+        }
+        if (f.inertiaPrincipal) {
+            m[r * 3 + r] = number(w, j[r], path[r]);
+        } else {
+            const auto row = numbers<3>(w, j[r], path[r]);
+            std::copy(row.begin(), row.end(), m.begin() + static_cast<std::ptrdiff_t>(r * 3));
+        }
+    }
+    f.inertia = m;
+}
+
+/// An object's version-3 fields, read but not checked (applyBodyFields checks them).
+BodyFields readBodyFields(const Source& w, const Json& j, const Path& path) {
+    BodyFields f;
+    if (const Json* v = optional(j, "dynamic")) {
+        f.dynamic = boolean(w, *v, path / "dynamic");
+    }
+    if (const Json* v = optional(j, "mass_kg")) {
+        f.massKg = number(w, *v, path / "mass_kg");
+    }
+    if (const Json* v = optional(j, "density_kg_per_m3")) {
+        f.densityKgPerM3 = number(w, *v, path / "density_kg_per_m3");
+    }
+    if (const Json* v = optional(j, "inertia")) {
+        readInertia(w, *v, path / "inertia", f);
+    }
+    if (const Json* v = optional(j, "restitution")) {
+        f.restitution = number(w, *v, path / "restitution");
+    }
+    if (const Json* v = optional(j, "velocity")) {
+        f.velocity = vec3(w, *v, path / "velocity");
+    }
+    if (const Json* v = optional(j, "angular_velocity")) {
+        f.angularVelocity = vec3(w, *v, path / "angular_velocity");
+    }
+    return f;
+}
+
+/// Refuses version-3 fields in a file known to be older; remembers the first when the version
+/// is not known yet (checkTopLevel refuses it then).
+void gateBodyFields(const Source& w, const BodyFields& f, const Path& path, LoadContext& c) {
+    const char* key = f.firstKey();
+    if (!key) {
+        return;
+    }
+    if (c.version == 1 || c.version == 2) {
+        refuseBeforeVersion3(w, path / key, key);
+    }
+    if (!c.firstBodyField) {
+        c.firstBodyField.emplace(c.objectIndex, key);
+    }
+}
+
 void refuseMeshInVersion1(const Source& w, const Path& shapePath) {
     w.fail(shapePath, "\"mesh\" needs \"version\": 2 (version 1 has boxes and spheres only)");
 }
@@ -351,7 +422,9 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
     if (shapeText == "box") {
         o.shape = Shape::Box;
         checkKeys(w, j, path,
-                  {"id", "shape", "center", "half_extents", "rotation", "stiffness", "friction"});
+                  {"id", "shape", "center", "half_extents", "rotation", "stiffness", "friction",
+                   "dynamic", "mass_kg", "density_kg_per_m3", "inertia", "restitution", "velocity",
+                   "angular_velocity"});
         const Path he = path / "half_extents";
         o.halfExtents = vec3(w, required(w, j, path, "half_extents"), he);
         for (std::size_t i = 0; i < 3; ++i) {
@@ -360,7 +433,9 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
     } else if (shapeText == "sphere") {
         o.shape = Shape::Sphere;
         checkKeys(w, j, path,
-                  {"id", "shape", "center", "radius", "rotation", "stiffness", "friction"});
+                  {"id", "shape", "center", "radius", "rotation", "stiffness", "friction",
+                   "dynamic", "mass_kg", "density_kg_per_m3", "inertia", "restitution", "velocity",
+                   "angular_velocity"});
         const Path rp = path / "radius";
         o.halfExtents = Vec3(checkRadius(w, number(w, required(w, j, path, "radius"), rp), rp));
     } else if (shapeText == "mesh") {
@@ -370,7 +445,8 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
         o.shape = Shape::Mesh;
         checkKeys(w, j, path,
                   {"id", "shape", "center", "rotation", "scale", "file", "vertices", "triangles",
-                   "stiffness", "friction"});
+                   "stiffness", "friction", "dynamic", "mass_kg", "density_kg_per_m3", "inertia",
+                   "restitution", "velocity", "angular_velocity"});
         double scale = 1.0;
         if (const Json* v = optional(j, "scale")) {
             scale = checkMeshScale(w, number(w, *v, path / "scale"), path / "scale");
@@ -406,6 +482,9 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
         o.material.staticFriction = f[0];
         o.material.dynamicFriction = f[1];
     }
+    const BodyFields body = readBodyFields(w, j, path);
+    gateBodyFields(w, body, path, context);
+    applyBodyFields(w, o, body, path);
     return o;
 }
 
@@ -573,6 +652,7 @@ private:
             return false;
         }
         if (mInObjects && depth == 2) {
+            mContext.objectIndex = mObjects.size();
             mObjects.push_back(parseObject(mW, parsed, mObjectsPath[mObjects.size()], mContext));
             return false;
         }
@@ -596,13 +676,13 @@ private:
 /// version 1 file: "version" may follow "objects", so meshes read before it are refused here)
 /// and "objects" as an array.
 void checkTopLevel(const Source& w, const Json& root, const std::vector<SceneObject>& objects,
-                   const Path& objectsPath) {
+                   const Path& objectsPath, const LoadContext& context) {
     const Path top;
     if (!root.is_object()) {
         w.fail(top,
                "expected a JSON object with \"format\": \"hapto-scene\", got " + typeName(root));
     }
-    checkKeys(w, root, top, {"format", "version", "bounds", "objects"});
+    checkKeys(w, root, top, {"format", "version", "bounds", "objects", "gravity", "dynamics"});
     const Json& format = required(w, root, top, "format");
     if (!format.is_string() || format.get<std::string>() != "hapto-scene") {
         w.fail(top / "format", "expected \"hapto-scene\", got " + describe(format));
@@ -621,6 +701,17 @@ void checkTopLevel(const Source& w, const Json& root, const std::vector<SceneObj
             }
         }
     }
+    if (version.get<std::int64_t>() < 3) {
+        if (context.firstBodyField) {
+            const auto [i, key] = *context.firstBodyField;
+            refuseBeforeVersion3(w, objectsPath[i] / key, key);
+        }
+        for (const char* key : kPhysicsKeys) {
+            if (optional(root, key)) {
+                refuseBeforeVersion3(w, top / key, key);
+            }
+        }
+    }
     const Json* objectsJson = optional(root, "objects");
     if (!objectsJson) {
         w.fail(top, "missing required field 'objects' (an array, possibly empty)");
@@ -628,6 +719,25 @@ void checkTopLevel(const Source& w, const Json& root, const std::vector<SceneObj
     if (!objectsJson->is_array()) {
         w.fail(objectsPath, "expected an array, got " + typeName(*objectsJson));
     }
+}
+
+/// The top level's "gravity" and "dynamics" (version 3), checked.
+ScenePhysics parsePhysics(const Source& w, const Json& root) {
+    const Path top;
+    std::optional<Vec3> gravity;
+    std::optional<double> rateHz;
+    if (const Json* g = optional(root, "gravity")) {
+        gravity = vec3(w, *g, top / "gravity");
+    }
+    if (const Json* d = optional(root, "dynamics")) {
+        const Path dp = top / "dynamics";
+        object(w, *d, dp);
+        checkKeys(w, *d, dp, {"rate_hz"});
+        if (const Json* r = optional(*d, "rate_hz")) {
+            rateHz = number(w, *r, dp / "rate_hz");
+        }
+    }
+    return checkPhysics(w, gravity, rateHz, top);
 }
 
 } // namespace
@@ -646,14 +756,17 @@ Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
         parseText(text, w, [&stream](int depth, Json::parse_event_t event, Json& parsed) {
             return stream.event(depth, event, parsed);
         });
-    checkTopLevel(w, root, objects, objectsPath);
+    checkTopLevel(w, root, objects, objectsPath, context);
     checkUniqueIds(w, objects, objectsPath);
     const Json* boundsJson = optional(root, "bounds");
     std::optional<Aabb> bounds;
     if (boundsJson) {
         bounds = parseBounds(w, *boundsJson, top / "bounds");
     }
-    return finishScene(w, std::move(objects), bounds, objectsPath);
+    const ScenePhysics physics = parsePhysics(w, root);
+    Scene scene = finishScene(w, std::move(objects), bounds, objectsPath);
+    scene.setPhysics(physics);
+    return scene;
 }
 
 namespace {
@@ -714,6 +827,41 @@ Scene parseScene(std::string_view text, std::string_view sourceName,
 
 namespace {
 
+/// The scene's "gravity" and "dynamics" (version 3: always both, explicit).
+void appendPhysics(std::string& out, const ScenePhysics& physics) {
+    out += ",\n \"gravity\": ";
+    appendVec(out, &physics.gravity.x, 3);
+    out += ", \"dynamics\": {\"rate_hz\": ";
+    appendNumber(out, physics.rateHz);
+    out += '}';
+}
+
+/// An object's version-3 fields: a restitution other than 0; a dynamic body's mass, full
+/// inertia tensor (rows) and velocities. Nothing for a static object without restitution.
+void appendBody(std::string& out, const BodyProperties& b) {
+    if (b.dynamic) {
+        out += ", \"dynamic\": true, \"mass_kg\": ";
+        appendNumber(out, b.massKg);
+        out += ", \"inertia\": [";
+        for (int r = 0; r < 3; ++r) {
+            const double row[3] = {b.inertia[0][r], b.inertia[1][r], b.inertia[2][r]};
+            out += r ? ", " : "";
+            appendVec(out, row, 3);
+        }
+        out += ']';
+    }
+    if (b.restitution != 0.0 || b.dynamic) {
+        out += ", \"restitution\": ";
+        appendNumber(out, b.restitution);
+    }
+    if (b.dynamic) {
+        out += ", \"velocity\": ";
+        appendVec(out, &b.velocity.x, 3);
+        out += ", \"angular_velocity\": ";
+        appendVec(out, &b.angularVelocity.x, 3);
+    }
+}
+
 // Streams the JSON in chunks of about a megabyte, so 10^7 objects never sit in one string.
 void writeSceneJson(const Scene& scene, std::ostream& os) {
     std::string out;
@@ -722,11 +870,13 @@ void writeSceneJson(const Scene& scene, std::ostream& os) {
         os.write(out.data(), static_cast<std::streamsize>(out.size()));
         out.clear();
     };
-    // A scene without meshes is written as version 1, byte for byte as before version 2 (a
-    // mesh has at least one triangle, so triangleCount() tells).
+    // A scene without meshes is written as version 1, byte for byte as before version 2.
+    const int version = sceneFormatVersionOf(scene);
     out += "{\"format\": \"hapto-scene\", \"version\": ";
-    out += std::to_string(scene.triangleCount() > 0 ? kSceneFormatVersion
-                                                    : kSceneFormatVersionWithoutMeshes);
+    out += std::to_string(version);
+    if (version >= 3) {
+        appendPhysics(out, scene.physics());
+    }
     out += ",\n \"bounds\": {\"min\": ";
     appendVec(out, &scene.bounds().min.x, 3);
     out += ", \"max\": ";
@@ -770,6 +920,7 @@ void writeSceneJson(const Scene& scene, std::ostream& os) {
         const double f[2] = {o.material.staticFriction, o.material.dynamicFriction};
         out += ", \"friction\": ";
         appendVec(out, f, 2);
+        appendBody(out, o.body);
         out += '}';
         if (out.size() > (1u << 20)) {
             flush();
@@ -780,6 +931,19 @@ void writeSceneJson(const Scene& scene, std::ostream& os) {
 }
 
 } // namespace
+
+int sceneFormatVersionOf(const Scene& scene) {
+    const auto objects = scene.objects();
+    const bool bodies = std::any_of(objects.begin(), objects.end(), [](const SceneObject& o) {
+        return o.body.dynamic || o.body.restitution != 0.0;
+    });
+    if (bodies || scene.physics() != ScenePhysics{}) {
+        return kSceneFormatVersion;
+    }
+    // A mesh has at least one triangle, so triangleCount() tells.
+    return scene.triangleCount() > 0 ? kSceneFormatVersionWithMeshes
+                                     : kSceneFormatVersionWithoutMeshes;
+}
 
 std::string sceneToJson(const Scene& scene) {
     std::ostringstream os;

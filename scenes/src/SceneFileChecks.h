@@ -7,6 +7,7 @@
 #include "hapto/io/JsonInput.h"
 #include "hapto/scenes/Scene.h"
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -45,6 +46,42 @@ void checkUniqueIds(const json::Source& s, std::span<const SceneObject> objects,
 /// the objects.
 Scene finishScene(const json::Source& s, std::vector<SceneObject> objects,
                   const std::optional<Aabb>& bounds, const json::Path& objectsPath);
+
+/// The version-3 fields of one object, as a file gave them (each value already read as a
+/// finite number), before any check.
+struct BodyFields {
+    std::optional<bool> dynamic;                  ///< "dynamic"
+    std::optional<double> massKg;                 ///< "mass_kg"
+    std::optional<double> densityKgPerM3;         ///< "density_kg_per_m3"
+    std::optional<std::array<double, 9>> inertia; ///< "inertia", row-major 3x3
+    bool inertiaPrincipal = false;                ///< "inertia" was 3 principal moments
+    std::optional<double> restitution;            ///< "restitution"
+    std::optional<Vec3> velocity;                 ///< "velocity" (m/s)
+    std::optional<Vec3> angularVelocity;          ///< "angular_velocity" (rad/s)
+
+    /// The first field given, in kBodyKeys' order, or nullptr when none is.
+    const char* firstKey() const;
+};
+/// An object's version-3 keys, in the order the writer writes them.
+inline constexpr std::array<const char*, 7> kBodyKeys = {
+    "dynamic",     "mass_kg",  "density_kg_per_m3", "inertia",
+    "restitution", "velocity", "angular_velocity"};
+/// The scene's version-3 top-level keys.
+inline constexpr std::array<const char*, 2> kPhysicsKeys = {"gravity", "dynamics"};
+/// Refuses a version-3 field (`fieldPath`, named `key`) in a file of an older version.
+[[noreturn]] void refuseBeforeVersion3(const json::Source& s, const json::Path& fieldPath,
+                                       const char* key);
+/// Checks an object's version-3 fields and applies them to `o` (its shape, size and mesh
+/// already read): mass or density (exactly one, dynamic only), inertia (3 positive principal
+/// moments or a symmetric positive definite 3x3, either obeying the triangle inequality),
+/// restitution in [0, 1], velocities within BodyProperties' limits; then the mass properties
+/// (MassProperties.h) and a mesh's hull.
+void applyBodyFields(const json::Source& s, SceneObject& o, const BodyFields& f,
+                     const json::Path& path);
+/// The scene's physics from its "gravity" (|g| <= ScenePhysics::kMaxGravity) and
+/// "dynamics"."rate_hz" (kMinRateHz..kMaxRateHz), defaults where not given; `top` is the root.
+ScenePhysics checkPhysics(const json::Source& s, const std::optional<Vec3>& gravity,
+                          const std::optional<double>& rateHz, const json::Path& top);
 
 /// An inline mesh at `path` from its vertices (before `scale`) and triangles: every scaled
 /// vertex finite, every index in range (an index equal to `farMark` is reported as `farValue`

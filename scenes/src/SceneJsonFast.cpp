@@ -9,6 +9,10 @@
 // path. So a valid box-and-sphere scene is read once at simdjson's speed, and every refusal is
 // the checked loader's, word for word; the cost of a bad file is a second parse.
 //
+// Version 3's fields (dynamic bodies, "gravity", "dynamics") are read here too and checked by the
+// same applyBodyFields and checkPhysics; one in a file of an older version is not vouched for
+// (the checked loader refuses it).
+//
 // Numbers are read as nlohmann reads them: an integer token (even "-0") as its integer value
 // converted to double, any other as the nearest double (both correctly rounded).
 
@@ -20,6 +24,7 @@
 
 #include <simdjson.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -85,8 +90,65 @@ void once(unsigned& seen, unsigned bit) {
     seen |= bit;
 }
 
-/// One element of "objects": a box or a sphere, checked as parseObject checks it.
-SceneObject object(const Source& w, od::value v, const Path& path) {
+/// "inertia": 3 principal moments or 3 rows of 3, as readInertia reads them.
+void inertia(od::value v, BodyFields& f) {
+    std::array<double, 9> m{};
+    std::size_t r = 0;
+    for (auto element : ok(v.get_array())) {
+        od::value row = ok(std::move(element));
+        const bool isRow = ok(row.type()) == od::json_type::array;
+        if (r == 3 || (r > 0 && isRow == f.inertiaPrincipal)) {
+            throw NotVouched{};
+        }
+        f.inertiaPrincipal = !isRow;
+        if (isRow) {
+            const auto values = numbers<3>(row);
+            std::copy(values.begin(), values.end(), m.begin() + static_cast<std::ptrdiff_t>(r * 3));
+        } else {
+            m[r * 3 + r] = number(row);
+        }
+        ++r;
+    }
+    if (r != 3) {
+        throw NotVouched{};
+    }
+    f.inertia = m;
+}
+
+/// One version-3 field of an object into `f`; false when `key` is none of them.
+bool bodyField(std::string_view key, od::value value, BodyFields& f) {
+    const auto set = [](auto& field, auto v) {
+        if (field) {
+            throw NotVouched{}; // repeated
+        }
+        field = v;
+    };
+    if (key == "dynamic") {
+        set(f.dynamic, ok(value.get_bool()));
+    } else if (key == "mass_kg") {
+        set(f.massKg, number(value));
+    } else if (key == "density_kg_per_m3") {
+        set(f.densityKgPerM3, number(value));
+    } else if (key == "inertia") {
+        if (f.inertia) {
+            throw NotVouched{};
+        }
+        inertia(value, f);
+    } else if (key == "restitution") {
+        set(f.restitution, number(value));
+    } else if (key == "velocity") {
+        set(f.velocity, vec3(value));
+    } else if (key == "angular_velocity") {
+        set(f.angularVelocity, vec3(value));
+    } else {
+        return false;
+    }
+    return true;
+}
+
+/// One element of "objects": a box or a sphere, checked as parseObject checks it. Sets
+/// `version3` when it has a version-3 field.
+SceneObject object(const Source& w, od::value v, const Path& path, bool& version3) {
     enum : unsigned {
         kId = 1,
         kShape = 2,
@@ -95,7 +157,8 @@ SceneObject object(const Source& w, od::value v, const Path& path) {
         kRadius = 16,
         kRotation = 32,
         kStiffness = 64,
-        kFriction = 128
+        kFriction = 128,
+        kBody = 256 // any version-3 field: `body` holds them
     };
     unsigned seen = 0;
     SceneObject o;
@@ -104,6 +167,7 @@ SceneObject object(const Source& w, od::value v, const Path& path) {
     double radius = 0.0;
     std::array<double, 4> rotation{};
     std::array<double, 2> friction{};
+    BodyFields body;
     for (auto f : ok(v.get_object())) {
         od::field field = ok(std::move(f));
         const std::string_view key = ok(field.unescaped_key());
@@ -139,6 +203,8 @@ SceneObject object(const Source& w, od::value v, const Path& path) {
         } else if (key == "friction") {
             once(seen, kFriction);
             friction = numbers<2>(value);
+        } else if (bodyField(key, value, body)) {
+            seen |= kBody;
         } else {
             throw NotVouched{};
         }
@@ -181,6 +247,10 @@ SceneObject object(const Source& w, od::value v, const Path& path) {
         o.material.staticFriction = friction[0];
         o.material.dynamicFriction = friction[1];
     }
+    if (seen & kBody) {
+        version3 = true;
+        applyBodyFields(w, o, body, path);
+    }
     return o;
 }
 
@@ -211,6 +281,19 @@ Aabb bounds(const Source& w, od::value v, const Path& path) {
     return b;
 }
 
+/// "dynamics": {"rate_hz": r}, the rate when given.
+std::optional<double> dynamics(od::value v) {
+    std::optional<double> rate;
+    for (auto f : ok(v.get_object())) {
+        od::field field = ok(std::move(f));
+        if (ok(field.unescaped_key()) != "rate_hz" || rate) {
+            throw NotVouched{};
+        }
+        rate = number(field.value());
+    }
+    return rate;
+}
+
 } // namespace
 
 std::optional<Scene> parseSceneFast(std::string_view text, std::size_t capacity,
@@ -233,6 +316,9 @@ std::optional<Scene> parseSceneFast(std::string_view text, std::size_t capacity,
         std::int64_t version = 0;
         std::optional<Aabb> box;
         std::vector<SceneObject> objects;
+        bool version3 = false;
+        std::optional<Vec3> gravity;
+        std::optional<double> rateHz;
         for (auto f : ok(doc.get_object())) {
             od::field field = ok(std::move(f));
             const std::string_view key = ok(field.unescaped_key());
@@ -252,8 +338,14 @@ std::optional<Scene> parseSceneFast(std::string_view text, std::size_t capacity,
                 once(seen, 8);
                 for (auto element : ok(value.get_array())) {
                     objects.push_back(
-                        object(w, ok(std::move(element)), objectsPath[objects.size()]));
+                        object(w, ok(std::move(element)), objectsPath[objects.size()], version3));
                 }
+            } else if (key == "gravity") {
+                once(seen, 16);
+                gravity = vec3(value);
+            } else if (key == "dynamics") {
+                once(seen, 32);
+                rateHz = dynamics(value);
             } else {
                 throw NotVouched{};
             }
@@ -261,11 +353,15 @@ std::optional<Scene> parseSceneFast(std::string_view text, std::size_t capacity,
         // Nothing may follow the top-level object: at the end, the location is out of bounds.
         const char* rest = nullptr;
         if (doc.current_location().get(rest) != simdjson::OUT_OF_BOUNDS || (seen & 11) != 11 ||
-            version < 1 || version > kSceneFormatVersion) {
+            version < 1 || version > kSceneFormatVersion ||
+            (version < 3 && (version3 || (seen & 48) != 0))) {
             throw NotVouched{};
         }
+        const ScenePhysics physics = checkPhysics(w, gravity, rateHz, top);
         checkUniqueIds(w, objects, objectsPath);
-        return finishScene(w, std::move(objects), box, objectsPath);
+        Scene scene = finishScene(w, std::move(objects), box, objectsPath);
+        scene.setPhysics(physics);
+        return scene;
     } catch (const NotVouched&) {
         return std::nullopt;
     } catch (const InputError&) {

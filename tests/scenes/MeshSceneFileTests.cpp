@@ -209,8 +209,8 @@ TEST_CASE("bad mesh objects are refused with the file, the JSON path and the pla
              "center": [0,0,0], )" +
              tet + R"(}], "version": 1})",
          R"(bad.json: objects[0].shape: "mesh" needs "version": 2)"},
-        {"version 3", R"({"format": "hapto-scene", "version": 3, "objects": []})",
-         "bad.json: version: this build reads versions 1 to 2, got 3"},
+        {"version 4", R"({"format": "hapto-scene", "version": 4, "objects": []})",
+         "bad.json: version: this build reads versions 1 to 3, got 4"},
         {"index out of range", scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0],
              "vertices": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2],[0,1,7]]})"),
          "bad.json: objects[0].triangles[1][2]: vertex index 7 is out of range (the mesh has 3 "

@@ -138,8 +138,8 @@ TEST_CASE("every class of bad file is refused with the file, the JSON path and t
         {"wrong format", R"({"format": "obj", "version": 1, "objects": []})",
          "bad.json: format: expected \"hapto-scene\""},
         {"missing format", R"({"version": 1, "objects": []})", "missing required field 'format'"},
-        {"unknown version", R"({"format": "hapto-scene", "version": 3, "objects": []})",
-         "bad.json: version: this build reads versions 1 to 2, got 3"},
+        {"unknown version", R"({"format": "hapto-scene", "version": 4, "objects": []})",
+         "bad.json: version: this build reads versions 1 to 3, got 4"},
         {"missing objects", R"({"format": "hapto-scene", "version": 1})",
          "missing required field 'objects'"},
         {"objects not an array", R"({"format": "hapto-scene", "version": 1, "objects": {}})",
@@ -274,11 +274,11 @@ TEST_CASE("a deeply nested wrong value is named by its type, not printed") {
     // overflowed the stack under ASan (corpus crash-deep-version-dump.json).
     const std::string deep = std::string(12000, '[') + std::string(12000, ']');
     CHECK(errorOf(R"({"format": "hapto-scene", "version": )" + deep + R"(, "objects": []})") ==
-          "bad.json: version: this build reads versions 1 to 2, got an array");
+          "bad.json: version: this build reads versions 1 to 3, got an array");
     CHECK(errorOf(R"({"format": )" + deep + R"(, "version": 1, "objects": []})") ==
           "bad.json: format: expected \"hapto-scene\", got an array");
     CHECK(errorOf(R"({"format": "hapto-scene", "version": 1.5, "objects": []})") ==
-          "bad.json: version: this build reads versions 1 to 2, got 1.5");
+          "bad.json: version: this build reads versions 1 to 3, got 1.5");
 }
 
 TEST_CASE("a missing file is named in the message") {

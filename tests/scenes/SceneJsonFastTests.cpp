@@ -91,7 +91,7 @@ TEST_CASE("what the fast path does not vouch for gets the checked loader's messa
         sceneWith(R"({"id": 0, "shape": "box", "center": [0,0,0], "half_extents": [1,1,0]})"),
         sceneWith(R"({"id": 0, "shape": "cone", "center": [0,0,0], "half_extents": [1,1,1]})"),
         sceneWith(std::string(box) + ", " + box), // duplicate id
-        R"({"format": "hapto-scene", "version": 3, "objects": []})",
+        R"({"format": "hapto-scene", "version": 4, "objects": []})",
         R"({"format": "hapto-scene", "version": 1, "objects": [], "objects": []})",
         R"({"format": "hapto-scene", "version": 1})",
         R"({"format": "hapto-scene", "version": 1, "objects": [)" + std::string(box) + ",]}",

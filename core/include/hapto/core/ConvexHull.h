@@ -20,6 +20,9 @@ struct ConvexHull {
     struct Face {
         Vec3 normal{0.0};    ///< Outward unit normal.
         double offset = 0.0; ///< (m).
+
+        /// Both fields equal (ConvexHull's operator== needs it).
+        bool operator==(const Face&) const = default;
     };
     std::vector<Vec3> vertices;                      ///< Corners (m, own frame).
     std::vector<Face> faces;                         ///< Face planes.

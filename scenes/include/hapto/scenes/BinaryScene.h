@@ -84,7 +84,9 @@ Scene parseBinaryScene(std::string_view bytes, std::string_view sourceName,
 /// Writes the scene in the binary format; the same scene gives the same bytes. Meshes as the
 /// JSON writer writes them: a mesh from a model file by its file (so the scene must be written
 /// to the same folder or the path must be absolute) and scale; any other mesh inline, its
-/// vertices as held (scale applied) with scale 1. [control]
+/// vertices as held (scale applied) with scale 1. A scene that needs JSON version 3 (dynamic
+/// bodies, restitution, non-default physics: sceneFormatVersionOf) is refused with an
+/// InputError before anything is written. [control]
 void writeBinaryScene(const Scene& scene, std::ostream& out);
 
 /// The bytes writeBinaryScene writes. [control]

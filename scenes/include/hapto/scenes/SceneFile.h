@@ -9,12 +9,20 @@
 
 namespace hapto {
 
-/// The newest scene file format version this build reads and writes: 2, which adds mesh
-/// objects (`"shape": "mesh"`). Version 1 files (boxes and spheres) still load unchanged.
-inline constexpr int kSceneFormatVersion = 2;
+/// The newest scene file format version this build reads and writes: 3, which adds dynamic
+/// bodies (`"dynamic": true`, mass, inertia, restitution, initial velocities) and the scene's
+/// `"gravity"` and `"dynamics"`. Version 2 added mesh objects (`"shape": "mesh"`); version 1 and
+/// 2 files still load unchanged.
+inline constexpr int kSceneFormatVersion = 3;
+/// The version a scene with meshes but nothing of version 3 is written as.
+inline constexpr int kSceneFormatVersionWithMeshes = 2;
 /// The version a scene without meshes is written as, so its file is byte-identical to what
 /// builds before version 2 wrote.
 inline constexpr int kSceneFormatVersionWithoutMeshes = 1;
+
+/// The oldest version that holds the scene: 3 when an object is dynamic or has a restitution,
+/// or the physics is not the default; else 2 when it has meshes; else 1. [any thread]
+int sceneFormatVersionOf(const Scene& scene);
 
 /// Loads a scene file, JSON or binary (BinaryScene.h; told apart by its magic, not its name).
 /// Streams the objects, so 10^7 objects load in bounded extra memory.
@@ -35,8 +43,9 @@ Scene parseScene(std::string_view text, std::string_view sourceName,
 Scene parseSceneChecked(std::string_view text, std::string_view sourceName,
                         const std::filesystem::path& baseDir = {});
 
-/// Writes the scene as JSON, every field explicit; the same scene gives the same bytes. A scene
-/// without meshes is written as version 1, one with meshes as version 2: a mesh from a model file
+/// Writes the scene as JSON, every field explicit; the same scene gives the same bytes, in the
+/// version sceneFormatVersionOf gives (a dynamic body with its mass and full inertia tensor, so
+/// it reads back to the same values bit for bit). A mesh from a model file
 /// by its file (as the scene that loaded it named it, so the scene must be written to the same
 /// folder or the path must be absolute) and scale; any other mesh inline, its vertices as held
 /// (scale applied) with scale 1. [control]

@@ -51,6 +51,17 @@ struct Material {
 /// object's own frame (a box's and a sphere's is 0; a mesh's is its volume centroid), and its
 /// inertia is about that point, in the object's own axes.
 struct BodyProperties {
+    /// Largest mass a scene file may give (kg): 10^4, ten tonnes, far above anything a hand
+    /// lifts, low enough that m g stays a small finite force.
+    static constexpr double kMaxMassKg = 1e4;
+    /// Largest density a scene file may give (kg/m^3): 10^5, above the densest element
+    /// (osmium, 22,590 kg/m^3; CRC Handbook of Chemistry and Physics).
+    static constexpr double kMaxDensityKgPerM3 = 1e5;
+    /// Largest initial speed a scene file may give (m/s): 100, ten times a hard throw.
+    static constexpr double kMaxSpeed = 100.0;
+    /// Largest initial angular speed a scene file may give (rad/s): 10^4.
+    static constexpr double kMaxAngularSpeed = 1e4;
+
     bool dynamic = false;        ///< Simulated by the dynamics thread (scene key "dynamic").
     double massKg = 0.0;         ///< Mass (kg), > 0 when dynamic.
     Mat3 inertia{0.0};           ///< Inertia tensor about the centre of mass, own axes
