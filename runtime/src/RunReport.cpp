@@ -1,8 +1,11 @@
 // Reports: the run's summary from each device's metrics and record, as values, as JSON (the
 // `hapto run --report` format) and as one live line per device. Nothing here runs on a servo
-// thread; report() takes each device's record lock briefly, never a servo's.
+// thread; report() takes each device's record lock briefly, never a servo's. The dynamics
+// thread is reported like a device (its load, misses and verdict by the same rule, loadStable)
+// with each body's measured figures.
 
 #include "Channel.h"
+#include "DynamicsChannel.h"
 
 #include <nlohmann/json.hpp>
 
@@ -29,10 +32,55 @@ const char* faultName(FaultKind kind) noexcept {
     return "unknown";
 }
 
+namespace {
+
+/// A histogram of times (ns) as fractions of `periodNs`.
+HistogramSummary asFractionOf(const HistogramSummary& t, double periodNs) {
+    return {t.count,          t.mean / periodNs, t.p50 / periodNs,
+            t.p99 / periodNs, t.p999 / periodNs, t.max / periodNs};
+}
+
+} // namespace
+
+bool loadStable(std::uint64_t steps, const HistogramSummary& loadFraction,
+                std::uint64_t missedDeadlines) {
+    return steps > 0 && loadFraction.p999 < 1.0 &&
+           static_cast<double>(missedDeadlines) <= 0.001 * static_cast<double>(steps);
+}
+
+std::optional<DynamicsReport> Runtime::dynamicsReport() const {
+    if (!mDynamics) {
+        return std::nullopt;
+    }
+    const DynamicsChannel& dc = *mDynamics;
+    const DynamicsMetrics& m = dc.metrics;
+    DynamicsReport d;
+    d.rateHz = dc.rateHz;
+    d.steps = m.steps.load();
+    d.stepNs = m.stepNs.summary();
+    d.loadFraction = asFractionOf(d.stepNs, static_cast<double>(dc.periodNs));
+    d.latenessNs = m.latenessNs.summary();
+    d.lateWakeups = m.lateWakeups.load();
+    d.missedDeadlines = m.missedDeadlines.load();
+    d.stoppedBodies = m.stoppedBodies.load();
+    d.realtime = m.realtime.load();
+    d.stable = loadStable(d.steps, d.loadFraction, d.missedDeadlines) && d.stoppedBodies == 0;
+    for (std::size_t i = 0; i < dc.ids.size(); ++i) {
+        const DynamicsBodyRecord& b = dc.records[i];
+        d.bodies.push_back(BodyReport{dc.ids[i], b.deepestPenetrationM.load(),
+                                      b.largestEnergyGainJ.load(), b.stopped.load()});
+    }
+    return d;
+}
+
 RunReport Runtime::report() const {
     RunReport r;
     r.cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    r.stable = !mChannels.empty();
+    r.dynamics = dynamicsReport();
+    r.stable = !mChannels.empty() || r.dynamics.has_value();
+    if (r.dynamics) {
+        r.stable = r.dynamics->stable;
+    }
     for (const auto& chp : mChannels) {
         const Channel& ch = *chp;
         const ChannelRecord& c = ch.record;
@@ -43,9 +91,7 @@ RunReport Runtime::report() const {
         d.rateHz = c.rd.config.rateHz;
         d.ticks = m.ticks.load();
         HistogramSummary t = m.tickNs.summary();
-        const double period = static_cast<double>(ch.servo.periodNs);
-        d.loadFraction = {t.count,        t.mean / period, t.p50 / period,
-                          t.p99 / period, t.p999 / period, t.max / period};
+        d.loadFraction = asFractionOf(t, static_cast<double>(ch.servo.periodNs));
         d.latenessNs = m.latenessNs.summary();
         d.ioNs = m.ioNs.summary();
         d.lateWakeups = m.lateWakeups.load();
@@ -80,8 +126,8 @@ RunReport Runtime::report() const {
         if (c.eventsDropped > 0) {
             d.events.push_back("... and " + std::to_string(c.eventsDropped) + " more events");
         }
-        d.stable = d.fault.empty() && d.faults == 0 && d.ticks > 0 && d.loadFraction.p999 < 1.0 &&
-                   static_cast<double>(d.missedDeadlines) <= 0.001 * static_cast<double>(d.ticks);
+        d.stable = d.fault.empty() && d.faults == 0 &&
+                   loadStable(d.ticks, d.loadFraction, d.missedDeadlines);
         r.loadSum += d.loadFraction.mean;
         r.stable = r.stable && d.stable;
         r.devices.push_back(std::move(d));
@@ -137,12 +183,41 @@ std::string lateWakeupNote(const DeviceReport& d) {
     return text;
 }
 
+namespace {
+
+nlohmann::json summaryJson(const HistogramSummary& s) {
+    return nlohmann::json{
+        {"mean", s.mean}, {"p50", s.p50}, {"p99", s.p99}, {"p999", s.p999}, {"max", s.max}};
+}
+
+/// The dynamics thread's part of the report: its row and one per body.
+nlohmann::json dynamicsJson(const DynamicsReport& d) {
+    using nlohmann::json;
+    json bodies = json::array();
+    for (const BodyReport& b : d.bodies) {
+        bodies.push_back(json{{"id", b.id},
+                              {"deepest_penetration_m", b.deepestPenetrationM},
+                              {"largest_energy_gain_j", b.largestEnergyGainJ},
+                              {"stopped_non_finite", b.stopped}});
+    }
+    return json{{"rate_hz", d.rateHz},
+                {"steps", d.steps},
+                {"step_ns", summaryJson(d.stepNs)},
+                {"load", summaryJson(d.loadFraction)},
+                {"lateness_ns", summaryJson(d.latenessNs)},
+                {"late_wakeups", d.lateWakeups},
+                {"missed_deadlines", d.missedDeadlines},
+                {"stopped_bodies", d.stoppedBodies},
+                {"realtime", d.realtime},
+                {"stable", d.stable},
+                {"bodies", bodies}};
+}
+
+} // namespace
+
 std::string reportToJson(const RunReport& r) {
     using nlohmann::json;
-    const auto load = [](const HistogramSummary& s) {
-        return json{
-            {"mean", s.mean}, {"p50", s.p50}, {"p99", s.p99}, {"p999", s.p999}, {"max", s.max}};
-    };
+    const auto load = [](const HistogramSummary& s) { return summaryJson(s); };
     json devices = json::array();
     for (const DeviceReport& d : r.devices) {
         devices.push_back(json{
@@ -196,6 +271,9 @@ std::string reportToJson(const RunReport& r) {
         total["wake_latency_us"] = r.wakeLatencyUs;
     }
     json out{{"devices", devices}, {"total", total}};
+    if (r.dynamics) {
+        out["dynamics"] = dynamicsJson(*r.dynamics);
+    }
     if (!r.realtimeNote.empty()) {
         out["realtime_note"] = r.realtimeNote;
     }

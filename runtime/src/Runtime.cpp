@@ -4,9 +4,12 @@
 // step lives in ServoStep.cpp and its loop in ServoLoop.cpp, supervision (the watchdog,
 // closing, reopening) in Supervision.cpp, reports in RunReport.cpp; this file opens devices,
 // starts the threads (or the step mode, which runs the same step and the same supervision pass
-// on the caller's thread with the caller's clock), and stops them.
+// on the caller's thread with the caller's clock), and stops them. When the world's scene has
+// dynamic bodies, the runtime builds their Dynamics here from the world's first snapshot and
+// owns it with its dynamics thread (DynamicsLoop.cpp); every servo gets its pose table.
 
 #include "Channel.h"
+#include "DynamicsChannel.h"
 
 #include "hapto/runtime/Realtime.h"
 
@@ -66,6 +69,9 @@ Runtime::Runtime(World& world, std::vector<RuntimeDevice> devices, RuntimeOption
         mChannels.push_back(std::move(ch));
     }
     makeGroups();
+    if (mWorld.current().scene->hasDynamicBodies()) {
+        mDynamics = std::make_unique<DynamicsChannel>(mWorld.current(), mOptions);
+    }
     // The warm-up spins on its core until the deadline: free on a core of its own; on a shared
     // one it costs CPU the other servo threads could use, for little (their ticks keep the
     // caches warm for each other; docs/results/many-devices.md).
@@ -123,6 +129,9 @@ std::size_t Runtime::start() {
         }
     }
     const std::size_t started = openAll();
+    if (mDynamics) {
+        startDynamics(now()); // its poses are published before any servo reads them
+    }
     for (auto& chp : mChannels) {
         if (chp->record.opened) {
             if (chp->record.group < 0) {
@@ -145,6 +154,9 @@ std::size_t Runtime::start() {
 std::size_t Runtime::startStepped(ManualClock& clock) {
     mClock = &clock;
     const std::size_t opened = openAll();
+    if (mDynamics) {
+        startDynamics(mStartNs); // its poses are published before any servo reads them
+    }
     for (auto& chp : mChannels) {
         if (chp->record.opened) {
             startServo(*chp, mStartNs);
@@ -202,6 +214,7 @@ void Runtime::stop() {
             }
         }
     }
+    stopDynamics();                       // after the servos: none hands it an impulse any more
     mWakeLatency = rt::WakeLatencyHold(); // every servo thread has stopped: idle CPUs may sleep
     std::uint64_t none = 0;
     if (mStartNs != 0) {
@@ -216,6 +229,9 @@ void Runtime::emergencyStop(std::uint64_t waitNs) noexcept {
     }
     for (auto& g : mGroups) {
         g->stop.store(true, std::memory_order_release); // each member commands zero as it leaves
+    }
+    if (mDynamics) {
+        mDynamics->stop.store(true, std::memory_order_release); // it drives no device
     }
     if (mClock) {
         for (auto& chp : mChannels) {
@@ -247,6 +263,9 @@ void Runtime::emergencyStop(std::uint64_t waitNs) noexcept {
 bool Runtime::anyRunning() const {
     if (mStopping.load(std::memory_order_acquire)) {
         return false;
+    }
+    if (mDynamics && mDynamics->metrics.running.load(std::memory_order_acquire)) {
+        return true;
     }
     return std::any_of(mChannels.begin(), mChannels.end(), [](auto& ch) {
         return ch->record.opened && !ch->record.gaveUp.load(std::memory_order_acquire);

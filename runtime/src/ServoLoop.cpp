@@ -8,6 +8,7 @@
 #include "hapto/runtime/ServoLoop.h"
 
 #include "Channel.h"
+#include "DynamicsChannel.h"
 
 #include "hapto/core/CpuPause.h"
 #include "hapto/core/Finite.h"
@@ -82,6 +83,7 @@ void Runtime::startServo(Channel& ch, std::uint64_t nowNs) noexcept {
     s.ports.effects = &ch.effects;
     s.ports.effectsPublished = &ch.effectsPublished;
     s.ports.clock = mClock;
+    s.ports.bodies = mDynamics ? &mDynamics->poses : nullptr;
     s.ports.startNs = mStartNs;
     s.start(nowNs);
 }
@@ -161,6 +163,7 @@ bool Runtime::step(std::size_t i, std::uint64_t nowNs) {
 
 void Runtime::stepAll(std::uint64_t nowNs) {
     requireStepped("stepAll");
+    (void)stepDynamicsIfDue(nowNs); // a step due at t before the servo ticks due at t
     for (std::size_t i = 0; i < mChannels.size(); ++i) {
         if (mChannels[i]->record.group < 0) {
             (void)step(i, nowNs);
@@ -174,8 +177,9 @@ void Runtime::runUntil(std::uint64_t untilNs) {
     requireStepped("runUntil");
     std::uint64_t at = mClock->nowNs();
     for (;;) {
-        // The next event: a running servo's deadline, or a recovering device's reopen time.
-        std::uint64_t next = UINT64_MAX;
+        // The next event: a running servo's deadline, a recovering device's reopen time, or
+        // the dynamics' next step.
+        std::uint64_t next = std::max(nextDynamicsDeadlineNs(), at);
         for (const auto& chp : mChannels) {
             const Channel& ch = *chp;
             if (ch.metrics.running.load(std::memory_order_acquire)) {

@@ -3,6 +3,7 @@
 #include "hapto/runtime/Session.h"
 
 #include "hapto/devices/TraceRecorder.h"
+#include "hapto/runtime/BodyTrace.h"
 
 #include <thread>
 #include <utility>
@@ -42,6 +43,11 @@ Session::~Session() {
 
 std::size_t Session::start() {
     mStarted = true;
+    if (mOptions.bodyRecorder && !mRuntime.hasDynamics()) {
+        mOptions.bodyRecorder->abandon(); // no body to record
+        mOptions.bodyRecorder = nullptr;
+    }
+    mRuntime.setBodyRecorder(mOptions.bodyRecorder);
     const std::size_t opened =
         mOptions.steppedClock ? mRuntime.startStepped(*mOptions.steppedClock) : mRuntime.start();
     if (mOptions.steppedClock) {
@@ -98,6 +104,9 @@ SessionEnd Session::run(const ControlStep& step) {
         for (TraceRecorder* recorder : mOptions.recorders) {
             recorder->drain();
         }
+        if (mOptions.bodyRecorder) {
+            mOptions.bodyRecorder->drain();
+        }
         if (!goOn) {
             return SessionEnd::Finished;
         }
@@ -114,6 +123,9 @@ const RunReport& Session::stop() {
         for (TraceRecorder* recorder : mOptions.recorders) {
             recorder->close();
         }
+    }
+    if (mOptions.bodyRecorder) {
+        mOptions.bodyRecorder->close(); // the dynamics ran from start() to stop()
     }
     mReport = mRuntime.report();
     return mReport;

@@ -11,7 +11,7 @@ set(HAPTO_MODULE_NEEDS_scenes core io)
 set(HAPTO_MODULE_NEEDS_index core scenes)
 set(HAPTO_MODULE_NEEDS_dynamics core index scenes)
 set(HAPTO_MODULE_NEEDS_devices core io scenes)
-set(HAPTO_MODULE_NEEDS_runtime core index devices scenes)
+set(HAPTO_MODULE_NEEDS_runtime core index dynamics devices scenes)
 set(HAPTO_MODULE_NEEDS_experiments runtime index devices scenes)
 set(HAPTO_MODULE_NEEDS_view runtime devices scenes)
 

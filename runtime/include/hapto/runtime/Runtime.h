@@ -5,6 +5,7 @@
 #include "hapto/devices/Device.h"
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/index/Cursor.h"
+#include "hapto/runtime/BodyPoses.h"
 #include "hapto/runtime/DeviceFile.h"
 #include "hapto/runtime/DeviceMetrics.h"
 #include "hapto/runtime/Effects.h"
@@ -34,6 +35,7 @@
 namespace hapto {
 
 class TraceRecorder;
+class BodyTraceRecorder;
 
 // ContactReport (what a servo tells the control thread every tick) is in ServoStep.h.
 
@@ -118,13 +120,44 @@ struct DeviceReport {
     bool stable = false;             ///< p99.9 load < 1 and misses <= 0.1 % of ticks, no fault.
 };
 
+/// What was measured of one dynamic body over the run (Dynamics' BodyStats).
+struct BodyReport {
+    ObjectId id = 0;                  ///< The scene object's id.
+    double deepestPenetrationM = 0.0; ///< Largest overlap with anything, after a step (m).
+    double largestEnergyGainJ = 0.0;  ///< Largest energy rise with no external work (J).
+    bool stopped = false; ///< Its state turned non-finite: stopped at its last finite pose.
+};
+
+/// Summary of the dynamics thread's run, loads as fractions of its period.
+struct DynamicsReport {
+    double rateHz = 0;                 ///< Steps per second (ScenePhysics::rateHz).
+    std::uint64_t steps = 0;           ///< Steps run.
+    HistogramSummary stepNs;           ///< Wake-up to every pose published (ns).
+    HistogramSummary loadFraction;     ///< stepNs / period.
+    HistogramSummary latenessNs;       ///< Wake-up lateness (ns).
+    std::uint64_t lateWakeups = 0;     ///< Wake-ups later than 10 % of the period.
+    std::uint64_t missedDeadlines = 0; ///< Steps that ended after the next deadline.
+    std::uint64_t stoppedBodies = 0;   ///< Bodies stopped for a non-finite state.
+    bool realtime = false;             ///< SCHED_FIFO was granted.
+    /// p99.9 load < 1, misses <= 0.1 % of steps, no body stopped (the devices' rule, loadStable).
+    bool stable = false;
+    std::vector<BodyReport> bodies; ///< One per dynamic body, in the scene's slot order.
+};
+
+/// The verdict's rule for a thread with a period: some steps ran, the p99.9 of (step time /
+/// period) is below 1 and at most 0.1 % of the steps missed their deadline. [any thread]
+bool loadStable(std::uint64_t steps, const HistogramSummary& loadFraction,
+                std::uint64_t missedDeadlines);
+
 /// The whole run.
 struct RunReport {
     std::vector<DeviceReport> devices; ///< One per device, in configuration order.
+    /// The dynamics thread, when the scene has dynamic bodies.
+    std::optional<DynamicsReport> dynamics;
     double loadSum = 0;       ///< Sum of the devices' mean loads (CPU cores' worth of servo work).
     double loadPerCore = 0;   ///< loadSum / cores.
     int cores = 1;            ///< Hardware threads.
-    bool stable = false;      ///< Every device stable.
+    bool stable = false;      ///< Every device stable, and the dynamics when it runs.
     double durationS = 0;     ///< Wall time from start to stop (s).
     std::string realtimeNote; ///< Why SCHED_FIFO or pinning was not granted, if not.
     /// The CPU latency request held during the run (us; RuntimeOptions::wakeLatencyUs), or -1.
@@ -171,9 +204,11 @@ public:
     std::size_t startStepped(ManualClock& clock);
     /// Step mode: runs every device at each of its deadlines (an on-time wake-up) and a
     /// supervision pass after each, in time order, up to and including `untilNs`; a faulted
-    /// device is reopened at its reopen times. Ends with the clock at `untilNs`. [control]
+    /// device is reopened at its reopen times. The dynamics steps at its deadlines too, a step
+    /// due at t before the servo ticks due at t. Ends with the clock at `untilNs`. [control]
     void runUntil(std::uint64_t untilNs);
-    /// Step mode: at `nowNs`, one tick of every device whose deadline has come (a `nowNs`
+    /// Step mode: at `nowNs`, first one dynamics step if its deadline has come, then one
+    /// tick of every device whose deadline has come (a `nowNs`
     /// past a deadline is a late wake-up), in device order, then one supervision pass. Before
     /// each device's tick the clock is set to `nowNs`; the device may advance it inside its
     /// read() or write() (that tick then takes that long: its load, misses and next deadline
@@ -210,8 +245,31 @@ public:
     /// thread]
     void emergencyStop(std::uint64_t waitNs = 200'000'000) noexcept;
     /// True while some device is driven or will be again (a faulted device waiting to be
-    /// reopened counts when reopening is on). [control]
+    /// reopened counts when reopening is on), or the dynamics runs. [control]
     bool anyRunning() const;
+
+    /// True when the world's scene has dynamic bodies: the runtime then builds a Dynamics
+    /// from the world's current snapshot (its scene and index) at construction, runs it on a
+    /// dynamics thread of its own from start() (stepped: between the servo ticks), and hands
+    /// every servo its BodyPoseTable (ServoStepPorts::bodies). [any thread]
+    bool hasDynamics() const;
+    /// The dynamic bodies' latest poses (read without locks; BodyPoseTable::read) and where
+    /// the hands' impulses go; null without dynamics. Body i is bodyIds()[i]. [any thread]
+    const BodyPoseTable* bodyPoses() const;
+    /// The same, to add impulses to a body (BodyPoseTable::addImpulse: an application's push;
+    /// it reaches the body at the next dynamics step, once). [any thread]
+    BodyPoseTable* bodyPoses();
+    /// Each body's scene object id, in body order; empty without dynamics. [any thread]
+    std::span<const ObjectId> bodyIds() const;
+    /// The dynamics' step rate (Hz), 0 without dynamics. [any thread]
+    double dynamicsRateHz() const;
+    /// Records every body's state at every dynamics step into `recorder` (owned by the
+    /// caller, drained by the control thread; Session does). Before start() or
+    /// startStepped(); ignored without dynamics. [control]
+    void setBodyRecorder(BodyTraceRecorder* recorder);
+    /// When the next dynamics step is due (ns, the runtime's clock); UINT64_MAX when none
+    /// runs. [control]
+    std::uint64_t nextDynamicsDeadlineNs() const;
 
     /// Live metrics of device i. [any thread]
     const DeviceMetrics& metrics(std::size_t i) const;
@@ -259,6 +317,15 @@ public:
 private:
     struct Channel;
     struct Group;
+    struct DynamicsChannel;
+    // DynamicsLoop.cpp: the dynamics thread, threaded or stepped.
+    void startDynamics(std::uint64_t nowNs);
+    void dynamicsMain();
+    void runDynamicsStep(DynamicsChannel& dc, std::uint64_t wakeNs) noexcept;
+    void publishBodies(DynamicsChannel& dc, std::uint64_t timeNs) noexcept;
+    bool stepDynamicsIfDue(std::uint64_t nowNs);
+    void stopDynamics();
+    std::optional<DynamicsReport> dynamicsReport() const;
     // Runtime.cpp: set-up and shutdown.
     std::size_t openAll();
     std::uint64_t now() const noexcept;
@@ -291,6 +358,7 @@ private:
     RuntimeOptions mOptions;
     std::vector<std::unique_ptr<Channel>> mChannels;
     std::vector<std::unique_ptr<Group>> mGroups; // empty: one servo thread per device
+    std::unique_ptr<DynamicsChannel> mDynamics;  // null: the scene has no dynamic body
     ManualClock* mClock = nullptr; // step mode's clock; nullptr: threaded, CLOCK_MONOTONIC
     bool mStarted = false;         // start() or startStepped() was called (hooks are fixed)
     std::uint64_t mStartNs = 0;

@@ -27,6 +27,7 @@
 namespace hapto {
 
 class TraceRecorder;
+class BodyTraceRecorder;
 
 /// Why a session's control loop ended.
 enum class SessionEnd : std::uint8_t {
@@ -65,6 +66,10 @@ struct SessionOptions {
     /// Recorders (the devices' RuntimeDevice::recorder, owned by the caller): drained every
     /// control step, closed after the devices are stopped, abandoned when no device opened.
     std::vector<TraceRecorder*> recorders;
+    /// The dynamic bodies' recorder (Runtime::setBodyRecorder, owned by the caller): given to
+    /// the runtime at start(), drained every control step, closed after the runtime stops.
+    /// Null: none. Ignored (and abandoned) when the runtime has no dynamics.
+    BodyTraceRecorder* bodyRecorder = nullptr;
 };
 
 /// Drives one Runtime through a session: start(), run(), stop(). Threading: [control], all of
@@ -78,9 +83,11 @@ public:
     Session(const Session&) = delete;
     Session& operator=(const Session&) = delete;
 
-    /// Opens the devices and starts the servo threads (or step mode on the options' clock);
-    /// session time 0 is now. Returns how many devices opened; when none did, the recorders
-    /// are abandoned (an older trace of the same name stays). [control]
+    /// Opens the devices and starts the servo threads and the dynamics thread, if any (or
+    /// step mode on the options' clock); session time 0 is now. Returns how many devices
+    /// opened; when none did, the devices' recorders are abandoned (an older trace of the same
+    /// name stays). A session with dynamics and no device runs until its end like any: the
+    /// dynamics counts as running (Runtime::anyRunning). [control]
     std::size_t start();
     /// The control loop, after start(): until the stop request, the end of every device, the
     /// control step's false or the duration, whichever comes first. Before each step the
