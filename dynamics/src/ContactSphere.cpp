@@ -7,9 +7,9 @@
 // feature names the other shape's region: a box's 27 regions (face, edge, corner, inside)
 // by the sign of the clamped local coordinates, a hull's face, a triangle's face/edge/corner.
 //
-// A one-sided triangle (triangleNormal set) pushes only out of its front: a sphere whose
-// front-most point is behind the plane gets no point, and a centre behind the plane gets the
-// plane's normal (never a normal pointing through the wall).
+// A one-sided triangle (triangleNormal set) pushes only out of its front: a centre behind the
+// plane gets the plane's normal when it lies over the face and the sphere reaches the front,
+// and nothing otherwise (never a normal pointing through the wall).
 
 #include "ContactInternal.h"
 
@@ -105,14 +105,15 @@ void sphereTriangle(const Vec3& c, double r, const ConvexShape& b, PointSink& si
     }
     if (front != Vec3(0.0)) {
         const double height = glm::dot(c - t[0], front);
-        if (height + r < 0.0) {
-            return; // wholly behind a one-sided face
-        }
-        if (height <= 0.0 || dist == 0.0) {
-            addSpherePoint(c, r, front, height - r, feature, sink);
+        if (height < 0.0) {
+            // Centre behind: pushed out of the front when over the face; beside it, the
+            // neighbouring face of the closed mesh owns the contact.
+            if (feature == 1u && height + r >= 0.0) {
+                addSpherePoint(c, r, front, height - r, feature, sink);
+            }
             return;
         }
-        addSpherePoint(c, r, away / dist, dist - r, feature, sink);
+        addSpherePoint(c, r, dist > 0.0 ? away / dist : front, dist - r, feature, sink);
         return;
     }
     if (dist > 0.0) {
