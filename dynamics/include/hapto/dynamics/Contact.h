@@ -8,6 +8,11 @@
 /// `separation` is the signed distance between the two surfaces along the normal at that point
 /// (< 0: they overlap by that much). Points are reported while separation <= the margin given,
 /// so a solver can stop an approaching body before it reaches a surface (speculative contacts).
+/// Depths are exact; so are the gaps of sphere pairs and of faces facing each other; the gap
+/// of two polytopes apart corner to edge or corner to corner is a lower bound (the best
+/// separating axis's), so such a point may come early, never late. Cost: constant for sphere
+/// pairs, box-box and box-triangle; a hull costs O(its vertices) per axis tested and every
+/// pair of edge directions is an axis, so hull-hull grows as edges(a) x edges(b) x vertices.
 /// Every function here is noexcept, allocates nothing and is deterministic (the same inputs in
 /// the same order give the same points in the same order, bit for bit). [any thread]
 
@@ -25,7 +30,7 @@ namespace hapto {
 struct ConvexShape {
     /// What it is.
     enum class Kind : std::uint8_t { Box, Sphere, Hull, Triangle };
-    Kind kind = Kind::Box;
+    Kind kind = Kind::Box;            ///< Which of the fields below describe it.
     Vec3 center{0.0};                 ///< Box, sphere: centre; hull: its frame's origin (m, world).
     Mat3 axes{1.0};                   ///< Box, hull: own axes (column i = axis i, world).
     Vec3 halfExtents{0.0};            ///< Box: half size per own axis (m).
