@@ -8,6 +8,7 @@
 #include "hapto/io/OutputFile.h"
 
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -143,6 +144,36 @@ BodyTrace readBodyTrace(const std::filesystem::path& path) {
         trace.samples.push_back(s);
     }
     return trace;
+}
+
+bool isBodyTrace(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    char magic[8] = {};
+    return in.read(magic, sizeof magic) && std::memcmp(magic, kMagic, sizeof magic) == 0;
+}
+
+std::string bodyTraceCsvHeader() {
+    return "time_s,id,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
+}
+
+void appendBodyTraceCsvRow(const BodyTrace& trace, const BodyTraceSample& s, std::string& out) {
+    const auto append = [&out](auto v) {
+        char buf[32];
+        const auto res = std::to_chars(buf, buf + sizeof buf, v); // shortest exact form
+        out.append(buf, res.ptr);
+    };
+    append(static_cast<double>(s.timeNs) * 1e-9);
+    out += ',';
+    append(trace.ids.at(s.body));
+    const double v[] = {
+        s.centerOfMass.x,    s.centerOfMass.y,    s.centerOfMass.z,   s.rotation.w, s.rotation.x,
+        s.rotation.y,        s.rotation.z,        s.velocity.x,       s.velocity.y, s.velocity.z,
+        s.angularVelocity.x, s.angularVelocity.y, s.angularVelocity.z};
+    for (double x : v) {
+        out += ',';
+        append(x);
+    }
+    out += '\n';
 }
 
 BodyTraceRecorder::BodyTraceRecorder(const std::filesystem::path& path,

@@ -1,4 +1,7 @@
-// `hapto run`: a session of D devices over one shared world, reporting each device's load.
+// `hapto run`: a session of D devices over one shared world, reporting each device's load,
+// and the dynamics thread's when the scene has dynamic bodies (then D may be 0: --no-devices).
+// --stepped runs the same session on the step mode's clock, as fast as the CPU allows, with
+// byte-identical results run after run.
 
 #include "Commands.h"
 #include "LiveLines.h"
@@ -14,7 +17,9 @@
 #include "hapto/index/IndexSpec.h"
 #include "hapto/io/InputError.h"
 #include "hapto/io/OutputFile.h"
+#include "hapto/runtime/BodyTrace.h"
 #include "hapto/runtime/DeviceFile.h"
+#include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Runtime.h"
 #include "hapto/runtime/Session.h"
 
@@ -48,8 +53,27 @@ struct RunArgs {
     std::int32_t wakeLatencyUs = -1;
     double reopenMs = static_cast<double>(RuntimeOptions{}.reopenAfterNs) / 1e6;
     bool quiet = false;
+    bool noDevices = false; ///< --no-devices: only the dynamics runs.
+    bool stepped = false;   ///< --stepped: the session runs on the step mode's clock.
     ViewArgs view;
 };
+
+// The dynamics thread's row and each body's figures.
+void printDynamics(const DynamicsReport& d) {
+    std::printf("%-10s %-7s %6.0fHz %9llu %7.2f%% %7.2f%% %7.2f%% %7.1f%% %7llu %7llu %6s %s\n",
+                "dynamics", "bodies", d.rateHz, static_cast<unsigned long long>(d.steps),
+                100 * d.loadFraction.mean, 100 * d.loadFraction.p50, 100 * d.loadFraction.p999,
+                100 * d.loadFraction.max, static_cast<unsigned long long>(d.missedDeadlines),
+                static_cast<unsigned long long>(d.lateWakeups), "-",
+                d.stable ? "stable" : "UNSTABLE");
+    std::printf("  dynamics: step p50 %.1f us, p99.9 %.1f us\n", d.stepNs.p50 / 1000.0,
+                d.stepNs.p999 / 1000.0);
+    for (const BodyReport& b : d.bodies) {
+        std::printf("  body %u: deepest penetration %.3g mm, largest energy gain %.3g J%s\n", b.id,
+                    b.deepestPenetrationM * 1000.0, b.largestEnergyGainJ,
+                    b.stopped ? ", STOPPED (non-finite state)" : "");
+    }
+}
 
 void printSummary(const RunReport& r) {
     std::printf("\n%-10s %-7s %8s %9s %8s %8s %8s %8s %7s %7s %6s %s\n", "device", "kind", "rate",
@@ -68,6 +92,9 @@ void printSummary(const RunReport& r) {
         if (const std::string note = lateWakeupNote(d); !note.empty()) {
             std::printf("%s\n", wrapText("  " + d.name + ": " + note, kTextWidth - 4, 4).c_str());
         }
+    }
+    if (r.dynamics) {
+        printDynamics(*r.dynamics);
     }
     std::printf(
         "total: load %.2f%% of one core summed over %zu devices, %.2f%% per core (%d cores); %s\n",
@@ -95,6 +122,9 @@ void printSummary(const RunReport& r) {
 // Throws InputError.
 void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
     useTraceSettings(configs, !(a.rateHz > 0));
+    if (a.stepped) {
+        checkSteppable(configs);
+    }
     checkDeviceCount(configs.size(), a.devices);
     checkSpinAgainstRates(a.spinUs, configs);
     for (const DeviceConfig& c : configs) {
@@ -140,13 +170,58 @@ std::unique_ptr<TraceRecorder> recorderFor(const DeviceConfig& c, const std::str
                                            header);
 }
 
+// The devices: none with --no-devices, else the --devices file's or the two default hands.
+DeviceFile deviceFileFor(const RunArgs& a) {
+    if (a.noDevices) {
+        return DeviceFile{{}, {}};
+    }
+    return a.devices.empty() ? DeviceFile{defaultDeviceConfigs(), {}} : loadDeviceFile(a.devices);
+}
+
+// What can only be checked once the scene is loaded: --no-devices needs a dynamic body to run,
+// and --record writes the bodies' trace beside the devices'. Throws InputError.
+void checkAgainstScene(const RunArgs& a, const Scene& scene,
+                       std::span<const DeviceConfig> configs) {
+    if (!scene.hasDynamicBodies()) {
+        if (a.noDevices) {
+            throw InputError(
+                "--no-devices: " +
+                (a.scene.empty() ? std::string("the default scene") : "the scene " + a.scene) +
+                " has no dynamic body (an object with \"dynamic\": true), so "
+                "nothing would run; give a scene with one, or devices");
+        }
+        return;
+    }
+    checkBodyTraceFile({a.scene, a.devices, a.report, a.record}, configs);
+}
+
+// The session's recorders: each device's <folder>/<name>.trace, and <folder>/bodies.trace when
+// the runtime has dynamics.
+struct Recorders {
+    std::vector<std::unique_ptr<TraceRecorder>> devices;
+    std::unique_ptr<BodyTraceRecorder> bodies;
+};
+
+RuntimeOptions runtimeOptionsFor(const RunArgs& a) {
+    RuntimeOptions opt;
+    opt.realtime = a.realtime && !a.stepped; // stepped, no servo thread runs
+    opt.spinNs = static_cast<std::uint64_t>(a.spinUs * 1000);
+    if (a.warmUs >= 0) {
+        opt.warmUpNs = static_cast<std::uint64_t>(a.warmUs * 1000);
+    }
+    opt.missLimit = a.missLimit;
+    opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
+    opt.devicesPerThread = a.devicesPerThread;
+    opt.wakeLatencyUs = a.stepped ? -1 : a.wakeLatencyUs;
+    return opt;
+}
+
 int runSession(const RunArgs& a) {
     // First, before any thread starts (the index build's TBB workers included), so that every
     // thread inherits the blocked stop signals and only the signal thread takes them.
     // Until endStartUp() below, a signal ends the process at once: nothing is open or written.
     StopSignals signals;
-    DeviceFile file =
-        a.devices.empty() ? DeviceFile{defaultDeviceConfigs(), {}} : loadDeviceFile(a.devices);
+    DeviceFile file = deviceFileFor(a);
     std::vector<DeviceConfig>& configs = file.devices;
     if (a.rateHz > 0) {
         for (DeviceConfig& c : configs) {
@@ -157,11 +232,16 @@ int runSession(const RunArgs& a) {
     // One copy of the scene: the world's first snapshot shares it with the devices and the view.
     const auto shared = std::make_shared<const Scene>(loadSceneOrDefault(a.scene));
     const Scene& scene = *shared;
+    checkAgainstScene(a, scene, configs);
     const IndexSpec spec = sessionIndexSpec(a.index, scene, a.maxIndexMb);
+    ManualClock clock;         // --stepped: the session's time, for the world and the runtime
     World world(shared, spec); // the world is ready before any device, recording or view
+    if (a.stepped) {
+        world.useClock(clock);
+    }
     signals.endStartUp();
 
-    std::vector<std::unique_ptr<TraceRecorder>> recorders;
+    Recorders recorders;
     if (!a.record.empty()) {
         std::filesystem::create_directories(a.record);
     }
@@ -170,39 +250,41 @@ int runSession(const RunArgs& a) {
         const DeviceConfig& c = configs[i];
         RuntimeDevice rd{makeDevice(c, scene), c, nullptr, file.renderingOf(i)};
         if (!a.record.empty()) {
-            recorders.push_back(recorderFor(c, a.record));
-            rd.recorder = recorders.back().get();
+            recorders.devices.push_back(recorderFor(c, a.record));
+            rd.recorder = recorders.devices.back().get();
         }
         devices.push_back(std::move(rd));
     }
-    RuntimeOptions opt;
-    opt.realtime = a.realtime;
-    opt.spinNs = static_cast<std::uint64_t>(a.spinUs * 1000);
-    if (a.warmUs >= 0) {
-        opt.warmUpNs = static_cast<std::uint64_t>(a.warmUs * 1000);
+    Runtime runtime(world, std::move(devices), runtimeOptionsFor(a));
+    if (!a.record.empty() && runtime.hasDynamics()) {
+        recorders.bodies = std::make_unique<BodyTraceRecorder>(
+            std::filesystem::path(a.record) / kBodyTraceFileName, runtime.bodyIds(),
+            runtime.dynamicsRateHz());
     }
-    opt.missLimit = a.missLimit;
-    opt.reopenAfterNs = static_cast<std::uint64_t>(a.reopenMs * 1e6);
-    opt.devicesPerThread = a.devicesPerThread;
-    opt.wakeLatencyUs = a.wakeLatencyUs;
-    Runtime runtime(world, std::move(devices), opt);
     // A second signal while the orderly stop below is under way (or blocked): zero force
-    // now, from the signal thread, and exit.
-    signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
+    // now, from the signal thread, and exit. Stepped, this thread never blocks: it sees the
+    // first signal, and the step mode's emergency stop belongs to it.
+    if (!a.stepped) {
+        signals.onSecondSignal([&runtime] { runtime.emergencyStop(); });
+    }
     // The view binds before the devices open: a port in use fails the run before it starts.
     LiveView view(a.view, "hapto run", scene, runtime);
 
     const bool live = !a.quiet && isatty(STDERR_FILENO);
     char header[256];
-    std::snprintf(header, sizeof header, "hapto run: %zu devices, %u objects, index %s, %.1f s%s\n",
-                  configs.size(), scene.size(), spec.toString().c_str(), a.durationS,
-                  a.durationS <= 0 ? " (until Ctrl-C)" : "");
+    std::snprintf(header, sizeof header,
+                  "hapto run: %zu devices, %u objects (%zu dynamic), index %s, %.1f s%s%s\n",
+                  configs.size(), scene.size(), runtime.bodyIds().size(), spec.toString().c_str(),
+                  a.durationS, a.durationS <= 0 ? " (until Ctrl-C)" : "",
+                  a.stepped ? ", stepped" : "");
     SessionOptions options;
     options.durationS = a.durationS;
+    options.steppedClock = a.stepped ? &clock : nullptr;
     options.stopRequested = [&signals] { return signals.requested(); };
-    for (const auto& rec : recorders) {
+    for (const auto& rec : recorders.devices) {
         options.recorders.push_back(rec.get());
     }
+    options.bodyRecorder = recorders.bodies.get();
     Session session(runtime, std::move(options));
     RunReport r;
     {
@@ -210,10 +292,14 @@ int runSession(const RunArgs& a) {
         // paused terminal blocks only that thread, never the session, its stop or its signals.
         LiveLines terminal(live ? &runtime : nullptr);
         terminal.say(header);
-        if (session.start() == 0) { // the recordings are abandoned: older traces stay
+        // No device opened (of some): the recordings are abandoned, older traces stay.
+        if (session.start() == 0 && !configs.empty()) {
             std::string why;
             for (const DeviceReport& d : runtime.report().devices) {
                 why += "hapto run: " + d.name + ": " + d.fault + "\n";
+            }
+            if (recorders.bodies) {
+                recorders.bodies->abandon(); // the run failed: an older bodies.trace stays
             }
             terminal.say(why + "hapto run: no device could be opened\n");
             return 1;
@@ -296,12 +382,21 @@ void addRunCommands(CLI::App& app) {
         ->check(finiteRange(1, static_cast<double>(kMaxSessionDevices)));
     addWakeLatencyOption(cmd, a->wakeLatencyUs, "the devices run (unset: no request)");
     cmd->add_flag("--quiet", a->quiet, "No live lines on the terminal");
+    cmd->add_flag("--no-devices", a->noDevices,
+                  "Drive no device: only the scene's dynamic bodies run (the scene must have one)");
+    cmd->add_flag("--stepped", a->stepped,
+                  "Run on the step mode's clock, as fast as the CPU allows, the same every run "
+                  "(simulated hands and replays only; real-time scheduling is not used)");
     addViewOptions(cmd, a->view);
-    setExamples(cmd,
-                {"hapto run --duration 10 --view",
-                 "hapto run --scene scene.json --devices hands.json --report run.json",
-                 "hapto run --record traces --duration 5   # then: hapto view --trace traces"});
+    setExamples(cmd, {"hapto run --duration 10 --view",
+                      "hapto run --scene scene.json --devices hands.json --report run.json",
+                      "hapto run --record traces --duration 5   # then: hapto view --trace traces",
+                      "hapto run --scene drop.json --no-devices --stepped --report drop-run.json"});
     cmd->callback([a] {
+        if (a->noDevices && !a->devices.empty()) {
+            throw InputError("--no-devices drives no device: give it or --devices " + a->devices +
+                             ", not both");
+        }
         const int rc = runSession(*a);
         if (rc != 0) {
             std::exit(rc);

@@ -4,6 +4,8 @@
 
 #include "hapto/io/InputError.h"
 #include "hapto/io/OutputFile.h"
+#include "hapto/runtime/BodyTrace.h"
+#include "hapto/runtime/Session.h"
 #include "hapto/runtime/World.h"
 
 #include <cstdio>
@@ -74,6 +76,48 @@ void checkSessionFiles(const SessionPaths& paths, std::span<const DeviceConfig> 
             checkOutputKind(trace, option); // a folder, FIFO, socket or device there
         }
     }
+}
+
+void checkSteppable(std::span<const DeviceConfig> configs) {
+    for (const DeviceConfig& c : configs) {
+        if (!runsOnStepClock(c.kind)) {
+            throw InputError("--stepped: device '" + c.name + "' is a " +
+                             std::string(name(c.kind)) +
+                             "; only simulated hands (sim) and replays run on the step clock (a "
+                             "hardware device keeps real time: run it without --stepped)");
+        }
+    }
+}
+
+void checkBodyTraceFile(const SessionPaths& paths, std::span<const DeviceConfig> configs) {
+    if (paths.record.empty()) {
+        return;
+    }
+    const fs::path trace = fs::path(paths.record) / kBodyTraceFileName;
+    const std::string option = std::string("--record (") + kBodyTraceFileName + ")";
+    for (const DeviceConfig& c : configs) {
+        if (c.name + ".trace" == kBodyTraceFileName) {
+            throw InputError("--record " + paths.record + ": device '" + c.name +
+                             "''s trace would be " + trace.string() +
+                             ", where the dynamic bodies are recorded; rename the device");
+        }
+        if (const auto* replay = std::get_if<ReplayConfig>(&c.params)) {
+            refuseSameFile(trace, option, replay->trace,
+                           "the trace replay device '" + c.name + "' reads");
+        }
+    }
+    if (!paths.scene.empty()) {
+        refuseSameFile(trace, option, paths.scene, "--scene");
+    }
+    if (!paths.devices.empty()) {
+        refuseSameFile(trace, option, paths.devices, "--devices");
+    }
+    if (sameFile(trace, paths.report)) {
+        throw InputError("--report " + paths.report +
+                         " is where --record writes the dynamic "
+                         "bodies' trace; give the report another name");
+    }
+    checkOutputKind(trace, option);
 }
 
 } // namespace hapto::cli

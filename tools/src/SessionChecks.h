@@ -41,4 +41,14 @@ void checkSpinAgainstRates(double spinUs, std::span<const DeviceConfig> configs)
 /// created. [control]
 void checkSessionFiles(const SessionPaths& paths, std::span<const DeviceConfig> configs);
 
+/// `--stepped` runs only devices whose time the session gives them (runsOnStepClock:
+/// simulated hands, replays); refuses any other (a Falcon or PHANToM keeps real time), naming
+/// it. [control]
+void checkSteppable(std::span<const DeviceConfig> configs);
+
+/// With --record `folder` and dynamic bodies in the scene: refuses a `<folder>/bodies.trace`
+/// (kBodyTraceFileName) that is a device's trace, an input, the report or not a regular file.
+/// [control]
+void checkBodyTraceFile(const SessionPaths& paths, std::span<const DeviceConfig> configs);
+
 } // namespace hapto::cli

@@ -8,6 +8,7 @@
 #include "hapto/experiments/Plot.h"
 #include "hapto/io/InputError.h"
 #include "hapto/io/OutputFile.h"
+#include "hapto/runtime/BodyTrace.h"
 
 #include <algorithm>
 #include <charconv>
@@ -43,6 +44,26 @@ void exportCsv(const std::string& tracePath, const std::string& outPath) {
     csv.finish();
     if (toFile) {
         std::cerr << "wrote " << rows << " samples to " << outPath << "\n";
+    }
+}
+
+// The dynamic bodies' trace (DIR/bodies.trace, BodyTrace.h) as CSV: one row per body per step.
+void exportBodyCsv(const std::string& tracePath, const std::string& outPath) {
+    const bool toFile = !outPath.empty() && outPath != "-";
+    if (toFile) {
+        refuseSameFile(outPath, "-o", tracePath, "the trace");
+        checkOutputFile(outPath, "-o");
+    }
+    const BodyTrace trace = readBodyTrace(tracePath);
+    TextOutput csv(toFile ? outPath : std::string());
+    csv.text() = bodyTraceCsvHeader();
+    for (const BodyTraceSample& s : trace.samples) {
+        appendBodyTraceCsvRow(trace, s, csv.text());
+        csv.afterRow();
+    }
+    csv.finish();
+    if (toFile) {
+        std::cerr << "wrote " << trace.samples.size() << " body samples to " << outPath << "\n";
     }
 }
 
@@ -245,13 +266,22 @@ void addTraceCommands(CLI::App& app) {
             "Write a trace as CSV, every column it holds: tick, time_ns, position (m, device "
             "frame), force (N), compute_ns, io_ns, status, buttons; version 2 traces also the "
             "proxy (m), velocity (m/s), orientation (quaternion), angular velocity (rad/s), "
-            "contact count and the sample flags (0/1)");
+            "contact count and the sample flags (0/1). A bodies.trace (the dynamic bodies): "
+            "time_s, id, x, y, z (centre of mass, m, world), qw, qx, qy, qz, vx, vy, vz (m/s), "
+            "wx, wy, wz (rad/s), one row per body per dynamics step");
         auto path = std::make_shared<std::string>();
         auto out = std::make_shared<std::string>();
         cmd->add_option("trace", *path, "The trace file")->required();
         cmd->add_option("-o,--output", *out, "CSV file to write (default: standard output)");
-        setExamples(cmd, {"hapto trace export traces/left.trace -o left.csv"});
-        cmd->callback([path, out] { exportCsv(*path, *out); });
+        setExamples(cmd, {"hapto trace export traces/left.trace -o left.csv",
+                          "hapto trace export traces/bodies.trace -o bodies.csv"});
+        cmd->callback([path, out] {
+            if (isBodyTrace(*path)) {
+                exportBodyCsv(*path, *out);
+            } else {
+                exportCsv(*path, *out);
+            }
+        });
     }
     {
         auto* cmd = trace->add_subcommand("info", "Describe a trace: device, rate, samples");

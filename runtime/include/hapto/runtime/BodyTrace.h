@@ -74,6 +74,17 @@ struct BodyTrace {
 /// another version, truncated, a body index out of range, a non-finite value). [control]
 BodyTrace readBodyTrace(const std::filesystem::path& path);
 
+/// True when `path` is a readable file beginning with the body trace's magic. [control]
+bool isBodyTrace(const std::filesystem::path& path);
+
+/// The CSV export's header row, newline included: `time_s,id,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,
+/// wy,wz`; time in s since the session started, id the scene object's, x,y,z its centre of
+/// mass (m, world), the rotation, the velocity (m/s) and the angular velocity (rad/s). [any
+/// thread]
+std::string bodyTraceCsvHeader();
+/// Appends one sample of `trace` as a CSV row (numbers that read back exactly). [any thread]
+void appendBodyTraceCsvRow(const BodyTrace& trace, const BodyTraceSample& sample, std::string& out);
+
 /// Writes DIR/bodies.trace from the dynamics thread's samples without ever making it wait.
 /// One producer thread (the dynamics thread or the stepping thread) and one consumer.
 class BodyTraceRecorder {
