@@ -33,6 +33,12 @@ struct DynamicsOptions {
     double sleepSpeedMPerS = 2e-3;     ///< A body slower than this (centre of mass) ...
     double sleepAngularRadPerS = 2e-2; ///< ... and turning slower than this ...
     double sleepAfterS = 0.5;          ///< ... for this long falls asleep (0: never sleeps).
+    /// Restitution acts on contacts closing faster than this (m/s): slower impacts end at
+    /// rest. Above g dt (0.01 m/s at 1 kHz), so a resting contact never bounces.
+    double restitutionThresholdMPerS = 0.05;
+    /// A new contact, or a sliding one, sticks (static friction, an anchor) when its
+    /// tangential speed is below this (m/s).
+    double stickSpeedMPerS = 1e-2;
 };
 
 /// One body's state (world frame). Plain value.
@@ -96,9 +102,16 @@ public:
     void applyImpulse(std::size_t i, const Vec3& linearNs, const Vec3& angularNms) noexcept;
     /// Wakes body i (and it stays awake for at least sleepAfterS).
     void wake(std::size_t i) noexcept;
+    /// Candidates and contacts a step had no room for, since the start (0 unless a body
+    /// touches more than the fixed capacities allow: 256 static items, 64 contact points
+    /// a body).
+    std::uint64_t droppedContacts() const noexcept;
+
+    struct Impl; ///< The solver's preallocated working state (dynamics/src/DynamicsImpl.h).
 
 private:
-    struct Impl;
+    void recordPenetration() noexcept;
+    void updateEnergyStats() noexcept;
     std::shared_ptr<const Scene> mScene;
     std::shared_ptr<const SpatialIndex> mIndex;
     DynamicsOptions mOptions;
