@@ -6,8 +6,9 @@
 // gives the face's polygon, its fan of outward triangles and its edges (each edge lies on two
 // faces and is kept once). Vertices are copies of input points (qh_pointid maps them back), so a
 // hull of a mesh's vertices has exactly the mesh's coordinates. Cost: qhull's O(n log n), then
-// O(h log h) for h hull vertices. qhull reports errors through its exit code and a message
-// stream; we give the message to nobody and say what is wrong in our own words.
+// O(f) for f facets (a merged facet's vertices sorted by angle). qhull reports errors through its
+// exit code and a message stream; we give the message to nobody and say what is wrong in our own
+// words.
 
 #include "hapto/scenes/ConvexHullOf.h"
 
@@ -20,7 +21,6 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <utility>
 
 extern "C" {
@@ -60,16 +60,24 @@ private:
     std::FILE* mErr = nullptr;
 };
 
-/// One facet's vertices (input point ids), ordered counter-clockwise about `n`.
+/// One facet's vertices (input point ids), ordered counter-clockwise about `n`: a triangle by
+/// the sign of its normal, a merged facet by angle about its centroid in its plane.
 std::vector<int> orderedFacet(qhT* qh, facetT* facet, const Vec3& n, std::span<const Vec3> points) {
     std::vector<int> ids;
     vertexT *vertex, **vertexp;
     FOREACHvertex_(facet->vertices) {
         ids.push_back(qh_pointid(qh, vertex->point));
     }
+    const auto at = [&points](int id) { return points[static_cast<std::size_t>(id)]; };
+    if (ids.size() == 3) {
+        if (glm::dot(glm::cross(at(ids[1]) - at(ids[0]), at(ids[2]) - at(ids[0])), n) < 0.0) {
+            std::swap(ids[1], ids[2]);
+        }
+        return ids;
+    }
     Vec3 c(0.0);
     for (const int id : ids) {
-        c += points[static_cast<std::size_t>(id)];
+        c += at(id);
     }
     c /= static_cast<double>(ids.size());
     const Vec3 u = glm::normalize(std::abs(n.x) < 0.9 ? glm::cross(n, Vec3(1, 0, 0))
@@ -77,7 +85,7 @@ std::vector<int> orderedFacet(qhT* qh, facetT* facet, const Vec3& n, std::span<c
     const Vec3 v = glm::cross(n, u);
     std::vector<std::pair<double, int>> byAngle;
     for (const int id : ids) {
-        const Vec3 d = points[static_cast<std::size_t>(id)] - c;
+        const Vec3 d = at(id) - c;
         byAngle.emplace_back(std::atan2(glm::dot(d, v), glm::dot(d, u)), id);
     }
     std::sort(byAngle.begin(), byAngle.end());
@@ -125,18 +133,19 @@ ConvexHullSurface convexHullOf(std::span<const Vec3> points) {
     }
     qhT* qh = q.get();
     ConvexHullSurface out;
-    std::unordered_map<int, std::uint32_t> dense; // input point id -> hull vertex index
+    constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+    std::vector<std::uint32_t> dense(points.size(), kNone); // input point id -> hull vertex
     facetT* facet;
     FORALLfacets {
         const Vec3 n(facet->normal[0], facet->normal[1], facet->normal[2]);
         std::vector<std::uint32_t> polygon;
         for (const int id : orderedFacet(qh, facet, n, points)) {
-            const auto [it, added] =
-                dense.try_emplace(id, static_cast<std::uint32_t>(out.hull.vertices.size()));
-            if (added) {
+            std::uint32_t& index = dense[static_cast<std::size_t>(id)];
+            if (index == kNone) {
+                index = static_cast<std::uint32_t>(out.hull.vertices.size());
                 out.hull.vertices.push_back(points[static_cast<std::size_t>(id)]);
             }
-            polygon.push_back(it->second);
+            polygon.push_back(index);
         }
         addFace(out, polygon, glm::normalize(n), -facet->offset);
     }

@@ -136,19 +136,6 @@ void checkSpeed(const Source& s, const Vec3& v, const Path& path, double limit, 
 
 } // namespace
 
-const char* BodyFields::firstKey() const {
-    const bool given[7] = {dynamic.has_value(),        massKg.has_value(),
-                           densityKgPerM3.has_value(), inertia.has_value(),
-                           restitution.has_value(),    velocity.has_value(),
-                           angularVelocity.has_value()};
-    for (std::size_t i = 0; i < kBodyKeys.size(); ++i) {
-        if (given[i]) {
-            return kBodyKeys[i];
-        }
-    }
-    return nullptr;
-}
-
 void refuseBeforeVersion3(const Source& s, const Path& fieldPath, const char* key) {
     s.fail(fieldPath, std::string("\"") + key +
                           "\" needs \"version\": 3 (dynamic bodies and gravity are new in "

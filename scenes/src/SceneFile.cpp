@@ -385,18 +385,19 @@ BodyFields readBodyFields(const Source& w, const Json& j, const Path& path) {
     return f;
 }
 
-/// Refuses version-3 fields in a file known to be older; remembers the first when the version
-/// is not known yet (checkTopLevel refuses it then).
-void gateBodyFields(const Source& w, const BodyFields& f, const Path& path, LoadContext& c) {
-    const char* key = f.firstKey();
-    if (!key) {
+/// Refuses version-3 fields in a file known to be older, before their values are read;
+/// remembers the first when the version is not known yet (checkTopLevel refuses it then).
+void gateBodyFields(const Source& w, const Json& j, const Path& path, LoadContext& c) {
+    const auto given = std::find_if(kBodyKeys.begin(), kBodyKeys.end(),
+                                    [&j](const char* key) { return optional(j, key) != nullptr; });
+    if (given == kBodyKeys.end()) {
         return;
     }
     if (c.version == 1 || c.version == 2) {
-        refuseBeforeVersion3(w, path / key, key);
+        refuseBeforeVersion3(w, path / *given, *given);
     }
     if (!c.firstBodyField) {
-        c.firstBodyField.emplace(c.objectIndex, key);
+        c.firstBodyField.emplace(c.objectIndex, *given);
     }
 }
 
@@ -482,9 +483,8 @@ SceneObject parseObject(const Source& w, const Json& j, const Path& path, LoadCo
         o.material.staticFriction = f[0];
         o.material.dynamicFriction = f[1];
     }
-    const BodyFields body = readBodyFields(w, j, path);
-    gateBodyFields(w, body, path, context);
-    applyBodyFields(w, o, body, path);
+    gateBodyFields(w, j, path, context);
+    applyBodyFields(w, o, readBodyFields(w, j, path), path);
     return o;
 }
 

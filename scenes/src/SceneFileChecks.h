@@ -58,11 +58,8 @@ struct BodyFields {
     std::optional<double> restitution;            ///< "restitution"
     std::optional<Vec3> velocity;                 ///< "velocity" (m/s)
     std::optional<Vec3> angularVelocity;          ///< "angular_velocity" (rad/s)
-
-    /// The first field given, in kBodyKeys' order, or nullptr when none is.
-    const char* firstKey() const;
 };
-/// An object's version-3 keys, in the order the writer writes them.
+/// An object's version-3 keys (the first given is the one a version check names).
 inline constexpr std::array<const char*, 7> kBodyKeys = {
     "dynamic",     "mass_kg",  "density_kg_per_m3", "inertia",
     "restitution", "velocity", "angular_velocity"};

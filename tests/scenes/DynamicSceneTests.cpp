@@ -514,3 +514,21 @@ TEST_CASE("the example scene: a dynamic box resting on a static floor") {
     CHECK(box.aabb().min.y == Approx(floorTop).margin(1e-12));
     CHECK(s.physics() == ScenePhysics{});
 }
+
+TEST_CASE("the user guide shows the example scene file") {
+    const auto squash = [](std::string t) {
+        t.erase(std::remove_if(t.begin(), t.end(), ::isspace), t.end());
+        return t;
+    };
+    const std::string guide =
+        test::guideJsonBlock("scenes.md", "### Dynamic bodies (version 3)", 0);
+    const std::string file = test::readFile(std::filesystem::path(HAPTO_SOURCE_DIR) / "scenes" /
+                                            "examples" / "dynamic_box_on_floor.json");
+    CHECK(squash(guide) == squash(file));
+}
+
+TEST_CASE("an older file is refused for a version 3 field before its value is looked at") {
+    checkRefused(R"({"format": "hapto-scene", "version": 2, "objects": [{"id": 0, "shape": "box",
+                     "center": [0,0,0], "half_extents": [1,1,1], "mass_kg": "heavy"}]})",
+                 "d.json: objects[0].mass_kg: \"mass_kg\" needs \"version\": 3");
+}
