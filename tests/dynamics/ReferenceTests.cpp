@@ -14,11 +14,14 @@
 //   penetration slop (hapto: 0.1 mm; Bullet: none, but one step's gravity sag g dt^2 = 0.01 mm
 //   before the split impulse pushes it back), and both remove only part of an overlap per step.
 // - Ramp: after 1 s a sliding box has moved a t^2 / 2 with a = g (sin - mu_d cos) within 2 %
-//   (Euler's bias is dt / t = 0.1 %; the rest is the solver's: 10 iterations over 4 contact
-//   points with a friction pyramid, not an exact cone); a holding one under 0.5 mm (creep).
-// - Stack: each box stays within 0.5 mm horizontally and 0.25 mm vertically of where it started
-//   over 2 s (vertical as the rest height; horizontal is what a solver's asymmetry lets creep;
-//   a stable stack has none, an unstable one walks off by centimetres).
+//   (Euler's bias is dt / t = 0.1 %; the rest is the solvers': iterations over 4 contact
+//   points, and how each starts the slide from rest; measured: Bullet -0.4 %, hapto -1.5 %),
+//   and hapto within 2 % of Bullet's; a holding one moves under 0.5 mm (creep).
+// - Stack: over 2 s each box stays within 0.5 mm horizontally of where it started (what a
+//   solver's asymmetry lets creep: a stable stack has none, an unstable one walks off by
+//   centimetres), and the k-th box from the floor within k * 0.1 mm + 0.05 mm vertically: each
+//   contact below it may keep hapto's 0.1 mm slop, plus the gravity sag of a step and what the
+//   partial correction has not yet removed (hapto measured 0.09, 0.17, 0.20 mm; Bullet 0.03).
 // - Bounce: the first apex after impact is e^2 h within 5 % (the impact speed is Euler's,
 //   sqrt(2gh) within g dt = 0.7 %, squared; the apex is sampled once a step).
 // - Free fall (before any contact): hapto and Bullet within 1e-9 m, the same integrator.
@@ -129,12 +132,12 @@ void checkHold(const Trajectory& t) {
 
 void checkStack(const std::vector<Trajectory>& boxes) {
     REQUIRE(boxes.size() == 3);
-    for (const Trajectory& t : boxes) {
-        const Drift d = driftOf(t);
-        INFO("box " << t.id << " drifted " << d.horizontalM << " m horizontally, " << d.verticalM
-                    << " m vertically");
+    for (std::size_t k = 0; k < boxes.size(); ++k) { // bottom to top
+        const Drift d = driftOf(boxes[k]);
+        INFO("box " << boxes[k].id << " drifted " << d.horizontalM << " m horizontally, "
+                    << d.verticalM << " m vertically");
         CHECK(d.horizontalM <= 5e-4);
-        CHECK(d.verticalM <= 2.5e-4);
+        CHECK(d.verticalM <= 1e-4 * static_cast<double>(k + 1) + 5e-5);
     }
 }
 
@@ -228,6 +231,18 @@ TEST_CASE("hapto vs Bullet: a box on a ramp holds when mu_s exceeds tan(theta)",
     const auto hapto = haptoRun(rampScene(kHoldAngle, 0.6, 0.5), 1000);
     REQUIRE(hapto.size() == 1);
     checkHold(hapto[0]);
+}
+
+TEST_CASE("hapto vs Bullet: a box on a ramp slides as far as Bullet's in 1 s", "[reference]") {
+    const Scene scene = rampScene(kSlideAngle, kSlideMuS, kSlideMuD);
+    const auto hapto = haptoRun(scene, 1000);
+    const auto bullet = bulletRun(scene, 1000);
+    REQUIRE(hapto.size() == 1);
+    checkSlide(hapto[0]);
+    const double h = rampDisplacementM(hapto[0], kSlideAngle);
+    const double b = rampDisplacementM(bullet[0], kSlideAngle);
+    INFO("hapto slid " << h << " m, Bullet " << b << " m");
+    CHECK(std::abs(h - b) <= 0.02 * kSlideAccel / 2);
 }
 
 TEST_CASE("hapto vs Bullet: a stack of three boxes stays put as Bullet's does", "[reference]") {
