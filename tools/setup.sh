@@ -29,6 +29,7 @@ main_packages=(
 test_packages=(
   git catch2 gnuplot-nox libbenchmark-dev libbullet-dev libfcl-dev libboost-dev
   umockdev libumockdev-dev libglib2.0-dev libjs-three chromium python3 doxygen
+  python3-dev python3-numpy python3-pytest pybind11-dev python3-matplotlib
 )
 packages=("${main_packages[@]}")
 [ "$mode" = test ] && packages+=("${test_packages[@]}")
