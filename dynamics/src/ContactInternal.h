@@ -40,6 +40,12 @@ public:
     explicit Polytope(const ConvexShape& shape) noexcept;
 
     bool degenerate() const noexcept { return mDegenerate; }
+    /// The hull of a Hull shape, else null.
+    const ConvexHull* hull() const noexcept {
+        return mShape.kind == ConvexShape::Kind::Hull ? mShape.hull : nullptr;
+    }
+    /// Turns a vector of the shape's own frame into world coordinates.
+    Vec3 toWorld(const Vec3& local) const noexcept { return mShape.axes * local; }
     bool isTriangle() const noexcept { return mShape.kind == ConvexShape::Kind::Triangle; }
     /// True for a one-sided triangle (its only face is +n).
     bool oneSided() const noexcept { return mOneSided; }

@@ -29,11 +29,11 @@
 //
 // Cost: the face axes F(a) V(b) + F(b) V(a) dot products, the edge axes E(a) E(b) (V(a) +
 // V(b)) (a box: 6 faces, 3 edge directions, an O(1) support function), clipping O(face
-// corners^2). A hull of tens of vertices is thus fine against boxes and triangles but slow
-// against another hull; Gregorius's Gauss-map pruning ("The Separating Axis Test between
-// Convex Polyhedra", GDC 2013) would test only the edge pairs that build a face of the
-// Minkowski difference in O(1) each, and needs each edge's two faces, which ConvexHull does
-// not store.
+// corners^2). Between two hulls of at most kGaussEdgeMax edges, Gregorius's Gauss-map pruning
+// ("The Separating Axis Test between Convex Polyhedra", GDC 2013) keeps only the edge pairs
+// that build a face of the Minkowski difference (the others never realise the separation):
+// each edge's two faces are found per call, E F plane tests, since ConvexHull does not store
+// them; larger hulls test every pair.
 //
 // Features: a face point is (side of the reference << 31) | reference face << 23 | incident
 // face << 15 | corner tag (an incident corner, or the clipping plane and the edge it cut); an
@@ -93,12 +93,71 @@ FaceQuery queryFaces(const Polytope& p, const Polytope& q, double margin, const 
     return best;
 }
 
-// Best edge-pair axis; sets `apart` when some axis separates by more than the margin.
+// Each edge's two face normals (world) for Gregorius's Gauss-map test, hull-hull only.
+constexpr int kGaussEdgeMax = 512; // 2 x 24 KB of stack per call
+struct EdgeFaces {
+    std::array<Vec3, kGaussEdgeMax> n1;
+    std::array<Vec3, kGaussEdgeMax> n2;
+};
+
+// Fills `out` for a hull of at most kGaussEdgeMax edges each lying on exactly two faces; false
+// otherwise (then every edge pair is tested).
+bool edgeFaces(const Polytope& p, EdgeFaces& out) noexcept {
+    const ConvexHull* hull = p.hull();
+    if (hull == nullptr || hull->edges.size() > static_cast<std::size_t>(kGaussEdgeMax)) {
+        return false;
+    }
+    double size = 0.0;
+    for (const Vec3& v : hull->vertices) {
+        size = std::max(size, glm::length(v));
+    }
+    const double tol = 1e-6 * size;
+    for (std::size_t e = 0; e < hull->edges.size(); ++e) {
+        const Vec3& s = hull->vertices[hull->edges[e][0]];
+        const Vec3& t = hull->vertices[hull->edges[e][1]];
+        int found = 0;
+        for (const ConvexHull::Face& f : hull->faces) {
+            if (std::abs(glm::dot(f.normal, s) - f.offset) <= tol &&
+                std::abs(glm::dot(f.normal, t) - f.offset) <= tol) {
+                (found == 0 ? out.n1 : out.n2)[e] = p.toWorld(f.normal);
+                if (++found == 2) {
+                    break;
+                }
+            }
+        }
+        if (found != 2) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// True when the arcs (a, b) and (c, d) of the Gauss map cross: the two edges build a face of
+// the Minkowski difference (Gregorius, GDC 2013; c, d are the negated normals of b's edge).
+bool minkowskiFace(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) noexcept {
+    const Vec3 bxa = glm::cross(b, a);
+    const Vec3 dxc = glm::cross(d, c);
+    const double cba = glm::dot(c, bxa);
+    const double dba = glm::dot(d, bxa);
+    const double adc = glm::dot(a, dxc);
+    const double bdc = glm::dot(b, dxc);
+    return cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0;
+}
+
+// Best edge-pair axis; sets `apart` when some axis separates by more than the margin. Between
+// two hulls whose edges' faces are known, only the pairs building a Minkowski face are axes
+// (the others never realise the separation); otherwise every pair of edge directions.
 EdgeQuery queryEdges(const Polytope& a, const Polytope& b, double margin, bool& apart) noexcept {
     EdgeQuery best;
+    EdgeFaces fa;
+    EdgeFaces fb;
+    const bool gauss = edgeFaces(a, fa) && edgeFaces(b, fb);
     for (int i = 0; i < a.edgeDirCount(); ++i) {
         const Vec3 da = a.edgeDir(i);
         for (int j = 0; j < b.edgeDirCount(); ++j) {
+            if (gauss && !minkowskiFace(fa.n1[at(i)], fa.n2[at(i)], -fb.n1[at(j)], -fb.n2[at(j)])) {
+                continue;
+            }
             const Vec3 db = b.edgeDir(j);
             const Vec3 cross = glm::cross(da, db);
             const double len = glm::length(cross);
