@@ -81,6 +81,8 @@ Dynamics::Dynamics(std::shared_ptr<const Scene> scene, std::shared_ptr<const Spa
         mImpl->work.push_back(bodyWorkOf(o));
     }
     mImpl->scene = mScene.get();
+    mImpl->index = mIndex.get();
+    mImpl->seenStamp.assign(mScene->itemCount(), 0);
     const std::size_t n = std::max<std::size_t>(mBodies.size(), 1);
     mStats.resize(mBodies.size());
     mImpl->candidates.reserve(n * dyn::kCandidatesPerBody);

@@ -4,16 +4,21 @@
 // Design note. A body's box is its shape's tightest AABB grown by the speculative margin plus
 // the distance it can travel in one step, (|v| + |w| r) dt for r its bounding radius, so any
 // surface it could reach before the next step is a candidate (speculative contacts need it).
-// Static candidates are items of the scene whose object is not dynamic; items of dynamic
-// objects are skipped. TEMPORARY: until the index has a box query (SpatialIndex::visitLeaves,
-// helper C), the candidates come from a loop over the scene's items, O(items) a body; the
-// switch keeps the same order (ascending item) so results stay deterministic. Body pairs are
-// tested in findContacts. Invariants: no allocation (the candidate list has a fixed capacity;
-// the excess is counted, never stored); a sleeping body gathers nothing.
+// Static candidates come from the shared index's box query (SpatialIndex::visitLeaves, plus
+// outsideObjects() where the box leaves the index's bounds): items of dynamic objects are
+// skipped, an item met in several leaves is taken once (a stamp per item, sized by the
+// constructor), and each body's candidates are sorted by item, so the contacts and their order
+// do not depend on the index's kind or leaf order. Body pairs are tested in findContacts
+// (every pair's swept boxes: O(bodies^2), fine for the tens of bodies here). Invariants: no
+// allocation (the candidate list has a fixed capacity; the excess is counted, never stored);
+// a sleeping body gathers nothing.
 
 #include "DynamicsImpl.h"
 
 #include <glm/gtc/quaternion.hpp>
+
+#include <algorithm>
+#include <cstddef>
 
 namespace hapto::dyn {
 
@@ -71,27 +76,60 @@ static Aabb sweptBox(const BodyWork& w, const BodyState& b, double marginM, doub
     return box;
 }
 
+namespace {
+
+// Adds `item` as a candidate of `body` if it is static, new for this body and its box
+// overlaps the body's swept box.
+void consider(const Scene& scene, Dynamics::Impl& impl, std::uint32_t body,
+              std::uint32_t item) noexcept {
+    const std::uint32_t dense =
+        isTriangleItem(item) ? scene.size() + (item & ~kTriangleItemBit) : item;
+    if (impl.seenStamp[dense] == impl.stamp) {
+        return; // already seen through another leaf
+    }
+    impl.seenStamp[dense] = impl.stamp;
+    if (scene.object(scene.objectSlotOf(item)).body.dynamic ||
+        !overlaps(impl.work[body].sweptBox, itemBox(scene, item))) {
+        return;
+    }
+    if (impl.candidates.size() == impl.candidates.capacity()) {
+        ++impl.droppedCandidates;
+        return;
+    }
+    impl.candidates.push_back({body, item});
+}
+
+// Body i's static candidates through the index's box query, in ascending item order.
+void gatherBody(const Scene& scene, Dynamics::Impl& impl, std::uint32_t i) noexcept {
+    ++impl.stamp;
+    const std::size_t begin = impl.candidates.size();
+    const Aabb& box = impl.work[i].sweptBox;
+    auto visit = [&](std::uint32_t leaf) {
+        for (const std::uint32_t item : impl.index->leafObjects(leaf)) {
+            consider(scene, impl, i, item);
+        }
+        return true;
+    };
+    impl.index->visitLeavesWith(box, visit);
+    if (impl.index->reachesOutside(box)) {
+        for (const std::uint32_t item : impl.index->outsideObjects()) {
+            consider(scene, impl, i, item);
+        }
+    }
+    // Ascending items: the same contacts in the same order whatever the index's leaf order.
+    std::sort(impl.candidates.begin() + static_cast<std::ptrdiff_t>(begin), impl.candidates.end(),
+              [](const Candidate& a, const Candidate& b) { return a.item < b.item; });
+}
+
+} // namespace
+
 void gatherCandidates(const Scene& scene, std::span<const BodyState> bodies, Dynamics::Impl& impl,
                       const DynamicsOptions& options, double dtS) noexcept {
     impl.candidates.clear();
-    const std::size_t capacity = impl.candidates.capacity();
     for (std::uint32_t i = 0; i < bodies.size(); ++i) {
         impl.work[i].sweptBox = sweptBox(impl.work[i], bodies[i], options.speculativeMarginM, dtS);
-        if (!moves(bodies[i]) || impl.work[i].sweptBox.isEmpty()) {
-            continue;
-        }
-        // TEMPORARY loop over the scene's items until the index's box query lands.
-        for (std::uint32_t k = 0; k < scene.itemCount(); ++k) {
-            const std::uint32_t item = scene.item(k);
-            if (!scene.isIndexed(item) || scene.object(scene.objectSlotOf(item)).body.dynamic ||
-                !overlaps(impl.work[i].sweptBox, itemBox(scene, item))) {
-                continue;
-            }
-            if (impl.candidates.size() == capacity) {
-                ++impl.droppedCandidates;
-                continue;
-            }
-            impl.candidates.push_back({i, item});
+        if (moves(bodies[i]) && !impl.work[i].sweptBox.isEmpty()) {
+            gatherBody(scene, impl, i);
         }
     }
 }

@@ -86,10 +86,13 @@ struct Candidate {
 namespace hapto {
 
 struct Dynamics::Impl {
-    const Scene* scene = nullptr;                     // the dynamics' scene (static materials)
-    std::vector<dyn::BodyWork> work;                  // by body
-    std::vector<dyn::Candidate> candidates;           // capacity fixed
-    std::vector<dyn::ContactWork> contacts, previous; // capacity fixed
+    const Scene* scene = nullptr;           // the dynamics' scene (static materials)
+    const SpatialIndex* index = nullptr;    // the static items' index (broad phase)
+    std::vector<std::uint64_t> seenStamp;   // by dense item position: last gathering that saw it
+    std::uint64_t stamp = 0;                // this gathering's stamp
+    std::vector<dyn::BodyWork> work;        // by body
+    std::vector<dyn::Candidate> candidates; // capacity fixed
+    std::vector<dyn::ContactWork> contacts, previous;         // capacity fixed
     std::vector<dyn::FrictionPatch> patches, previousPatches; // capacity fixed
     std::uint64_t droppedContacts = 0;
     std::uint64_t droppedCandidates = 0;

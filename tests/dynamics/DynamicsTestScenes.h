@@ -9,6 +9,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace hapto::test {
@@ -55,21 +56,36 @@ inline SceneObject dynamicSphere(ObjectId id, Vec3 center, double radius, double
     return o;
 }
 
-/// A scene over the objects with the given gravity (m/s^2) and rate (Hz), its default index
-/// and the Dynamics stepping it.
+/// A static mesh object with the 12 triangles of box `b`'s surface, wound outward (a closed
+/// mesh: contacts push out of it only).
+inline SceneObject meshOfBox(const SceneObject& b) {
+    std::vector<Vec3> v;
+    for (int k = 0; k < 8; ++k) {
+        v.push_back(b.halfExtents * Vec3(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1));
+    }
+    std::vector<TriangleIndices> t{{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6},
+                                   {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},
+                                   {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    return makeMesh(b.id, b.center, TriangleMesh::make(std::move(v), std::move(t), {}, "box"),
+                    b.rotation, b.material);
+}
+
+/// A scene over the objects with the given gravity (m/s^2) and rate (Hz), an index (the
+/// default unless `indexSpec` names one) and the Dynamics stepping it.
 struct World {
     std::shared_ptr<Scene> scene;
     std::unique_ptr<Dynamics> dynamics;
 
     explicit World(std::vector<SceneObject> objects, Vec3 gravity = Vec3(0.0, -kG, 0.0),
-                   DynamicsOptions options = {}, double rateHz = 1000.0) {
+                   DynamicsOptions options = {}, double rateHz = 1000.0,
+                   std::string indexSpec = {}) {
         scene = std::make_shared<Scene>(Scene::defaultBounds(objects), std::move(objects));
         ScenePhysics physics;
         physics.gravity = gravity;
         physics.rateHz = rateHz;
         scene->setPhysics(physics);
-        std::shared_ptr<const SpatialIndex> index =
-            buildIndex(*scene, IndexSpec::parse(defaultIndexSpec(*scene)));
+        std::shared_ptr<const SpatialIndex> index = buildIndex(
+            *scene, IndexSpec::parse(indexSpec.empty() ? defaultIndexSpec(*scene) : indexSpec));
         dynamics = std::make_unique<Dynamics>(scene, index, options);
     }
 
