@@ -1,4 +1,6 @@
-// `hapto view`: the view's page over a recorded session, with play, pause and a time slider.
+// `hapto view`: the view's page over a recorded session, with play, pause and a time slider;
+// the devices' traces and, when the folder (or the list) has one, the dynamic bodies'
+// (bodies.trace, told from a device trace by its magic).
 
 #include "Commands.h"
 #include "Options.h"
@@ -7,6 +9,7 @@
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/TraceReader.h"
 #include "hapto/io/InputError.h"
+#include "hapto/runtime/BodyTrace.h"
 #include "hapto/runtime/DeviceFile.h"
 #include "hapto/view/ViewDocuments.h"
 #include "hapto/view/ViewServer.h"
@@ -15,6 +18,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
 namespace hapto::cli {
@@ -52,6 +56,23 @@ std::vector<std::filesystem::path> traceFiles(const std::vector<std::string>& na
     return files;
 }
 
+// The body trace among `files`, taken out of them (at most one).
+std::optional<BodyTrace> takeBodyTrace(std::vector<std::filesystem::path>& files) {
+    std::optional<BodyTrace> bodies;
+    for (auto it = files.begin(); it != files.end();) {
+        if (!isBodyTrace(*it)) {
+            ++it;
+            continue;
+        }
+        if (bodies) {
+            throw InputError(it->string() + ": a second body trace; give one session's traces");
+        }
+        bodies = readBodyTrace(*it);
+        it = files.erase(it);
+    }
+    return bodies;
+}
+
 void runView(const ViewCommandArgs& a) {
     StopSignals signals; // before the server's threads start
     const Scene scene = loadSceneOrDefault(a.scene);
@@ -62,7 +83,9 @@ void runView(const ViewCommandArgs& a) {
         a.devices.empty() ? defaultDeviceConfigs() : loadDeviceFile(a.devices).devices;
     std::vector<ViewTrace> traces;
     std::vector<ViewDevice> devices;
-    for (const auto& file : traceFiles(a.traces)) {
+    std::vector<std::filesystem::path> files = traceFiles(a.traces);
+    const std::optional<BodyTrace> bodies = takeBodyTrace(files);
+    for (const auto& file : files) {
         ViewTrace t;
         t.samples = TraceReader::load(file, &t.header);
         for (const DeviceConfig& c : configs) {
@@ -80,7 +103,8 @@ void runView(const ViewCommandArgs& a) {
     signals.endStartUp();       // a signal from now on stops the server in order
     ViewServer server(options);
     server.setDocument("/scene.json", viewSceneJson(scene, devices, ViewMode::Trace));
-    server.setDocument("/trace.json", viewTraceJson(scene, traces));
+    server.setDocument("/trace.json",
+                       viewTraceJson(scene, traces, 60.0, bodies ? &*bodies : nullptr));
     server.start();
     if (!isLoopbackAddress(a.view.bindAddress)) {
         std::fprintf(stderr,
@@ -88,7 +112,8 @@ void runView(const ViewCommandArgs& a) {
                      "who can reach port %d can watch this recording\n",
                      a.view.bindAddress.c_str(), server.port());
     }
-    std::fprintf(stderr, "hapto view: %zu trace(s) on %s%s\n", traces.size(), server.url().c_str(),
+    std::fprintf(stderr, "hapto view: %zu trace(s)%s on %s%s\n", traces.size(),
+                 bodies ? " and the dynamic bodies" : "", server.url().c_str(),
                  a.durationS > 0 ? "" : " (Ctrl-C to stop)");
     std::fflush(stderr);
     const auto start = std::chrono::steady_clock::now();

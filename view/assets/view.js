@@ -319,7 +319,12 @@ function playTrace(trace) {
   };
   const show = () => {
     const devices = trace.devices.map(d => d.frames.length ? at(d.frames, t) : { ticks: 0, misses: 0, loadP50: 0, loadP999: 0 });
-    showFrame({ t }, devices);
+    // The dynamic bodies (bodies.trace): each at its newest pose at or before t.
+    const poses = (trace.bodies || []).filter(b => b.frames.length).map(b => {
+      const f = at(b.frames, t);
+      return { id: b.id, center: f.center, rotation: f.rotation, moving: true };
+    });
+    showFrame({ t, poses }, devices);
     slider.value = String(Math.round(1000 * t / duration));
     clock.textContent = t.toFixed(2) + ' s';
     clock.dataset.t = String(t);

@@ -1,4 +1,5 @@
-// The live view's feed thread (LiveFeed.h).
+// The live view's feed thread (LiveFeed.h). Each frame carries the devices' figures and the
+// poses of what moves: objects the world moves, and the dynamic bodies at their live pose.
 
 #include "hapto/view/LiveFeed.h"
 
@@ -18,6 +19,23 @@ std::uint64_t steadyNs() {
     return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                           std::chrono::steady_clock::now().time_since_epoch())
                                           .count());
+}
+
+/// The dynamic bodies at their latest published pose (Runtime::bodyPoses, read without
+/// locks), as the frame's poses: the view places each object by its id. Moving unless asleep.
+void appendBodyPoses(const Runtime& runtime, nlohmann::json& poses) {
+    const BodyPoseTable* table = runtime.bodyPoses();
+    if (!table) {
+        return;
+    }
+    const std::span<const ObjectId> ids = runtime.bodyIds();
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+        const BodyPose p = table->read(i);
+        poses.push_back({{"id", ids[i]},
+                         {"center", vec(p.center)},
+                         {"rotation", {p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z}},
+                         {"moving", !p.sleeping}});
+    }
 }
 
 } // namespace
@@ -193,6 +211,7 @@ std::string LiveFeed::frame(std::uint64_t sessionNs) {
                              {"moving", p.moving}});
         }
     }
+    appendBodyPoses(mRuntime, poses); // after the world's: a body's pose is its live one
     return nlohmann::json{
         {"t", static_cast<double>(sessionNs) * 1e-9}, {"devices", devices}, {"poses", poses}}
         .dump();

@@ -282,8 +282,49 @@ std::string viewSceneJson(const Scene& scene, const std::vector<ViewDevice>& dev
     return doc.dump();
 }
 
-std::string viewTraceJson(const Scene& scene, const std::vector<ViewTrace>& traces,
-                          double frameHz) {
+namespace {
+
+/// Each body's frames: at most one per frame time, and its last sample.
+nlohmann::json bodyFramesJson(const Scene& scene, const BodyTrace& trace, double frameHz,
+                              double& durationS) {
+    const auto frameNs = static_cast<std::uint64_t>(1e9 / frameHz);
+    nlohmann::json bodies = nlohmann::json::array();
+    for (std::uint32_t b = 0; b < trace.ids.size(); ++b) {
+        const auto slot = scene.slotOf(trace.ids[b]);
+        const Vec3 comLocal = slot ? scene.object(*slot).body.centerOfMassLocal : Vec3(0.0);
+        nlohmann::json frames = nlohmann::json::array();
+        std::uint64_t nextFrameNs = 0;
+        const BodyTraceSample* last = nullptr;
+        const auto push = [&](const BodyTraceSample& s) {
+            const Quat& q = s.rotation;
+            frames.push_back({{"t", static_cast<double>(s.timeNs) * 1e-9},
+                              {"center", vec(s.centerOfMass - glm::mat3_cast(q) * comLocal)},
+                              {"rotation", {q.w, q.x, q.y, q.z}}});
+            durationS = std::max(durationS, static_cast<double>(s.timeNs) * 1e-9);
+        };
+        for (const BodyTraceSample& s : trace.samples) {
+            if (s.body != b) {
+                continue;
+            }
+            last = &s;
+            if (frames.empty() || s.timeNs >= nextFrameNs) {
+                push(s);
+                nextFrameNs = s.timeNs + frameNs;
+                last = nullptr;
+            }
+        }
+        if (last) {
+            push(*last); // the player ends where the body ended
+        }
+        bodies.push_back({{"id", trace.ids[b]}, {"frames", frames}});
+    }
+    return bodies;
+}
+
+} // namespace
+
+std::string viewTraceJson(const Scene& scene, const std::vector<ViewTrace>& traces, double frameHz,
+                          const BodyTrace* bodyTrace) {
     nlohmann::json devices = nlohmann::json::array();
     double durationS = 0;
     for (const ViewTrace& trace : traces) {
@@ -327,8 +368,12 @@ std::string viewTraceJson(const Scene& scene, const std::vector<ViewTrace>& trac
         devices.push_back(
             {{"name", trace.header.name}, {"rateHz", trace.header.rateHz}, {"frames", frames}});
     }
-    return nlohmann::json{{"durationS", durationS}, {"frameHz", frameHz}, {"devices", devices}}
-        .dump();
+    nlohmann::json out{{"frameHz", frameHz}, {"devices", devices}};
+    if (bodyTrace) {
+        out["bodies"] = bodyFramesJson(scene, *bodyTrace, frameHz, durationS);
+    }
+    out["durationS"] = durationS;
+    return out.dump();
 }
 
 } // namespace hapto

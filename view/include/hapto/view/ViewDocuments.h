@@ -4,6 +4,7 @@
 
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/TraceFormat.h"
+#include "hapto/runtime/BodyTrace.h"
 #include "hapto/scenes/Scene.h"
 
 #include <string>
@@ -50,8 +51,11 @@ struct ViewTrace {
 /// period) and the misses so far: the runtime's rule (a force written after the next deadline;
 /// the deadlines move past the slots a late force overran) over deadlines rebuilt from the
 /// recorded wake-ups, starting at the first tick's (ViewDocuments.cpp, MissCounter). A trace
-/// records no cursor leaves or candidates; the frames carry none. [control]
+/// records no cursor leaves or candidates; the frames carry none. With `bodies` (a
+/// bodies.trace, BodyTrace.h), also each dynamic body's frames at `frameHz`: time (s), the
+/// object's centre (from the recorded centre of mass and the scene object's
+/// BodyProperties::centerOfMassLocal) and rotation, for the player to place it. [control]
 std::string viewTraceJson(const Scene& scene, const std::vector<ViewTrace>& traces,
-                          double frameHz = 60.0);
+                          double frameHz = 60.0, const BodyTrace* bodies = nullptr);
 
 } // namespace hapto
