@@ -42,16 +42,6 @@ double distanceToSkin(const RenderBody& o, const Vec3& p) {
                : boxDistanceOutside(o.obb(), p, kSkinM);
 }
 
-/// Distance (m) from p to an item's skin, 0 inside, read from the scene.
-double itemDistanceToSkin(const Scene& scene, std::uint32_t item, const Vec3& p) {
-    if (isTriangleItem(item)) {
-        const WorldFace tp = scene.triangleFace(item);
-        return triangleSkinDistance(
-            tp.normal, tp.offset, [&] { return fetchTriangle(scene, item, tp.normal); }, p, kSkinM);
-    }
-    return distanceToSkin(scene.body(item), p);
-}
-
 /// True when a span before span s lists the item: it was decided there (the same test gives
 /// the same answer). Leaf lists are sorted; an unsorted span (the moving list) is only ever
 /// not found in.
@@ -63,6 +53,56 @@ bool listedEarlier(const CandidateSet& candidates, std::size_t s, std::uint32_t 
 }
 
 } // namespace
+
+const RenderBody& GodObjectRenderer::bodyAt(const Scene& scene, std::uint32_t slot) const noexcept {
+    if (mDynamic != nullptr && mDynamic->count > 0) {
+        if (const DynamicBodySet::Entry* e = mDynamic->find(slot)) {
+            return e->render;
+        }
+    }
+    return scene.body(slot);
+}
+
+void GodObjectRenderer::poseAt(const Scene& scene, std::uint32_t slot, Vec3& center,
+                               Quat& rotation) const noexcept {
+    const DynamicBodySet::Entry* e = mDynamic != nullptr ? mDynamic->find(slot) : nullptr;
+    center = e != nullptr ? e->center : scene.object(slot).center;
+    rotation = e != nullptr ? e->rotation : scene.object(slot).rotation;
+}
+
+WorldFace GodObjectRenderer::faceAt(const Scene& scene, std::uint32_t item) const noexcept {
+    if (mDynamic == nullptr || mDynamic->count == 0) {
+        return scene.triangleFace(item);
+    }
+    // Scene::triangleFace with the placed body: the same arithmetic, another pose.
+    const TriangleRef ref = scene.triangle(item);
+    const RenderBody& b = bodyAt(scene, ref.objectSlot);
+    const TriangleFace& f = scene.object(ref.objectSlot).mesh->face(ref.triangle);
+    const Vec3 n = b.rotate(f.normal);
+    return {n, f.offset + glm::dot(n, b.center)};
+}
+
+std::array<Vec3, 3> GodObjectRenderer::cornersAt(const Scene& scene,
+                                                 std::uint32_t item) const noexcept {
+    if (mDynamic == nullptr || mDynamic->count == 0) {
+        return scene.triangleCorners(item);
+    }
+    const TriangleRef ref = scene.triangle(item);
+    const RenderBody& b = bodyAt(scene, ref.objectSlot);
+    const auto [p, q, r] = scene.object(ref.objectSlot).mesh->corners(ref.triangle);
+    return {b.toWorld(p), b.toWorld(q), b.toWorld(r)};
+}
+
+bool GodObjectRenderer::skipItem(const Scene& scene, std::uint32_t item) const noexcept {
+    if (mDynamic == nullptr || !mDynamic->active) {
+        return false;
+    }
+    if (isTriangleItem(item)) {
+        return validItem(scene, item) && scene.object(scene.triangle(item).objectSlot).body.dynamic;
+    }
+    return item < scene.size() && scene.object(item).body.dynamic &&
+           mDynamic->find(item) == nullptr;
+}
 
 /// The scene numbers triangles mesh by mesh in slot order, so a binary search over the numbers
 /// finds a mesh's first. O(log triangles x log meshes).
@@ -83,7 +123,13 @@ std::uint32_t godobject::firstTriangleItem(const Scene& scene, std::uint32_t slo
 double GodObjectRenderer::distanceToSkinOf(const Scene& scene, std::uint32_t item,
                                            std::uint32_t near, const Vec3& p) const noexcept {
     if (near == kNotCached) {
-        return itemDistanceToSkin(scene, item, p);
+        if (!isTriangleItem(item)) {
+            return distanceToSkin(bodyAt(scene, item), p);
+        }
+        const WorldFace tp = faceAt(scene, item);
+        return triangleSkinDistance(
+            tp.normal, tp.offset, [&] { return fetchTriangle(cornersAt(scene, item), tp.normal); },
+            p, kSkinM);
     }
     const NearTriangle& t = mTriangleData[near];
     return triangleSkinDistance(
@@ -138,7 +184,7 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
             if (mNearOverflow) {
                 break;
             }
-            if (listedEarlier(candidates, s, item)) {
+            if (listedEarlier(candidates, s, item) || skipItem(scene, item)) {
                 continue;
             }
             if (isTriangleItem(item)) {
@@ -165,20 +211,20 @@ void GodObjectRenderer::considerTriangle(const Scene& scene, std::uint32_t item,
         t->item = item;
         t->hasCorners = false;
         t->hasEdges = false;
-        t->face = scene.triangleFace(item);
+        t->face = faceAt(scene, item);
         mTriangleCount = k + 1;
     }
     // The distance to the plane bounds the distance to the triangle: most candidates end at
     // one dot product.
-    const WorldFace f = t ? t->face : scene.triangleFace(item);
+    const WorldFace f = t ? t->face : faceAt(scene, item);
     if (std::abs(glm::dot(f.normal, center) - f.offset) > triangleReach) {
         return;
     }
     if (t && !t->hasCorners) {
-        t->corners = scene.triangleCorners(item);
+        t->corners = cornersAt(scene, item);
         t->hasCorners = true;
     }
-    const std::array<Vec3, 3> v = t ? t->corners : scene.triangleCorners(item);
+    const std::array<Vec3, 3> v = t ? t->corners : cornersAt(scene, item);
     // A corner well inside the ball (by far more than rounding) makes the triangle near
     // without the closest-point test.
     const double r2 = triangleReach * triangleReach;
@@ -197,7 +243,7 @@ void GodObjectRenderer::considerTriangle(const Scene& scene, std::uint32_t item,
 
 void GodObjectRenderer::considerObject(const Scene& scene, std::uint32_t item,
                                        double radius) noexcept {
-    const RenderBody& o = scene.body(item);
+    const RenderBody& o = bodyAt(scene, item);
     const double reach = radius + o.radius + kSkinM;
     if (length2(o.center - mNearCenter) > reach * reach) {
         return;

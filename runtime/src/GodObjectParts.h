@@ -39,10 +39,9 @@ inline bool insideSkin(const RenderBody& o, const Vec3& p) {
                : boxStrictlyContains(o.obb(), p, kSkinM - kShrinkM);
 }
 
-/// A triangle's corners and edges read from the scene (m, world), for one not in the near
-/// list's copy.
-inline TriangleGeometry fetchTriangle(const Scene& scene, std::uint32_t item, const Vec3& normal) {
-    const std::array<Vec3, 3> v = scene.triangleCorners(item);
+/// A triangle's corners and edges (m, world) from its corners, for one not in the near list's
+/// copy.
+inline TriangleGeometry fetchTriangle(const std::array<Vec3, 3>& v, const Vec3& normal) {
     return {v, triangleEdges(v, normal)};
 }
 
@@ -75,7 +74,7 @@ void GodObjectRenderer::forEachMeshTriangleNear(const Scene& scene, std::uint32_
     }
     // In the mesh's own frame: distances are the same there, and nothing is transformed but
     // the one point.
-    const Vec3 local = scene.body(slot).toLocal(center);
+    const Vec3 local = bodyAt(scene, slot).toLocal(center);
     const double reach = radius + godobject::kSkinM;
     const std::uint32_t first = godobject::firstTriangleItem(scene, slot);
     const TriangleMesh& mesh = *o.mesh;
@@ -103,6 +102,9 @@ void GodObjectRenderer::forEachNear(const Scene& scene, const CandidateSet& cand
     const std::uint32_t n = scene.size();
     for (std::size_t s = 0; s < candidates.count && s < CandidateSet::kMaxSpans; ++s) {
         for (const std::uint32_t item : candidates.spans[s]) {
+            if (skipItem(scene, item)) {
+                continue;
+            }
             if (isTriangleItem(item)) {
                 if (godobject::validItem(scene, item)) {
                     fn(item, kNotCached);

@@ -80,12 +80,13 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
                 t.face.normal, t.face.offset, [&]() -> const NearTriangle& { return t; }, from, to,
                 kSkinM, kShrinkM, kOnM);
         } else if (isTriangleItem(item)) {
-            const WorldFace tp = scene.triangleFace(item);
+            const WorldFace tp = faceAt(scene, item);
             e = sweepTriangleFront(
-                tp.normal, tp.offset, [&] { return fetchTriangle(scene, item, tp.normal); }, from,
-                to, kSkinM, kShrinkM, kOnM);
+                tp.normal, tp.offset,
+                [&] { return fetchTriangle(cornersAt(scene, item), tp.normal); }, from, to, kSkinM,
+                kShrinkM, kOnM);
         } else {
-            const RenderBody& o = scene.body(item);
+            const RenderBody& o = bodyAt(scene, item);
             if (o.shape == Shape::Sphere) {
                 e = sweepSphere(o.center, o.halfExtents.x, from, to, kSkinM, kShrinkM);
             } else {
@@ -106,7 +107,7 @@ bool GodObjectRenderer::covered(const Scene& scene, const CandidateSet& candidat
     // Boxes and spheres only: flush meshes are not looked for (see DESIGN, "Triangles").
     forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t) {
         if (!inside && item != self && !isTriangleItem(item)) {
-            inside = insideSkin(scene.body(item), probe);
+            inside = insideSkin(bodyAt(scene, item), probe);
         }
     });
     return inside;
@@ -153,14 +154,14 @@ bool GodObjectRenderer::addHitPlanes(const Scene& scene, const CandidateSet& can
                                      const Vec3& goal) noexcept {
     if (isTriangleItem(hit.item)) {
         const WorldFace tp =
-            hit.near != kNotCached ? mTriangleData[hit.near].face : scene.triangleFace(hit.item);
+            hit.near != kNotCached ? mTriangleData[hit.near].face : faceAt(scene, hit.item);
         if (!s.addPlane({tp.normal, tp.offset + kSkinM, hit.item, hit.near})) {
             return false;
         }
         addTriangleNeighbourPlanes(scene, candidates, s, hit, p, goal);
         return true;
     }
-    const RenderBody& o = scene.body(hit.item);
+    const RenderBody& o = bodyAt(scene, hit.item);
     if (o.shape == Shape::Sphere) {
         Vec3 n = p - o.center;
         const double len = glm::length(n);
@@ -193,12 +194,12 @@ void GodObjectRenderer::addTriangleNeighbourPlanes(const Scene& scene,
         if ((t ? t->mesh : scene.objectSlotOf(other)) != mesh) {
             return;
         }
-        const WorldFace op = t ? t->face : scene.triangleFace(other);
+        const WorldFace op = t ? t->face : faceAt(scene, other);
         const double offset = op.offset + kSkinM;
         if (op.normal == Vec3(0.0) || glm::dot(op.normal, goal) >= offset - kFeasibleM ||
             glm::dot(op.normal, p) < offset - kOnM ||
             !(t ? overGrownTriangle(p, t->corners, op.normal, t->edges, kSkinM + kOnM)
-                : overGrownTriangle(p, scene.triangleCorners(other), op.normal, kSkinM + kOnM))) {
+                : overGrownTriangle(p, cornersAt(scene, other), op.normal, kSkinM + kOnM))) {
             return;
         }
         s.addPlane({op.normal, offset, other, near});
@@ -210,7 +211,7 @@ void GodObjectRenderer::addBoxEdgePlanes(const Scene& scene, const CandidateSet&
                                          const Vec3& goal) noexcept {
     // On an edge or a corner: every other face there that the goal is behind, unless another
     // object covers it (flush neighbours make internal faces).
-    const RenderBody& o = scene.body(hit.item);
+    const RenderBody& o = bodyAt(scene, hit.item);
     const Vec3 entered = hit.sign * o.axes[hit.axis];
     const Vec3 l = o.toLocal(p);
     for (int j = 0; j < 3; ++j) {

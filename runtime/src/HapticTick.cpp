@@ -1,3 +1,29 @@
+/// The haptic tick (see HapticTick.h for the sequence), and its side of the coupling to the
+/// dynamic bodies.
+///
+/// Dynamic bodies (placeDynamic, splitReaction, handBack): the tick places them for the
+/// renderer and hands the reaction of their contact force back to them.
+///
+/// Placing. Each tick reads every dynamic body's latest pose from the BodyPoseTable (a seqlock
+/// read, no lock) and extrapolates it to the tick's time along its velocities (the centre of
+/// mass by v t, the rotation by the exact rotation of a constant omega over t); at most
+/// kMaxExtrapolationS either way, so a stalled dynamics thread leaves its bodies where they
+/// were last seen rather than flying off. A body whose bounding sphere comes within the tick's
+/// reach of the device point or the proxy (their distance, twice over for a friction lag, plus
+/// 1 mm) is placed in the tick's DynamicBodySet and its slot becomes a candidate span: brute
+/// force over the bodies, as the moving objects are, fine for the few bodies a scene holds.
+///
+/// The reaction (Newton's third law). The part of the force sent to the hand that the contacts
+/// exert, felt = sent - (external + effects + hook), is split among the <= 3 contact planes
+/// exactly: its normal part by solving G lambda = N^T felt (G the normals' Gram matrix; a
+/// normal dependent on the others gets no share), and the rest (the friction, tangent to every
+/// plane) in proportion to the planes' normal loads, as Coulomb friction is. The shares sum to
+/// felt. handBack() adds -share x dt at the contact point (the proxy, on the body's skin) to
+/// the share's body: linear, and about the centre of mass of the pose read. The table sums in
+/// fixed point, so the impulses a body receives equal minus the force the hand was sent times
+/// dt, tick by tick, to the 1e-12 N s quantum. A tick whose force is not sent (a miss rule's
+/// zero, a failed write, a stop) hands nothing back. Nothing here allocates, locks or throws.
+
 #include "hapto/runtime/HapticTick.h"
 
 #include "hapto/core/Finite.h"
@@ -5,6 +31,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace hapto {
 
@@ -78,6 +105,8 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
         mCandidates.add(atProxy.candidates);
     }
     mCandidates.add(snapshot.movingSlots());
+    placeDynamic(snapshot, p, dtS);
+    out.bodiesPlaced = static_cast<std::uint8_t>(mDynamic.count);
     out.locateSteps = atDevice.steps + atProxy.steps;
     out.outside = atDevice.outside;
     out.deviceLeaf = atDevice.leaf;
@@ -115,6 +144,10 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
     // 5. Safety.
     const Vec3 requested = out.render.force + externalForceN + out.effectsN + out.hookN;
     out.forceN = mSafety.filter(requested);
+    mShareCount = 0;
+    if (mDynamic.count > 0) {
+        splitReaction(*snapshot.scene, externalForceN + out.effectsN + out.hookN, out);
+    }
     stamp(4);
     return out;
 }
@@ -233,7 +266,183 @@ void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, con
 
 template class BasicHapticTick<GodObjectRenderer>;
 
-static_assert(sizeof(HapticTick) == 12032, "update the size in HapticTick.h");
+namespace coupling {
+
+/// Extrapolation limit, either way (s).
+constexpr double kMaxExtrapolationS = 0.05;
+/// Margin of the placing ball (m), as the renderer's near list gives objects.
+constexpr double kPlaceMarginM = 1e-3;
+/// A Gram pivot below this leaves its plane without a normal share.
+constexpr double kPivotEps = 1e-12;
+
+/// q turned by a constant angular velocity w (rad/s, world) over t seconds.
+Quat advance(const Quat& q, const Vec3& w, double t) noexcept {
+    const double rate = glm::length(w);
+    if (!(rate * std::abs(t) > 0.0)) {
+        return q;
+    }
+    return glm::normalize(glm::angleAxis(rate * t, w / rate) * q);
+}
+
+/// The render copy `b` (size, shape, bounding radius) at `pose` advanced by t seconds.
+RenderBody placedBody(RenderBody b, const BodyPose& pose, double t) noexcept {
+    const Quat rotation = advance(pose.rotation, pose.angularVelocity, t);
+    const Vec3 com = pose.centerOfMass + pose.velocity * t;
+    // The object's centre keeps its place in the body's frame.
+    b.center = com + rotation * (glm::conjugate(pose.rotation) * (pose.center - pose.centerOfMass));
+    if (b.shape != Shape::Sphere) {
+        b.axes = glm::mat3_cast(rotation);
+        b.axisAligned = b.axes == Mat3(1.0);
+    }
+    return b;
+}
+
+/// Body `body` (slot `slot`) as published in `pose`, advanced by t seconds, into `e`; false
+/// when the result is not finite.
+bool place(const Scene& scene, std::uint32_t slot, std::uint32_t body, const BodyPose& pose,
+           double t, double dtS, DynamicBodySet::Entry& e) noexcept {
+    e.slot = slot;
+    e.body = body;
+    e.velocity = pose.velocity;
+    e.angularVelocity = pose.angularVelocity;
+    e.centerOfMass = pose.centerOfMass + pose.velocity * t;
+    e.rotation = advance(pose.rotation, pose.angularVelocity, t);
+    e.massKg = scene.object(slot).body.massKg;
+    e.render = placedBody(scene.body(slot), pose, t);
+    e.center = e.render.center;
+    e.previous = placedBody(scene.body(slot), pose, t - (std::isfinite(dtS) ? dtS : 0.0));
+    return finite(e.center) && finite(e.centerOfMass) && finite(e.render.axes[0]) &&
+           finite(e.render.axes[1]) && finite(e.render.axes[2]);
+}
+
+/// Solves the k x k system a x = b (k <= 3) by elimination with partial pivoting; an unknown
+/// whose pivot vanishes (a dependent normal) is 0.
+std::array<double, 3> solveSmall(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b,
+                                 std::size_t k) noexcept {
+    std::array<double, 3> x{};
+    std::array<bool, 3> used{};
+    std::array<std::size_t, 3> pivotRow{};
+    for (std::size_t col = 0; col < k; ++col) {
+        std::size_t best = k;
+        for (std::size_t r = 0; r < k; ++r) {
+            if (!used[r] && (best == k || std::abs(a[r][col]) > std::abs(a[best][col]))) {
+                best = r;
+            }
+        }
+        pivotRow[col] = k;
+        if (best == k || std::abs(a[best][col]) <= kPivotEps) {
+            continue;
+        }
+        used[best] = true;
+        pivotRow[col] = best;
+        for (std::size_t r = 0; r < k; ++r) {
+            if (r != best) {
+                const double f = a[r][col] / a[best][col];
+                for (std::size_t c = 0; c < k; ++c) {
+                    a[r][c] -= f * a[best][c];
+                }
+                b[r] -= f * b[best];
+            }
+        }
+    }
+    for (std::size_t col = 0; col < k; ++col) {
+        if (pivotRow[col] < k) {
+            x[col] = b[pivotRow[col]] / a[pivotRow[col]][col];
+        }
+    }
+    return x;
+}
+
+} // namespace coupling
+
+template <ForceAlgorithm Algorithm>
+void BasicHapticTick<Algorithm>::placeDynamic(const WorldSnapshot& snapshot, const Vec3& p,
+                                              double dtS) noexcept {
+    mDynamic.clear();
+    const std::span<const std::uint32_t> slots = snapshot.dynamicSlots();
+    if (mTable == nullptr || slots.empty()) {
+        if constexpr (requires { mRenderer.useDynamicBodies(&mDynamic); }) {
+            mRenderer.useDynamicBodies(nullptr);
+        }
+        return;
+    }
+    mDynamic.active = true;
+    const Scene& scene = *snapshot.scene;
+    const Vec3 proxy = mRenderer.proxy();
+    const double reach = 2.0 * glm::length(proxy - p) + coupling::kPlaceMarginM;
+    const std::size_t n = std::min(slots.size(), mTable->size());
+    for (std::size_t i = 0; i < n && mDynamic.count < DynamicBodySet::kMaxBodies; ++i) {
+        const BodyPose pose = mTable->read(i);
+        const double t =
+            std::clamp((static_cast<double>(mBodiesNs) - static_cast<double>(pose.timeNs)) * 1e-9,
+                       -coupling::kMaxExtrapolationS, coupling::kMaxExtrapolationS);
+        DynamicBodySet::Entry& e = mDynamic.entries[mDynamic.count];
+        if (slots[i] >= scene.size() ||
+            !coupling::place(scene, slots[i], static_cast<std::uint32_t>(i), pose, t, dtS, e)) {
+            continue;
+        }
+        const double near = e.render.radius + reach;
+        const double d2 = std::min(glm::dot(e.center - p, e.center - p),
+                                   glm::dot(e.center - proxy, e.center - proxy));
+        if (d2 <= near * near) {
+            mDynamic.slots[mDynamic.count++] = slots[i];
+        }
+    }
+    mCandidates.add(mDynamic.slotSpan());
+    if constexpr (requires { mRenderer.useDynamicBodies(&mDynamic); }) {
+        mRenderer.useDynamicBodies(&mDynamic);
+    }
+}
+
+template <ForceAlgorithm Algorithm>
+void BasicHapticTick<Algorithm>::splitReaction(const Scene& scene, const Vec3& nonContactN,
+                                               TickOutput& out) noexcept {
+    const RenderOutput& r = out.render;
+    const std::size_t k = std::min<std::size_t>(r.contactCount, 3);
+    const Vec3 felt = out.forceN - nonContactN;
+    if (k == 0 || !finite(felt)) {
+        return;
+    }
+    std::array<std::array<double, 3>, 3> gram{};
+    std::array<double, 3> rhs{};
+    for (std::size_t i = 0; i < k; ++i) {
+        for (std::size_t j = 0; j < k; ++j) {
+            gram[i][j] = glm::dot(r.contacts[i].normal, r.contacts[j].normal);
+        }
+        rhs[i] = glm::dot(r.contacts[i].normal, felt);
+    }
+    const std::array<double, 3> lambda = coupling::solveSmall(gram, rhs, k);
+    Vec3 normalPart(0.0);
+    double load = 0.0;
+    for (std::size_t i = 0; i < k; ++i) {
+        normalPart += lambda[i] * r.contacts[i].normal;
+        load += std::max(lambda[i], 0.0);
+    }
+    const Vec3 tangent = felt - normalPart; // friction: tangent to every plane
+    for (std::size_t i = 0; i < k; ++i) {
+        const double weight = load > 0.0 ? std::max(lambda[i], 0.0) / load : 1.0 / double(k);
+        const Vec3 share = lambda[i] * r.contacts[i].normal + weight * tangent;
+        const DynamicBodySet::Entry* e = mDynamic.find(scene.objectSlotOf(r.contacts[i].slot));
+        if (e == nullptr) {
+            continue;
+        }
+        mShares[mShareCount++] = {e->body, share, r.proxy - e->centerOfMass};
+        out.reactionN += share;
+    }
+}
+
+template <ForceAlgorithm Algorithm> bool BasicHapticTick<Algorithm>::handBack(double dtS) noexcept {
+    bool ok = true;
+    for (std::uint8_t i = 0; i < mShareCount && mTable != nullptr; ++i) {
+        const Share& s = mShares[i];
+        const Vec3 impulse = -s.forceN * dtS;
+        ok = mTable->addImpulse(s.body, impulse, glm::cross(s.armM, impulse)) && ok;
+    }
+    mShareCount = 0;
+    return ok;
+}
+
+static_assert(sizeof(HapticTick) == 18944, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
 
 } // namespace hapto

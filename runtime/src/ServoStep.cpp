@@ -31,7 +31,7 @@ bool nonFinite(const DeviceState& s) noexcept {
 
 } // namespace
 
-static_assert(sizeof(ServoStep) == 12544, "update the size in ServoStep.h");
+static_assert(sizeof(ServoStep) == 19456, "update the size in ServoStep.h");
 
 void ServoStep::setTiming(std::uint64_t period, int limit, double lateWakeupFraction,
                           std::uint64_t stallTimeoutNs) noexcept {
@@ -145,6 +145,7 @@ bool ServoStep::run(const std::uint64_t wake, ServoStepProbe* probe) noexcept {
         probe->endNs[1] = rt::nowNs();
         haptic.timeStages(&probe->tickStages);
     }
+    haptic.placeBodies(ports.bodies, wake);
     const TickOutput out = haptic.tick(snap, p, v, dtS, external, sample);
     if (probe != nullptr) {
         haptic.timeStages(nullptr);
@@ -172,6 +173,9 @@ bool ServoStep::run(const std::uint64_t wake, ServoStepProbe* probe) noexcept {
     if (st != DeviceStatus::Ok) {
         fault(FaultKind::WriteFailed, st, done);
         return false;
+    }
+    if (force == out.forceN) {
+        (void)haptic.handBack(dtS); // the hand got the force: the bodies get its reaction
     }
 
     // Record. A force written after the next deadline missed it (the rule at the end).

@@ -60,6 +60,11 @@ void World::publish(std::shared_ptr<const Scene> scene, std::shared_ptr<const Sp
     next->scene = std::move(scene);
     next->index = std::move(index);
     next->moving = movingSlotsFor(*next->scene);
+    for (std::uint32_t slot = 0; slot < next->scene->size(); ++slot) {
+        if (next->scene->object(slot).body.dynamic) {
+            next->dynamic.push_back(slot);
+        }
+    }
     mCurrent.store(next.get(), std::memory_order_seq_cst);
     if (mOwned) {
         mRetired.push_back(std::move(mOwned));

@@ -4,6 +4,7 @@
 
 #include "hapto/core/ClosestPoint.h"
 #include "hapto/runtime/CandidateSet.h"
+#include "hapto/runtime/DynamicBodySet.h"
 #include "hapto/runtime/RenderOutput.h"
 #include "hapto/scenes/Scene.h"
 
@@ -99,6 +100,18 @@ public:
     bool inContact() const noexcept { return mState.contactCount > 0; }
     /// The configuration. [any thread]
     const RendererConfig& config() const noexcept { return mConfig; }
+    /// The damping c (N s/m) the coupling adds on the velocity relative to a dynamic body
+    /// touched with `stiffnessNPerM` (N/m) while the dynamics steps every `stepS` (s): c = k h.
+    /// The discrete loop (the force from the pose the step published, symplectic Euler) then
+    /// never raises the body's energy 1/2 m v^2 + sum 1/2 k_i x_i^2 while the touching
+    /// stiffnesses sum to at most m / h^2 (a = sum k h^2 / m <= 1), whatever the number of
+    /// hands, and is stable for a < 4/3; see the design note in GodObjectRenderer.cpp. 0 for
+    /// a non-positive input. [any thread]
+    static double dynamicCouplingDamping(double stiffnessNPerM, double stepS) noexcept;
+    /// The dynamic bodies placed for the next update()s (null: none): a dynamic object's pose
+    /// is read from here, never from the scene, and its items the static index lists are
+    /// skipped (DynamicBodySet.h). The set must stay unchanged while an update() runs. [servo]
+    void useDynamicBodies(const DynamicBodySet* bodies) noexcept { mDynamic = bodies; }
 
     /// What carries over from one tick to the next (the proxy, the friction and contact state,
     /// the counters), without the per-tick scratch: a tick solved again restores it. [servo]
@@ -182,13 +195,33 @@ private:
     /// Fills out.contacts from the final planes; returns the smallest stiffness among them.
     double takeContacts(const Scene& scene, const Solve& fin, bool stuck,
                         const Vec3& devicePosition, RenderOutput& out) const noexcept;
-    /// k (proxy - device) with the contact damping; zero (and no slipping) without contact.
-    Vec3 contactForce(const RenderOutput& out, double stiffness, const Vec3& devicePosition,
-                      const Vec3& velocity) noexcept;
+    /// k (proxy - device) with the contact damping (and a dynamic body's coupling damping, on
+    /// the velocity relative to the body's surface); zero (and no slipping) without contact.
+    Vec3 contactForce(const Scene& scene, const RenderOutput& out, double stiffness,
+                      const Vec3& devicePosition, const Vec3& velocity) noexcept;
+    /// The coupling damping (N s/m) of the touched dynamic bodies (the largest), and the
+    /// velocity of that body's surface at the proxy (m/s); 0 without one.
+    double couplingDampingOf(const Scene& scene, const RenderOutput& out, double stiffness,
+                             Vec3& surfaceVelocity) const noexcept;
     /// The status and counters, a non-finite result zeroed, and the state the next tick
     /// starts from.
     void finishTick(const Scene& scene, const CandidateSet& candidates, const Vec3& start,
                     const Vec3& goal, RenderOutput& out) noexcept;
+
+    // The poses, dynamic bodies placed (GodObjectNearList.cpp).
+    /// The render copy of an object slot: a placed dynamic body's, or the scene's.
+    const RenderBody& bodyAt(const Scene& scene, std::uint32_t slot) const noexcept;
+    /// An object's pose (centre, rotation) as SceneObject spells it, placed or the scene's.
+    void poseAt(const Scene& scene, std::uint32_t slot, Vec3& center,
+                Quat& rotation) const noexcept;
+    /// A valid triangle item's plane at its mesh's (placed) pose (m, world).
+    WorldFace faceAt(const Scene& scene, std::uint32_t item) const noexcept;
+    /// A valid triangle item's corners at its mesh's (placed) pose (m, world).
+    std::array<Vec3, 3> cornersAt(const Scene& scene, std::uint32_t item) const noexcept;
+    /// True for an item of a dynamic object that a span lists but this tick does not render
+    /// there: every triangle item of a dynamic mesh (its slot stands for them), and a box or
+    /// sphere slot of a body not placed.
+    bool skipItem(const Scene& scene, std::uint32_t item) const noexcept;
 
     // The candidate gathering (GodObjectNearList.cpp).
     /// Builds the near list around `goal` unless the current one covers a reach of `need`.
@@ -242,6 +275,7 @@ private:
 
     RendererConfig mConfig;
     State mState;
+    const DynamicBodySet* mDynamic = nullptr; ///< This tick's placed dynamic bodies, or none.
 
     // Per-tick scratch: the deduplicated candidates that can matter this tick.
     Vec3 mNearCenter{0.0};

@@ -4,7 +4,9 @@
 
 #include "hapto/devices/Device.h"
 #include "hapto/index/Cursor.h"
+#include "hapto/runtime/BodyPoses.h"
 #include "hapto/runtime/CandidateSet.h"
+#include "hapto/runtime/DynamicBodySet.h"
 #include "hapto/runtime/Effects.h"
 #include "hapto/runtime/ForceAlgorithm.h"
 #include "hapto/runtime/ForceSafety.h"
@@ -46,6 +48,10 @@ struct TickOutput {
     /// plus one per pull-back.
     std::uint8_t solves = 0;
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
+    /// The part of the force to send that dynamic bodies exert on the hand (N, world): what
+    /// handBack() gives back to them, as impulse -reactionN x dtS (summed over the bodies).
+    Vec3 reactionN{0.0};
+    std::uint8_t bodiesPlaced = 0; ///< Dynamic bodies placed near the tool this tick.
 };
 
 namespace detail {
@@ -80,8 +86,9 @@ template <std::size_t N> struct ListedLeaves {
 /// device, used by one thread at a time. The caller owns the snapshot (it stays valid for the
 /// tick) and the device side: reading, the frames, and what to do with the force.
 ///
-/// Size: 12032 bytes, 64-byte aligned (checked by a static_assert in the source file), of
-/// which 10176 are the renderer and 1288 the effect set (8 effects of 160 bytes).
+/// Size: 18944 bytes, 64-byte aligned (checked by a static_assert in the source file), of
+/// which 10176 are the renderer, 1288 the effect set (8 effects of 160 bytes) and about 6.7 kB
+/// the dynamic bodies placed for the tick (DynamicBodySet: 16 entries) and their shares.
 ///
 /// A template over the algorithm, instantiated in HapticTick.cpp for each one (today
 /// GodObjectRenderer); a new algorithm adds its line there.
@@ -119,6 +126,23 @@ public:
     /// sees a default DeviceState. [servo]
     TickOutput tick(const WorldSnapshot& snapshot, const Vec3& devicePointWorld,
                     const Vec3& velocityWorld, double dtS, const Vec3& externalForceN) noexcept;
+
+    /// The dynamic bodies for the next tick(): their poses come from `table` (null: none),
+    /// extrapolated to `nowNs` (the table's clock); the reaction of their contact force goes
+    /// back to it by handBack() (HapticTick.cpp). Call it before each tick that should
+    /// see them. [servo]
+    void placeBodies(BodyPoseTable* table, std::uint64_t nowNs) noexcept {
+        mTable = table;
+        mBodiesNs = nowNs;
+    }
+    /// The dynamic bodies the last tick placed. [servo]
+    const DynamicBodySet& dynamicBodies() const noexcept { return mDynamic; }
+    /// The last tick's force was sent as computed: hands each touched dynamic body the
+    /// reaction of its share of it (-share x `dtS` N s at the contact point, linear and about
+    /// the body's centre of mass) through the table, once (a second call adds nothing).
+    /// Returns false when the table refused one (not finite, out of range). Not calling it
+    /// (the force was not sent) hands nothing back. [servo]
+    bool handBack(double dtS) noexcept;
 
     /// Replaces the force effects from the next tick on (a copy, no allocation). [servo] (the
     /// thread that ticks; the Runtime's control side goes through Runtime::setEffects)
@@ -171,6 +195,13 @@ private:
                   const typename Algorithm::State& start, std::span<const std::uint32_t> known,
                   std::uint32_t& tested, TickOutput& out) noexcept;
 
+    /// Places the dynamic bodies near `p` and the proxy (mDynamic) from the table, now and
+    /// `dtS` before, and adds their span to the candidates (HapticTick.cpp).
+    void placeDynamic(const WorldSnapshot& snapshot, const Vec3& p, double dtS) noexcept;
+    /// Splits the contact part of the force to send among the contact planes and keeps the
+    /// dynamic bodies' shares for handBack() (HapticTick.cpp).
+    void splitReaction(const Scene& scene, const Vec3& nonContactN, TickOutput& out) noexcept;
+
     Cursor mDeviceCursor; ///< The device point's leaf.
     Cursor mProxyCursor;  ///< The proxy's leaf.
     Algorithm mRenderer;  ///< The force algorithm.
@@ -183,6 +214,17 @@ private:
     std::uint64_t mBoundVersion = 0; ///< The snapshot version they were bound for.
     StageStamps* mStamps = nullptr;  ///< Where tick() writes its stage ends, or none.
     bool mFresh = true;              ///< The next tick starts afresh (reset()).
+    BodyPoseTable* mTable = nullptr; ///< The dynamic bodies' poses and impulses, or none.
+    std::uint64_t mBodiesNs = 0;     ///< The time the next tick places them at (ns).
+    DynamicBodySet mDynamic;         ///< The bodies placed this tick.
+    /// A dynamic body's share of the last tick's force, waiting for handBack().
+    struct Share {
+        std::uint32_t body = 0; ///< Its body in the table.
+        Vec3 forceN{0.0};       ///< The share the hand is sent (N).
+        Vec3 armM{0.0};         ///< The contact point from the body's centre of mass (m).
+    };
+    std::array<Share, 3> mShares{}; ///< The first mShareCount wait for handBack().
+    std::uint8_t mShareCount = 0;
 };
 
 static_assert(ForceAlgorithm<GodObjectRenderer>);

@@ -27,9 +27,14 @@ struct WorldSnapshot {
     /// Slots of objects not (or not correctly) in the index: moving, or added since the last
     /// build. The renderer tests them by brute force every tick, the paper's section 3.
     std::vector<std::uint32_t> moving;
+    /// Slots of the scene's dynamic objects (BodyProperties::dynamic) in slot order: entry i
+    /// is body i of the BodyPoseTable. Their poses come from that table, never from `scene`.
+    std::vector<std::uint32_t> dynamic;
 
     /// The moving slots as a span. [servo]
     std::span<const std::uint32_t> movingSlots() const noexcept { return moving; }
+    /// The dynamic slots as a span (body i is entry i). [servo]
+    std::span<const std::uint32_t> dynamicSlots() const noexcept { return dynamic; }
 };
 
 /// A servo thread's published claim on a snapshot (a hazard pointer), one cache line each.
