@@ -194,12 +194,17 @@ TEST_CASE("the run report has the dynamics thread and each body") {
     CHECK(!nlohmann::json::parse(reportToJson(plain.runtime->report())).contains("dynamics"));
 }
 
-TEST_CASE("a session with a dynamic body and no device runs to its duration") {
-    NoDeviceRig rig(sceneWithBall(1000.0));
+/// A stepped session of 0.05 s over the rig.
+SessionOptions shortSession(NoDeviceRig& rig) {
     SessionOptions options;
     options.durationS = 0.05;
     options.steppedClock = &rig.clock;
-    Session session(rig.runtime, std::move(options));
+    return options;
+}
+
+TEST_CASE("a session with a dynamic body and no device runs to its duration") {
+    NoDeviceRig rig(sceneWithBall(1000.0));
+    Session session(rig.runtime, shortSession(rig));
     CHECK(session.start() == 0);
     CHECK(session.run() == SessionEnd::Duration);
     const RunReport& r = session.stop();
@@ -209,10 +214,7 @@ TEST_CASE("a session with a dynamic body and no device runs to its duration") {
     CHECK(!rig.runtime.anyRunning());
 
     NoDeviceRig none(cubeScene()); // nothing to run: the session ends at once
-    SessionOptions o2;
-    o2.durationS = 0.05;
-    o2.steppedClock = &none.clock;
-    Session empty(none.runtime, std::move(o2));
+    Session empty(none.runtime, shortSession(none));
     CHECK(empty.start() == 0);
     CHECK(empty.run() == SessionEnd::NoneRunning);
 }

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 
 using namespace hapto::test;
 using nlohmann::json;
@@ -27,22 +28,28 @@ const char* kStaticScene =
     R"({"format": "hapto-scene", "version": 1, "objects": [)"
     R"({"id": 1, "shape": "box", "center": [0, 0, 0], "half_extents": [0.02, 0.02, 0.02]}]})";
 
+/// Runs `hapto run --scene DIR/drop.json ARGS --report DIR/rK.json` twice (k = 0, 1), each
+/// to exit code 0 with the dynamics in its table; returns both reports.
+std::array<std::string, 2> twoRuns(const TempDir& dir, const std::string& args) {
+    writeFile(dir / "drop.json", kDropScene);
+    std::array<std::string, 2> reports;
+    for (int k = 0; k < 2; ++k) {
+        const auto report = dir / ("r" + std::to_string(k) + ".json");
+        const CommandResult r = runHapto("run --scene " + (dir / "drop.json").string() + " " +
+                                         args + " --report " + report.string());
+        INFO(r.output);
+        REQUIRE(r.exitCode == 0);
+        CHECK_THAT(r.output, Catch::Contains("dynamics") && Catch::Contains("body 5"));
+        reports[static_cast<std::size_t>(k)] = readFile(report);
+    }
+    return reports;
+}
+
 } // namespace
 
 TEST_CASE("hapto run --no-devices --stepped runs the bodies alone, the same every run") {
     TempDir dir;
-    writeFile(dir / "drop.json", kDropScene);
-    std::string reports[2];
-    for (int k = 0; k < 2; ++k) {
-        const auto report = dir / ("r" + std::to_string(k) + ".json");
-        const CommandResult r =
-            runHapto("run --scene " + (dir / "drop.json").string() +
-                     " --no-devices --stepped --quiet --duration 0.2 --report " + report.string());
-        INFO(r.output);
-        REQUIRE(r.exitCode == 0);
-        CHECK_THAT(r.output, Catch::Contains("dynamics") && Catch::Contains("body 5"));
-        reports[k] = readFile(report);
-    }
+    const auto reports = twoRuns(dir, "--no-devices --stepped --quiet --duration 0.2");
     CHECK(reports[0] == reports[1]);
     const json j = json::parse(reports[0]);
     CHECK(j["devices"].empty());
@@ -76,17 +83,7 @@ TEST_CASE("hapto run --no-devices is refused when the scene has no dynamic body"
 
 TEST_CASE("hapto run --stepped drives simulated hands byte-identically, and refuses hardware") {
     TempDir dir;
-    writeFile(dir / "drop.json", kDropScene);
-    std::string reports[2];
-    for (int k = 0; k < 2; ++k) {
-        const auto report = dir / ("r" + std::to_string(k) + ".json");
-        const CommandResult r =
-            runHapto("run --scene " + (dir / "drop.json").string() +
-                     " --stepped --quiet --duration 0.1 --report " + report.string());
-        INFO(r.output);
-        REQUIRE(r.exitCode == 0);
-        reports[k] = readFile(report);
-    }
+    const auto reports = twoRuns(dir, "--stepped --quiet --duration 0.1");
     CHECK(reports[0] == reports[1]);
     const json j = json::parse(reports[0]);
     REQUIRE(j["devices"].size() == 2);
