@@ -146,20 +146,43 @@ bool bodyField(std::string_view key, od::value value, BodyFields& f) {
     return true;
 }
 
+/// The fields of an object seen so far, one bit each.
+enum ObjectField : unsigned {
+    kId = 1,
+    kShape = 2,
+    kCenter = 4,
+    kHalf = 8,
+    kRadius = 16,
+    kRotation = 32,
+    kStiffness = 64,
+    kFriction = 128,
+    kBody = 256 // any version-3 field
+};
+
+/// An object's material (its stiffness already in `o`) and version-3 fields, checked as
+/// parseObject checks them.
+void checkMaterialAndBody(const Source& w, SceneObject& o, unsigned seen,
+                          const std::array<double, 2>& friction, const BodyFields& body,
+                          const Path& path) {
+    if (seen & kStiffness) {
+        const Path sp = path / "stiffness";
+        checkStiffness(w, json::finiteNumber(w, o.material.stiffness, sp), sp);
+    }
+    if (seen & kFriction) {
+        const Path fp = path / "friction";
+        checkFriction(w, json::finiteNumber(w, friction[0], fp[0]),
+                      json::finiteNumber(w, friction[1], fp[1]), fp);
+        o.material.staticFriction = friction[0];
+        o.material.dynamicFriction = friction[1];
+    }
+    if (seen & kBody) {
+        applyBodyFields(w, o, body, path);
+    }
+}
+
 /// One element of "objects": a box or a sphere, checked as parseObject checks it. Sets
 /// `version3` when it has a version-3 field.
 SceneObject object(const Source& w, od::value v, const Path& path, bool& version3) {
-    enum : unsigned {
-        kId = 1,
-        kShape = 2,
-        kCenter = 4,
-        kHalf = 8,
-        kRadius = 16,
-        kRotation = 32,
-        kStiffness = 64,
-        kFriction = 128,
-        kBody = 256 // any version-3 field: `body` holds them
-    };
     unsigned seen = 0;
     SceneObject o;
     std::uint64_t id = 0;
@@ -236,21 +259,8 @@ SceneObject object(const Source& w, od::value v, const Path& path, bool& version
         }
         o.rotation = json::unitQuaternion(w, rotation, qp);
     }
-    if (seen & kStiffness) {
-        const Path sp = path / "stiffness";
-        checkStiffness(w, json::finiteNumber(w, o.material.stiffness, sp), sp);
-    }
-    if (seen & kFriction) {
-        const Path fp = path / "friction";
-        checkFriction(w, json::finiteNumber(w, friction[0], fp[0]),
-                      json::finiteNumber(w, friction[1], fp[1]), fp);
-        o.material.staticFriction = friction[0];
-        o.material.dynamicFriction = friction[1];
-    }
-    if (seen & kBody) {
-        version3 = true;
-        applyBodyFields(w, o, body, path);
-    }
+    checkMaterialAndBody(w, o, seen, friction, body, path);
+    version3 = version3 || (seen & kBody) != 0;
     return o;
 }
 
