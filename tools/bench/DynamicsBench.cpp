@@ -4,7 +4,7 @@
 //
 // Benchmarks, named dynamics-step/N/B (N = 10^3 or 10^6 static cubes, B = 1 or 16 bodies):
 // the scene is makeRandomScene's 1 cm cubes at one density (N in a cube of 0.5 m * cbrt(N /
-// 10^3)), clear within 15 cm of the origin, plus a static 20 x 2 x 20 cm platform there whose
+// 10^3)), clear within 16 cm of the origin, plus a static 20 x 2 x 20 cm platform there whose
 // top is y = 0, and B dynamic 2 cm, 20 g cubes standing on it (a 4 x 4 grid, 5 cm apart; one at
 // the origin for B = 1). The bodies' neighbourhood is the same at every N, so what N changes is
 // the index the broad phase asks (the scene's default index) and the memory it spans.
