@@ -24,7 +24,7 @@ esac
 main_packages=(
   build-essential cmake ninja-build pkg-config
   libtbb-dev libglm-dev libeigen3-dev libusb-1.0-0-dev libcli11-dev nlohmann-json3-dev
-  libsimdjson-dev libcpp-httplib-dev libmeshoptimizer-dev
+  libsimdjson-dev libcpp-httplib-dev libmeshoptimizer-dev libqhull-dev
 )
 test_packages=(
   git catch2 gnuplot-nox libbenchmark-dev libbullet-dev libfcl-dev libboost-dev

@@ -66,8 +66,10 @@ struct WorldFace {
 struct ScenePhysics {
     /// Largest |gravity| a scene may give (m/s^2): 100, ten g.
     static constexpr double kMaxGravity = 100.0;
-    /// The dynamics step rates a scene may ask for (Hz).
-    static constexpr double kMinRateHz = 100.0, kMaxRateHz = 10'000.0;
+    /// The slowest dynamics step rate a scene may ask for (Hz).
+    static constexpr double kMinRateHz = 100.0;
+    /// The fastest dynamics step rate a scene may ask for (Hz).
+    static constexpr double kMaxRateHz = 10'000.0;
 
     Vec3 gravity{0.0, -9.81, 0.0}; ///< Acceleration of gravity (m/s^2, world; y is up).
     double rateHz = 1000.0;        ///< Dynamics steps per second (Hz).
