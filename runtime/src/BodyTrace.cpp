@@ -147,6 +147,12 @@ BodyTrace readBodyTrace(const std::filesystem::path& path) {
 }
 
 bool isBodyTrace(const std::filesystem::path& path) {
+    // Only a regular file is opened: a FIFO or a device would block the open or the read
+    // (the device trace reader then refuses it with its message).
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) {
+        return false;
+    }
     std::ifstream in(path, std::ios::binary);
     char magic[8] = {};
     return in.read(magic, sizeof magic) && std::memcmp(magic, kMagic, sizeof magic) == 0;

@@ -100,6 +100,7 @@ set(HAPTO_PC_REQUIRES_glm glm)
 set(HAPTO_PC_REQUIRES_nlohmann_json nlohmann_json)
 set(HAPTO_PC_REQUIRES_TBB tbb)
 set(HAPTO_PC_REQUIRES_simdjson simdjson)
+set(HAPTO_PC_REQUIRES_Qhull qhull_r)
 set(HAPTO_PC_LIBS_Threads -pthread)
 set(HAPTO_PC_LIBS_meshoptimizer -lmeshoptimizer)
 

@@ -74,7 +74,8 @@ struct BodyTrace {
 /// another version, truncated, a body index out of range, a non-finite value). [control]
 BodyTrace readBodyTrace(const std::filesystem::path& path);
 
-/// True when `path` is a readable file beginning with the body trace's magic. [control]
+/// True when `path` is a readable regular file beginning with the body trace's magic (a FIFO
+/// or device is never opened: false). [control]
 bool isBodyTrace(const std::filesystem::path& path);
 
 /// The CSV export's header row, newline included: `time_s,id,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,
