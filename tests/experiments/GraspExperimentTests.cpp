@@ -1,0 +1,132 @@
+// GraspProbe (experiments/GraspProbe.h): slip against the hands' midpoint, the hands' vertical
+// force against m g, held or dropped, on samples whose answers are worked out by hand.
+
+#include "hapto/experiments/GraspProbe.h"
+
+#include <catch2/catch.hpp>
+
+#include <limits>
+#include <stdexcept>
+
+using namespace hapto;
+using namespace hapto::experiments;
+
+namespace {
+
+constexpr double kMassKg = 0.1;
+constexpr double kG = 9.81;
+constexpr double kWeightN = kMassKg * kG;
+
+/// A body at `body` between hands 4 cm apart around `mid`, the hands sent `forceY` each
+/// (N, vertical; negative: the body pushes them down).
+GraspSample sampleAt(Vec3 body, Vec3 mid, double forceY = -0.5 * kWeightN) {
+    GraspSample s;
+    s.bodyM = body;
+    s.handAM = mid - Vec3(0.02, 0.0, 0.0);
+    s.handBM = mid + Vec3(0.02, 0.0, 0.0);
+    s.forceAN = Vec3(0.8, forceY, 0.0); // the squeeze cancels between the hands
+    s.forceBN = Vec3(-0.8, forceY, 0.0);
+    return s;
+}
+
+GraspProbeSettings settings() {
+    GraspProbeSettings s;
+    s.massKg = kMassKg;
+    s.gravityMPerS2 = kG;
+    return s;
+}
+
+} // namespace
+
+TEST_CASE("a body carried with the hands does not slip and the hands carry its weight") {
+    GraspProbe probe(settings());
+    const Vec3 offset(0.0, -0.001, 0.0); // the body may sit off the midpoint: only changes count
+    REQUIRE(probe.begin(sampleAt(Vec3(0.0) + offset, Vec3(0.0))));
+    for (int i = 1; i <= 100; ++i) {
+        const Vec3 mid(0.001 * i, 0.0005 * i, 0.0); // lifted and carried
+        probe.add(sampleAt(mid + offset, mid));
+    }
+    const GraspFigures f = probe.figures();
+    CHECK(f.samples == 100);
+    CHECK(f.maxSlipM == Approx(0.0).margin(1e-12));
+    CHECK(f.finalSlipM == Approx(0.0).margin(1e-12));
+    CHECK(f.forceErrorMedian == Approx(0.0).margin(1e-12));
+    CHECK(f.forceErrorWorst == Approx(0.0).margin(1e-12));
+    CHECK(f.held);
+}
+
+TEST_CASE("a body left on the floor while the hands rise slips by the lift and is dropped") {
+    GraspProbe probe(settings());
+    REQUIRE(probe.begin(sampleAt(Vec3(0.0), Vec3(0.0))));
+    for (int i = 1; i <= 50; ++i) {
+        probe.add(sampleAt(Vec3(0.0), Vec3(0.0, 0.001 * i, 0.0), 0.0)); // hands feel nothing
+    }
+    const GraspFigures f = probe.figures();
+    CHECK(f.maxSlipM == Approx(0.05));
+    CHECK(f.finalSlipM == Approx(0.05));
+    CHECK(f.forceErrorMedian == Approx(1.0)); // the hands carry none of m g
+    CHECK(!f.held);
+}
+
+TEST_CASE("slip that comes back is reported as its largest and its final value") {
+    GraspProbe probe(settings());
+    REQUIRE(probe.begin(sampleAt(Vec3(0.0), Vec3(0.0))));
+    probe.add(sampleAt(Vec3(0.0, -0.003, 0.004), Vec3(0.0))); // 5 mm off
+    probe.add(sampleAt(Vec3(0.0, -0.001, 0.0), Vec3(0.0)));   // 1 mm off
+    const GraspFigures f = probe.figures();
+    CHECK(f.maxSlipM == Approx(0.005));
+    CHECK(f.finalSlipM == Approx(0.001));
+    CHECK(f.held); // 1 mm <= the 10 mm drop slip
+    GraspProbeSettings tight = settings();
+    tight.dropSlipM = 0.0005;
+    GraspProbe strict(tight);
+    REQUIRE(strict.begin(sampleAt(Vec3(0.0), Vec3(0.0))));
+    strict.add(sampleAt(Vec3(0.0, -0.001, 0.0), Vec3(0.0)));
+    CHECK(!strict.figures().held);
+}
+
+TEST_CASE("the force error is |support - m g| / m g, median and worst over the window") {
+    GraspProbe probe(settings());
+    REQUIRE(probe.begin(sampleAt(Vec3(0.0), Vec3(0.0))));
+    // Support -(F_A + F_B).y = 1.1, 0.7 and 1.2 m g: errors 0.1, 0.3, 0.2.
+    for (const double ratio : {1.1, 0.7, 1.2}) {
+        probe.add(sampleAt(Vec3(0.0), Vec3(0.0), -0.5 * ratio * kWeightN));
+    }
+    const GraspFigures f = probe.figures();
+    CHECK(f.forceErrorMedian == Approx(0.2));
+    CHECK(f.forceErrorWorst == Approx(0.3));
+    CHECK(probe.forceError(sampleAt(Vec3(0.0), Vec3(0.0), 0.5 * kWeightN)) == Approx(2.0));
+}
+
+TEST_CASE("a grasp probe ignores samples before begin and non-finite ones, and counts the latter") {
+    GraspProbe probe(settings());
+    probe.add(sampleAt(Vec3(1.0), Vec3(0.0))); // before begin: nothing
+    CHECK(probe.figures().samples == 0);
+    CHECK(!probe.figures().held); // nothing measured is not a hold
+    GraspSample bad = sampleAt(Vec3(0.0), Vec3(0.0));
+    bad.forceAN.y = std::numeric_limits<double>::quiet_NaN();
+    CHECK(!probe.begin(bad));
+    CHECK(!probe.begun());
+    REQUIRE(probe.begin(sampleAt(Vec3(0.0), Vec3(0.0))));
+    probe.add(bad);
+    probe.add(sampleAt(Vec3(0.0), Vec3(0.0)));
+    const GraspFigures f = probe.figures();
+    CHECK(f.samples == 1);
+    CHECK(f.nonFinite == 2);
+    CHECK(f.held);
+}
+
+TEST_CASE("a grasp probe refuses a mass, gravity, drop slip or up it cannot judge by") {
+    GraspProbeSettings s = settings();
+    s.massKg = 0.0;
+    CHECK_THROWS_AS(GraspProbe(s), std::invalid_argument);
+    s = settings();
+    s.gravityMPerS2 = std::numeric_limits<double>::infinity();
+    CHECK_THROWS_AS(GraspProbe(s), std::invalid_argument);
+    s = settings();
+    s.dropSlipM = -1.0;
+    CHECK_THROWS_AS(GraspProbe(s), std::invalid_argument);
+    s = settings();
+    s.up = Vec3(0.0, 2.0, 0.0);
+    CHECK_THROWS_AS(GraspProbe(s), std::invalid_argument);
+}
