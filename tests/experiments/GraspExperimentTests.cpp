@@ -1,6 +1,9 @@
 // GraspProbe (experiments/GraspProbe.h): slip against the hands' midpoint, the hands' vertical
-// force against m g, held or dropped, on samples whose answers are worked out by hand.
+// force against m g, held or dropped, on samples whose answers are worked out by hand; and one
+// cell of `hapto experiment grasp` (GraspCell.h) run stepped: a squeeze above the analytic
+// hold rule holds, one below slips, and two runs measure the same figures.
 
+#include "hapto/experiments/GraspCell.h"
 #include "hapto/experiments/GraspProbe.h"
 
 #include <catch2/catch.hpp>
@@ -129,4 +132,49 @@ TEST_CASE("a grasp probe refuses a mass, gravity, drop slip or up it cannot judg
     s = settings();
     s.up = Vec3(0.0, 2.0, 0.0);
     CHECK_THROWS_AS(GraspProbe(s), std::invalid_argument);
+}
+
+// ---- One cell of the experiment, stepped (GraspCell.h): physics against the analytic rule.
+
+TEST_CASE("grasp cell: a squeeze above m g / (2 mu_s) lifts the box, one below lets it slip") {
+    GraspCellSpec firm; // 1.5 N a hand, 50 g, mu_s 0.6: margin 3.7
+    REQUIRE(graspHoldMargin(firm) > 1.0);
+    const GraspCellResult held = runGraspCell(firm);
+    INFO("firm: max slip " << held.grasp.maxSlipM << " m, lift " << held.liftM << " m, force "
+                           << held.grasp.forceErrorMedian);
+    CHECK(held.grasp.held);
+    CHECK(held.grasp.maxSlipM < 0.001); // issue 37: slip under 1 mm
+    CHECK(held.liftM > 0.045);          // the scripts lift by 5 cm
+    CHECK(held.grasp.forceErrorMedian < 0.05);
+    CHECK(held.stable);
+    CHECK(held.stepCpuNs.size() == held.dynamicsSteps);
+
+    GraspCellSpec light = firm;
+    light.squeezeN = 0.25; // margin 0.61
+    REQUIRE(graspHoldMargin(light) < 1.0);
+    const GraspCellResult slipped = runGraspCell(light);
+    INFO("light: max slip " << slipped.grasp.maxSlipM << " m, lift " << slipped.liftM << " m");
+    CHECK(!slipped.grasp.held);
+    CHECK(slipped.liftM < 0.025);
+}
+
+TEST_CASE("grasp cell: two runs of one spec measure the same figures, bit for bit") {
+    GraspCellSpec spec;
+    spec.servoRateHz = 2000.0;
+    const GraspCellResult a = runGraspCell(spec);
+    const GraspCellResult b = runGraspCell(spec);
+    CHECK(sameGraspFigures(a, b));
+    CHECK(a.grasp.samples > 0);
+}
+
+TEST_CASE("grasp cell: a spec it cannot run is refused naming the field") {
+    GraspCellSpec s;
+    s.massKg = -1.0;
+    CHECK_THROWS_WITH(checkGraspCellSpec(s), Catch::Contains("mass_kg"));
+    s = GraspCellSpec{};
+    s.servoRateHz = 3000.0; // 333333.3 ns
+    CHECK_THROWS_WITH(checkGraspCellSpec(s), Catch::Contains("whole nanoseconds"));
+    s = GraspCellSpec{};
+    s.squeezeN = std::numeric_limits<double>::quiet_NaN();
+    CHECK_THROWS_WITH(checkGraspCellSpec(s), Catch::Contains("squeeze_n"));
 }
