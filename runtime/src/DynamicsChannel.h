@@ -8,10 +8,23 @@
 /// (DynamicsLoop.cpp) reads and writes only these and the Dynamics' own preallocated state, so
 /// it never allocates, locks or throws. Figures the control thread reads while the thread runs
 /// (counters, histograms, each body's BodyStats) are relaxed atomics with one writer.
+///
+/// The watchdog (Supervision.cpp, superviseDynamics). `stateNs` is the time the published
+/// state is due at (the last step's deadline). When it is older than `stallBoundNs` (the
+/// servos' stallTimeoutNs plus one dynamics period) the supervision freezes the bodies: it
+/// republishes each body's last pose with zero velocities, so a servo extrapolates nothing and
+/// renders the body where it last was. The table has one writer at a time by a token,
+/// `DynamicsMetrics::publisher`: the dynamics step takes it (0 -> 1) around each publication,
+/// the supervision takes it for good (0 -> 2) to freeze, by compare-exchange, so neither waits
+/// on the other (a supervision pass that finds the token held tries again at its next pass).
+/// The freeze lasts to the end of the session: the hands' impulses during the stall were
+/// reactions to a body that did not move, so the solver's state no longer matches what they
+/// felt; the dynamics thread then takes and drops the impulses and steps no more.
 
 #include "hapto/dynamics/Dynamics.h"
 #include "hapto/runtime/BodyPoses.h"
 #include "hapto/runtime/BodyTrace.h"
+#include "hapto/runtime/DeviceMetrics.h"
 #include "hapto/runtime/LoadHistogram.h"
 #include "hapto/runtime/Realtime.h"
 #include "hapto/runtime/Runtime.h"
@@ -33,6 +46,16 @@ struct DynamicsMetrics {
     std::atomic<std::uint64_t> lateWakeups{0};     ///< Wake-ups later than the late threshold.
     std::atomic<std::uint64_t> stoppedBodies{0};   ///< Bodies stopped for a non-finite state.
     std::atomic<bool> running{false};              ///< The loop (or the step mode's) is live.
+    std::atomic<std::uint64_t> stateNs{0}; ///< The published state's time (ns, runtime clock).
+    /// Who may publish into the table: kFree, kStepping (the dynamics step, while it
+    /// publishes) or kFrozen (the supervision froze the bodies: no one, ever again).
+    std::atomic<int> publisher{0};
+    std::atomic<FaultKind> fault{FaultKind::None}; ///< Watchdog once frozen.
+    std::atomic<std::uint64_t> faultNs{0};         ///< When the watchdog froze the bodies (ns).
+    std::atomic<std::uint64_t> frozenAtStep{0};    ///< The step whose poses were frozen.
+    static constexpr int kFree = 0;                ///< No one is publishing.
+    static constexpr int kStepping = 1;            ///< The dynamics step is publishing.
+    static constexpr int kFrozen = 2;              ///< Frozen by the watchdog for good.
     std::atomic<bool> realtime{false};             ///< The thread was granted SCHED_FIFO.
 };
 
@@ -54,6 +77,8 @@ struct Runtime::DynamicsChannel {
     std::uint64_t periodNs = 0;
     std::uint64_t lateNs = 0;     ///< A wake-up later than this is late.
     std::uint64_t deadlineNs = 0; ///< [dynamics] The next step's deadline.
+    /// The watchdog's bound: a published state older than this freezes the bodies (ns).
+    std::uint64_t stallBoundNs = 0;
     BodyTraceRecorder* recorder = nullptr;
     std::atomic<bool> stop{false};
     std::thread thread;

@@ -9,6 +9,9 @@
 // until they are on time again, so the bodies' time is the session's. Invariants: below the
 // loop's entry nothing allocates, locks, logs or throws; the step mode runs the same step, at
 // each deadline before the servo ticks due then (ServoLoop.cpp's runUntil and stepAll).
+// Each publication is made under the table's publisher token (DynamicsChannel.h): once the
+// watchdog has frozen the bodies the step publishes nothing, steps no more and drops the
+// hands' impulses.
 
 #include "Channel.h"
 #include "DynamicsChannel.h"
@@ -28,7 +31,8 @@ Runtime::DynamicsChannel::DynamicsChannel(const WorldSnapshot& snapshot,
       rateHz(snapshot.scene->physics().rateHz),
       periodNs(static_cast<std::uint64_t>(std::llround(1e9 / rateHz))),
       lateNs(
-          static_cast<std::uint64_t>(options.lateWakeupFraction * static_cast<double>(periodNs))) {
+          static_cast<std::uint64_t>(options.lateWakeupFraction * static_cast<double>(periodNs))),
+      stallBoundNs(options.stallTimeoutNs + periodNs) {
     for (const BodyState& b : dynamics->bodies()) {
         ids.push_back(b.id);
     }
@@ -97,20 +101,48 @@ void Runtime::publishBodies(DynamicsChannel& dc, std::uint64_t timeNs) noexcept 
     }
 }
 
-void Runtime::runDynamicsStep(DynamicsChannel& dc, std::uint64_t wakeNs) noexcept {
-    Dynamics& d = *dc.dynamics;
+namespace {
+
+/// Takes every body's accumulated impulse into the Dynamics (a stopped body's, or every
+/// body's once frozen, is taken and dropped).
+void takeImpulses(Dynamics& d, BodyPoseTable& poses, const DynamicsBodyRecord* records,
+                  bool frozen) noexcept {
     for (std::size_t i = 0; i < d.bodyCount(); ++i) {
         Vec3 linear(0.0), angular(0.0);
-        dc.poses.takeImpulse(i, linear, angular); // taken even from a stopped body: dropped
-        if (!dc.records[i].stopped.load(std::memory_order_relaxed)) {
+        poses.takeImpulse(i, linear, angular);
+        if (!frozen && !records[i].stopped.load(std::memory_order_relaxed)) {
             d.applyImpulse(i, linear, angular);
         }
     }
-    d.step();
-    const std::uint64_t deadline = dc.deadlineNs;
-    publishBodies(dc, deadline); // the state is the one due at the step's deadline
-    const std::uint64_t done = now();
+}
+
+} // namespace
+
+bool Runtime::publishUnlessFrozen(DynamicsChannel& dc, std::uint64_t timeNs) noexcept {
     DynamicsMetrics& m = dc.metrics;
+    int expected = DynamicsMetrics::kFree;
+    if (!m.publisher.compare_exchange_strong(expected, DynamicsMetrics::kStepping,
+                                             std::memory_order_acquire)) {
+        return false; // frozen by the watchdog (no one else ever holds it)
+    }
+    publishBodies(dc, timeNs);
+    m.stateNs.store(timeNs, std::memory_order_relaxed);
+    m.publisher.store(DynamicsMetrics::kFree, std::memory_order_release);
+    return true;
+}
+
+void Runtime::runDynamicsStep(DynamicsChannel& dc, std::uint64_t wakeNs) noexcept {
+    DynamicsMetrics& m = dc.metrics;
+    const std::uint64_t deadline = dc.deadlineNs;
+    dc.deadlineNs = deadline + dc.periodNs; // never skipped: the bodies' time is the session's
+    const bool frozen = m.publisher.load(std::memory_order_acquire) == DynamicsMetrics::kFrozen;
+    takeImpulses(*dc.dynamics, dc.poses, dc.records.get(), frozen);
+    if (frozen) {
+        return; // the hands see the frozen poses to the end of the session
+    }
+    dc.dynamics->step();
+    (void)publishUnlessFrozen(dc, deadline); // the state is the one due at the step's deadline
+    const std::uint64_t done = now();
     const std::uint64_t lateness = wakeNs > deadline ? wakeNs - deadline : 0;
     m.stepNs.record(done > wakeNs ? done - wakeNs : 0);
     m.latenessNs.record(lateness);
@@ -121,13 +153,12 @@ void Runtime::runDynamicsStep(DynamicsChannel& dc, std::uint64_t wakeNs) noexcep
     if (done > deadline + dc.periodNs) {
         DeviceMetrics::bump(m.missedDeadlines);
     }
-    dc.deadlineNs = deadline + dc.periodNs; // never skipped: the bodies' time is the session's
 }
 
 void Runtime::startDynamics(std::uint64_t nowNs) {
     DynamicsChannel& dc = *mDynamics;
     dc.deadlineNs = nowNs + dc.periodNs;
-    publishBodies(dc, nowNs); // step 0: the scene's poses, before any servo reads them
+    (void)publishUnlessFrozen(dc, nowNs); // step 0: the scene's poses, before any servo reads
     dc.metrics.running.store(true, std::memory_order_release);
     if (!mClock) {
         dc.thread = std::thread([this] { dynamicsMain(); });

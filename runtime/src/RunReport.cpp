@@ -64,7 +64,20 @@ std::optional<DynamicsReport> Runtime::dynamicsReport() const {
     d.missedDeadlines = m.missedDeadlines.load();
     d.stoppedBodies = m.stoppedBodies.load();
     d.realtime = m.realtime.load();
-    d.stable = loadStable(d.steps, d.loadFraction, d.missedDeadlines) && d.stoppedBodies == 0;
+    if (m.fault.load(std::memory_order_acquire) != FaultKind::None) {
+        const std::uint64_t at = m.faultNs.load();
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "%s: no step for %.1f ms (bound %.1f ms); bodies frozen "
+                      "at step %llu",
+                      faultName(m.fault.load()), static_cast<double>(at - m.stateNs.load()) * 1e-6,
+                      static_cast<double>(dc.stallBoundNs) * 1e-6,
+                      static_cast<unsigned long long>(m.frozenAtStep.load()));
+        d.fault = text;
+        d.faultS = static_cast<double>(at - mStartNs) * 1e-9;
+    }
+    d.stable = loadStable(d.steps, d.loadFraction, d.missedDeadlines) && d.stoppedBodies == 0 &&
+               d.fault.empty();
     for (std::size_t i = 0; i < dc.ids.size(); ++i) {
         const DynamicsBodyRecord& b = dc.records[i];
         d.bodies.push_back(BodyReport{dc.ids[i], b.deepestPenetrationM.load(),
@@ -208,6 +221,8 @@ nlohmann::json dynamicsJson(const DynamicsReport& d) {
                 {"late_wakeups", d.lateWakeups},
                 {"missed_deadlines", d.missedDeadlines},
                 {"stopped_bodies", d.stoppedBodies},
+                {"fault", d.fault},
+                {"fault_s", d.faultS},
                 {"realtime", d.realtime},
                 {"stable", d.stable},
                 {"bodies", bodies}};

@@ -6,9 +6,12 @@
 // thread, a terminal, a disk or another device's open(). In step mode the same pass
 // (superviseChannel) runs on the caller's thread at the caller's times, and the close and the
 // opens run inline: closed in the pass that finds the fault, opened in the first pass at or
-// after each reopen time.
+// after each reopen time. The same pass watches the dynamics thread (superviseDynamics): a
+// published body state older than its bound freezes the bodies where they are, at zero
+// velocity, without waiting on that thread (DynamicsChannel.h's design note).
 
 #include "Channel.h"
+#include "DynamicsChannel.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -36,6 +39,7 @@ void Runtime::superviseMain() {
         for (auto& chp : mChannels) {
             superviseChannel(*chp, t);
         }
+        superviseDynamics(t);
     }
 }
 
@@ -46,6 +50,44 @@ void Runtime::supervise(std::uint64_t nowNs) {
         superviseChannel(*chp, nowNs);
     }
     mClock->set(nowNs); // an open or close that took time held up no other device
+    superviseDynamics(nowNs);
+}
+
+void Runtime::superviseDynamics(std::uint64_t nowNs) noexcept {
+    if (!mDynamics) {
+        return;
+    }
+    DynamicsChannel& dc = *mDynamics;
+    DynamicsMetrics& m = dc.metrics;
+    const auto stale = [&] {
+        const std::uint64_t state = m.stateNs.load(std::memory_order_relaxed);
+        return nowNs > state && nowNs - state > dc.stallBoundNs;
+    };
+    if (!m.running.load(std::memory_order_acquire) ||
+        m.fault.load(std::memory_order_relaxed) != FaultKind::None || !stale()) {
+        return;
+    }
+    int expected = DynamicsMetrics::kFree;
+    if (!m.publisher.compare_exchange_strong(expected, DynamicsMetrics::kFrozen,
+                                             std::memory_order_acquire)) {
+        return; // it is publishing right now, so not stalled: look again next pass
+    }
+    if (!stale()) { // it published between the first look and the token
+        m.publisher.store(DynamicsMetrics::kFree, std::memory_order_release);
+        return;
+    }
+    // The token is ours for good: the table's one writer from now on is this pass, once.
+    std::uint64_t step = 0;
+    for (std::size_t i = 0; i < dc.poses.size(); ++i) {
+        BodyPose p = dc.poses.read(i);
+        p.velocity = Vec3(0.0);
+        p.angularVelocity = Vec3(0.0); // a servo extrapolates nothing: the body stays put
+        dc.poses.publish(i, p);
+        step = p.step;
+    }
+    m.frozenAtStep.store(step, std::memory_order_relaxed);
+    m.faultNs.store(nowNs, std::memory_order_relaxed);
+    m.fault.store(FaultKind::Watchdog, std::memory_order_release);
 }
 
 void Runtime::superviseChannel(Channel& ch, std::uint64_t nowNs) {

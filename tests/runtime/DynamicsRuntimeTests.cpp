@@ -1,7 +1,8 @@
 // The runtime's dynamics thread (DynamicsLoop.cpp), in step mode: its published poses are the
 // Dynamics' own, bit for bit; its steps interleave with the servo ticks the same way every run;
 // the report carries it; a session with bodies and no device runs; impulses handed to the
-// table reach the body once; a non-finite body is stopped, not a crash. One threaded case
+// table reach the body once; a non-finite body is stopped, not a crash; a stalled dynamics
+// thread is noticed by the supervision, which freezes the bodies for the hands. One threaded case
 // ([realtime]) checks the thread starts, steps and stops.
 
 #include "CubeScene.h"
@@ -264,6 +265,100 @@ TEST_CASE("a body whose state turns non-finite is stopped and reported, the othe
     CHECK(!r.dynamics->bodies[0].stopped);
     CHECK(!r.dynamics->stable);
     CHECK(!r.stable);
+}
+
+/// A stepped runtime with no device whose watchdog bound is 20 ms + one 1 ms period.
+struct StallRig {
+    ManualClock clock;
+    World world;
+    Runtime runtime;
+    std::uint64_t t0 = 0;
+    static RuntimeOptions options() {
+        RuntimeOptions o = notRealtime();
+        o.stallTimeoutNs = 20'000'000;
+        return o;
+    }
+    explicit StallRig(Scene scene)
+        : world(std::move(scene), IndexSpec::parse(kDefaultIndexSpec)),
+          runtime(world, {}, options()) {
+        world.useClock(clock);
+        t0 = clock.nowNs();
+        runtime.startStepped(clock);
+    }
+    std::uint64_t at(double ms) const { return t0 + static_cast<std::uint64_t>(ms * 1e6); }
+};
+
+TEST_CASE("a stalled dynamics thread is noticed by the supervision and its bodies are frozen") {
+    // No gravity, the ball drifts at 0.1 m/s: a servo extrapolating its pose would move it.
+    std::vector<SceneObject> extra;
+    extra.push_back(ball(11, Vec3(-0.08, 0.1, 0.0), Vec3(0.1, 0.0, 0.0)));
+    StallRig rig(sceneWithBall(1000.0, Vec3(0.0), std::move(extra)));
+    const BodyPoseTable& table = *rig.runtime.bodyPoses();
+    rig.runtime.runUntil(rig.at(10)); // 10 steps, the state due at 10 ms
+    const BodyPose before = table.read(1);
+    REQUIRE(before.step == 10);
+    REQUIRE(before.velocity.x == 0.1);
+    // The dynamics thread stops stepping (nothing runs it), the supervision goes on: a state
+    // 21 ms old is within the bound, 22 ms is not.
+    for (int ms = 11; ms <= 31; ++ms) {
+        rig.runtime.supervise(rig.at(ms));
+    }
+    CHECK(rig.runtime.report().dynamics->fault.empty());
+    CHECK(table.read(1).velocity.x == 0.1);
+    rig.runtime.supervise(rig.at(32));
+    const BodyPose frozen = table.read(1);
+    CHECK(frozen.velocity == Vec3(0.0));
+    CHECK(frozen.angularVelocity == Vec3(0.0));
+    CHECK(frozen.centerOfMass == before.centerOfMass); // where it last was, not extrapolated
+    CHECK(frozen.step == 10);
+    CHECK(frozen.timeNs == before.timeNs);
+    const RunReport r = rig.runtime.report();
+    REQUIRE(r.dynamics.has_value());
+    CHECK(r.dynamics->fault ==
+          "watchdog: no step for 22.0 ms (bound 21.0 ms); bodies frozen at step 10");
+    CHECK(r.dynamics->faultS == Approx(0.032).margin(1e-12));
+    CHECK(!r.dynamics->stable);
+    CHECK(!r.stable);
+    const auto json = nlohmann::json::parse(reportToJson(r));
+    CHECK(json["dynamics"]["fault"] == r.dynamics->fault);
+
+    // The thread comes back: it publishes nothing, steps no more, drops the hands' impulses.
+    REQUIRE(rig.runtime.bodyPoses()->addImpulse(1, Vec3(1e-3, 0.0, 0.0), Vec3(0.0)));
+    rig.runtime.runUntil(rig.at(100));
+    CHECK(sameBits(table.read(1), frozen));
+    CHECK(table.read(0).velocity == Vec3(0.0));
+    CHECK(rig.runtime.report().dynamics->steps == 10);
+    Vec3 left(1.0), leftAngular(1.0);
+    rig.runtime.bodyPoses()->takeImpulse(1, left, leftAngular);
+    CHECK(left == Vec3(0.0));
+}
+
+TEST_CASE("a dynamics thread on time is never frozen, and devices stay up when it stalls") {
+    // On time: a 100 Hz dynamics (10 ms period) and 1 kHz servos for 0.3 s, supervised every
+    // servo tick: the published state is at most one period old, well within the bound.
+    RuntimeOptions options;
+    options.stallTimeoutNs = 20'000'000;
+    SteppedRig rig(2, 1000.0, {}, options, sceneWithBall(100.0));
+    REQUIRE(rig.start() == 2);
+    rig.runTo(300);
+    RunReport r = rig.runtime->report();
+    CHECK(r.dynamics->fault.empty());
+    CHECK(r.dynamics->steps == 30);
+    // Stalled: the servos tick and are supervised, the dynamics is not stepped.
+    for (int ms = 301; ms <= 340; ++ms) {
+        for (std::size_t i = 0; i < 2; ++i) {
+            (void)rig.runtime->step(i, rig.t0 + static_cast<std::uint64_t>(ms) * 1'000'000);
+        }
+        rig.runtime->supervise(rig.t0 + static_cast<std::uint64_t>(ms) * 1'000'000);
+    }
+    r = rig.runtime->report();
+    CHECK(!r.dynamics->fault.empty());
+    CHECK(r.dynamics->faultS == Approx(0.331).margin(1e-12)); // 300 ms state + 30 ms bound + 1
+    CHECK(rig.runtime->bodyPoses()->read(0).velocity == Vec3(0.0));
+    for (const DeviceReport& d : r.devices) {
+        CHECK(d.fault.empty()); // the hands go on, feeling the body where it stopped
+        CHECK(d.ticks == 340);
+    }
 }
 
 TEST_CASE("the dynamics thread steps on the wall clock and stops with the runtime", "[realtime]") {

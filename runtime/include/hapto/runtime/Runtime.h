@@ -139,7 +139,13 @@ struct DynamicsReport {
     std::uint64_t missedDeadlines = 0; ///< Steps that ended after the next deadline.
     std::uint64_t stoppedBodies = 0;   ///< Bodies stopped for a non-finite state.
     bool realtime = false;             ///< SCHED_FIFO was granted.
-    /// p99.9 load < 1, misses <= 0.1 % of steps, no body stopped (the devices' rule, loadStable).
+    /// Empty, or why the bodies were frozen: "watchdog: no step for 60 ms (bound 51 ms);
+    /// bodies frozen at step 40". A published state older than RuntimeOptions::stallTimeoutNs
+    /// plus one period freezes every body where it was, at zero velocity, to the session's end.
+    std::string fault;
+    double faultS = 0; ///< When the watchdog froze the bodies (s since the start); 0 if not.
+    /// p99.9 load < 1, misses <= 0.1 % of steps, no body stopped, no fault (the devices' rule,
+    /// loadStable).
     bool stable = false;
     std::vector<BodyReport> bodies; ///< One per dynamic body, in the scene's slot order.
 };
@@ -323,6 +329,7 @@ private:
     void dynamicsMain();
     void runDynamicsStep(DynamicsChannel& dc, std::uint64_t wakeNs) noexcept;
     void publishBodies(DynamicsChannel& dc, std::uint64_t timeNs) noexcept;
+    bool publishUnlessFrozen(DynamicsChannel& dc, std::uint64_t timeNs) noexcept;
     bool stepDynamicsIfDue(std::uint64_t nowNs);
     void stopDynamics();
     std::optional<DynamicsReport> dynamicsReport() const;
@@ -339,6 +346,7 @@ private:
     // Supervision.cpp: the watchdog, closing and reopening.
     void superviseMain();
     void superviseChannel(Channel& channel, std::uint64_t nowNs);
+    void superviseDynamics(std::uint64_t nowNs) noexcept;
     void recoverMain(Channel& channel);
     void closeFaulted(Channel& channel);
     bool openAgain(Channel& channel, std::uint64_t& backNs);
