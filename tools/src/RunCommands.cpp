@@ -66,10 +66,10 @@ void printDynamics(const DynamicsReport& d) {
                 100 * d.loadFraction.max, static_cast<unsigned long long>(d.missedDeadlines),
                 static_cast<unsigned long long>(d.lateWakeups), "-",
                 d.stable ? "stable" : "UNSTABLE");
-    std::printf("  dynamics: step p50 %.1f us, p99.9 %.1f us\n", d.stepNs.p50 / 1000.0,
     if (!d.fault.empty()) {
         std::printf("  dynamics: %.3f s: FAULT %s\n", d.faultS, d.fault.c_str());
     }
+    std::printf("  dynamics: step p50 %.1f us, p99.9 %.1f us\n", d.stepNs.p50 / 1000.0,
                 d.stepNs.p999 / 1000.0);
     for (const BodyReport& b : d.bodies) {
         std::printf("  body %u: deepest penetration %.3g mm, largest energy gain %.3g J%s\n", b.id,
