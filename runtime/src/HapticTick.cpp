@@ -106,7 +106,7 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
     }
     mCandidates.add(snapshot.movingSlots());
     placeDynamic(snapshot, p, dtS);
-    out.bodiesPlaced = static_cast<std::uint8_t>(mDynamic.count);
+    out.bodiesPlaced = static_cast<std::uint8_t>(mCoupling.bodies().count);
     out.locateSteps = atDevice.steps + atProxy.steps;
     out.outside = atDevice.outside;
     out.deviceLeaf = atDevice.leaf;
@@ -144,9 +144,9 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
     // 5. Safety.
     const Vec3 requested = out.render.force + externalForceN + out.effectsN + out.hookN;
     out.forceN = mSafety.filter(requested);
-    mShareCount = 0;
-    if (mDynamic.count > 0) {
-        splitReaction(*snapshot.scene, externalForceN + out.effectsN + out.hookN, out);
+    if (mCoupling.bodies().count > 0) {
+        mCoupling.split(*snapshot.scene, out.render,
+                        out.forceN - (externalForceN + out.effectsN + out.hookN), out.reactionN);
     }
     stamp(4);
     return out;
@@ -264,8 +264,6 @@ void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, con
     }
 }
 
-template class BasicHapticTick<GodObjectRenderer>;
-
 namespace coupling {
 
 /// Extrapolation limit, either way (s).
@@ -358,48 +356,55 @@ std::array<double, 3> solveSmall(std::array<std::array<double, 3>, 3> a, std::ar
 template <ForceAlgorithm Algorithm>
 void BasicHapticTick<Algorithm>::placeDynamic(const WorldSnapshot& snapshot, const Vec3& p,
                                               double dtS) noexcept {
-    mDynamic.clear();
-    const std::span<const std::uint32_t> slots = snapshot.dynamicSlots();
-    if (mTable == nullptr || slots.empty()) {
-        if constexpr (requires { mRenderer.useDynamicBodies(&mDynamic); }) {
-            mRenderer.useDynamicBodies(nullptr);
-        }
-        return;
-    }
-    mDynamic.active = true;
-    const Scene& scene = *snapshot.scene;
     const Vec3 proxy = mRenderer.proxy();
     const double reach = 2.0 * glm::length(proxy - p) + coupling::kPlaceMarginM;
+    const DynamicBodySet* placed =
+        mCoupling.place(snapshot, p, proxy, reach, dtS) ? &mCoupling.bodies() : nullptr;
+    if (placed != nullptr) {
+        mCandidates.add(placed->slotSpan());
+    }
+    if constexpr (requires { mRenderer.useDynamicBodies(placed); }) {
+        mRenderer.useDynamicBodies(placed);
+    }
+}
+
+template class BasicHapticTick<GodObjectRenderer>;
+
+bool BodyCoupling::place(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& proxy,
+                         double reachM, double dtS) noexcept {
+    mPlaced.clear();
+    mShareCount = 0;
+    const std::span<const std::uint32_t> slots = snapshot.dynamicSlots();
+    if (mTable == nullptr || slots.empty()) {
+        return false;
+    }
+    mPlaced.active = true;
+    const Scene& scene = *snapshot.scene;
     const std::size_t n = std::min(slots.size(), mTable->size());
-    for (std::size_t i = 0; i < n && mDynamic.count < DynamicBodySet::kMaxBodies; ++i) {
+    for (std::size_t i = 0; i < n && mPlaced.count < DynamicBodySet::kMaxBodies; ++i) {
         const BodyPose pose = mTable->read(i);
         const double t =
-            std::clamp((static_cast<double>(mBodiesNs) - static_cast<double>(pose.timeNs)) * 1e-9,
+            std::clamp((static_cast<double>(mNowNs) - static_cast<double>(pose.timeNs)) * 1e-9,
                        -coupling::kMaxExtrapolationS, coupling::kMaxExtrapolationS);
-        DynamicBodySet::Entry& e = mDynamic.entries[mDynamic.count];
+        DynamicBodySet::Entry& e = mPlaced.entries[mPlaced.count];
         if (slots[i] >= scene.size() ||
             !coupling::place(scene, slots[i], static_cast<std::uint32_t>(i), pose, t, dtS, e)) {
             continue;
         }
-        const double near = e.render.radius + reach;
+        const double near = e.render.radius + reachM;
         const double d2 = std::min(glm::dot(e.center - p, e.center - p),
                                    glm::dot(e.center - proxy, e.center - proxy));
         if (d2 <= near * near) {
-            mDynamic.slots[mDynamic.count++] = slots[i];
+            mPlaced.slots[mPlaced.count++] = slots[i];
         }
     }
-    mCandidates.add(mDynamic.slotSpan());
-    if constexpr (requires { mRenderer.useDynamicBodies(&mDynamic); }) {
-        mRenderer.useDynamicBodies(&mDynamic);
-    }
+    return true;
 }
 
-template <ForceAlgorithm Algorithm>
-void BasicHapticTick<Algorithm>::splitReaction(const Scene& scene, const Vec3& nonContactN,
-                                               TickOutput& out) noexcept {
-    const RenderOutput& r = out.render;
+void BodyCoupling::split(const Scene& scene, const RenderOutput& r, const Vec3& felt,
+                         Vec3& reactionN) noexcept {
+    mShareCount = 0;
     const std::size_t k = std::min<std::size_t>(r.contactCount, 3);
-    const Vec3 felt = out.forceN - nonContactN;
     if (k == 0 || !finite(felt)) {
         return;
     }
@@ -422,16 +427,16 @@ void BasicHapticTick<Algorithm>::splitReaction(const Scene& scene, const Vec3& n
     for (std::size_t i = 0; i < k; ++i) {
         const double weight = load > 0.0 ? std::max(lambda[i], 0.0) / load : 1.0 / double(k);
         const Vec3 share = lambda[i] * r.contacts[i].normal + weight * tangent;
-        const DynamicBodySet::Entry* e = mDynamic.find(scene.objectSlotOf(r.contacts[i].slot));
+        const DynamicBodySet::Entry* e = mPlaced.find(scene.objectSlotOf(r.contacts[i].slot));
         if (e == nullptr) {
             continue;
         }
         mShares[mShareCount++] = {e->body, share, r.proxy - e->centerOfMass};
-        out.reactionN += share;
+        reactionN += share;
     }
 }
 
-template <ForceAlgorithm Algorithm> bool BasicHapticTick<Algorithm>::handBack(double dtS) noexcept {
+bool BodyCoupling::handBack(double dtS) noexcept {
     bool ok = true;
     for (std::uint8_t i = 0; i < mShareCount && mTable != nullptr; ++i) {
         const Share& s = mShares[i];

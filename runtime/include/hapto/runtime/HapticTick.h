@@ -4,9 +4,8 @@
 
 #include "hapto/devices/Device.h"
 #include "hapto/index/Cursor.h"
-#include "hapto/runtime/BodyPoses.h"
+#include "hapto/runtime/BodyCoupling.h"
 #include "hapto/runtime/CandidateSet.h"
-#include "hapto/runtime/DynamicBodySet.h"
 #include "hapto/runtime/Effects.h"
 #include "hapto/runtime/ForceAlgorithm.h"
 #include "hapto/runtime/ForceSafety.h"
@@ -55,6 +54,18 @@ struct TickOutput {
 };
 
 namespace detail {
+/// Leaves the proxy may slide into in one tick, each solved again with its items
+/// (CandidateSet has a span for each: device, proxy, moving, and these).
+inline constexpr std::size_t kTickExtraLeaves = CandidateSet::kMaxSpans - 3;
+/// Goals pulled back when the proxy's path crosses more unlisted leaves than kTickExtraLeaves
+/// (pullBack() in HapticTick.cpp): three halvings toward the proxy's start, kTickNudgeM from
+/// it, the start itself; contacts and force stay the device point's, as hard as a full tick's.
+inline constexpr int kTickPullBacks = 5;
+/// The last pull-back but one moves the proxy at most this far (m): enough to meet the
+/// surfaces it rests on that the device point is behind, so the tick keeps their contact and
+/// force; 1 µm is inside the proxy's leaf unless it sits on the leaf's face.
+inline constexpr double kTickNudgeM = 1e-6;
+
 /// The leaves a tick's candidate spans list (N at most): the device's, the proxy's, then the
 /// extra ones, in the order their spans were added.
 template <std::size_t N> struct ListedLeaves {
@@ -66,6 +77,12 @@ template <std::size_t N> struct ListedLeaves {
     }
 };
 } // namespace detail
+
+/// The steady clock (ns, rt::nowNs) at the end of each of a tick's stages, in order: locate,
+/// candidates (the slide's leaves listed before solving included), render (the walk over the
+/// proxy's path, its re-solves and pull-backs included), effects (the hook included), safety.
+/// `hapto bench tick` times the tick with them.
+using TickStageStamps = std::array<std::uint64_t, 5>;
 
 /// One device's haptic tick around a force algorithm (the seam: ForceAlgorithm.h; HapticTick
 /// is the tick around the god-object renderer). Design note: the sequence every caller runs (the
@@ -94,17 +111,9 @@ template <std::size_t N> struct ListedLeaves {
 /// GodObjectRenderer); a new algorithm adds its line there.
 template <ForceAlgorithm Algorithm> class alignas(64) BasicHapticTick {
 public:
-    /// Leaves the proxy may slide into in one tick, each solved again with its items
-    /// (CandidateSet has a span for each: device, proxy, moving, and these).
-    static constexpr std::size_t kExtraLeaves = CandidateSet::kMaxSpans - 3;
-    /// Goals pulled back when the proxy's path crosses more unlisted leaves than kExtraLeaves
-    /// (pullBack() in HapticTick.cpp): three halvings toward the proxy's start, kNudgeM from it,
-    /// the start itself; contacts and force stay the device point's, as hard as a full tick's.
-    static constexpr int kPullBacks = 5;
-    /// The last pull-back but one moves the proxy at most this far (m): enough to meet the
-    /// surfaces it rests on that the device point is behind, so the tick keeps their contact
-    /// and force; 1 µm is inside the proxy's leaf unless it sits on the leaf's face.
-    static constexpr double kNudgeM = 1e-6;
+    static constexpr std::size_t kExtraLeaves = detail::kTickExtraLeaves; ///< See there.
+    static constexpr int kPullBacks = detail::kTickPullBacks;             ///< See there.
+    static constexpr double kNudgeM = detail::kTickNudgeM;                ///< See there (m).
 
     /// Checks both configurations; throws std::invalid_argument when one is invalid. [control]
     explicit BasicHapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
@@ -128,21 +137,15 @@ public:
                     const Vec3& velocityWorld, double dtS, const Vec3& externalForceN) noexcept;
 
     /// The dynamic bodies for the next tick(): their poses come from `table` (null: none),
-    /// extrapolated to `nowNs` (the table's clock); the reaction of their contact force goes
-    /// back to it by handBack() (HapticTick.cpp). Call it before each tick that should
-    /// see them. [servo]
+    /// extrapolated to `nowNs` (the table's clock) (BodyCoupling). [servo]
     void placeBodies(BodyPoseTable* table, std::uint64_t nowNs) noexcept {
-        mTable = table;
-        mBodiesNs = nowNs;
+        mCoupling.use(table, nowNs);
     }
     /// The dynamic bodies the last tick placed. [servo]
-    const DynamicBodySet& dynamicBodies() const noexcept { return mDynamic; }
-    /// The last tick's force was sent as computed: hands each touched dynamic body the
-    /// reaction of its share of it (-share x `dtS` N s at the contact point, linear and about
-    /// the body's centre of mass) through the table, once (a second call adds nothing).
-    /// Returns false when the table refused one (not finite, out of range). Not calling it
-    /// (the force was not sent) hands nothing back. [servo]
-    bool handBack(double dtS) noexcept;
+    const DynamicBodySet& dynamicBodies() const noexcept { return mCoupling.bodies(); }
+    /// The last tick's force was sent as computed: hands the touched dynamic bodies its
+    /// reaction, once (BodyCoupling::handBack). False when the table refused one. [servo]
+    bool handBack(double dtS) noexcept { return mCoupling.handBack(dtS); }
 
     /// Replaces the force effects from the next tick on (a copy, no allocation). [servo] (the
     /// thread that ticks; the Runtime's control side goes through Runtime::setEffects)
@@ -154,11 +157,7 @@ public:
     /// ticks: it is a plain field, not synchronised.
     void setHook(const TickHook& hook) noexcept { mHook = hook; }
 
-    /// The steady clock (ns, rt::nowNs) at the end of each of tick()'s stages, in order:
-    /// locate, candidates (the slide's leaves listed before solving included), render (the
-    /// walk over the proxy's path, its re-solves and pull-backs included), effects (the hook
-    /// included), safety. `hapto bench tick` times the tick with them.
-    using StageStamps = std::array<std::uint64_t, 5>;
+    using StageStamps = TickStageStamps; ///< The clock at each stage's end (TickStageStamps).
     /// From the next tick on, tick() writes the clock at each stage's end into `*stamps`;
     /// null (the default) reads no clock. [control] before the ticks it is for
     void timeStages(StageStamps* stamps) noexcept { mStamps = stamps; }
@@ -182,25 +181,18 @@ private:
     void stamp(std::size_t i) noexcept;
     /// Binds the cursors to a new snapshot's index, and the proxy to `p` on a fresh start.
     void bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& out) noexcept;
-    /// Lists the leaves of the likely slide (from `from` along the last contact plane toward
-    /// `p`) before solving.
+    /// Lists the leaves of the likely slide (`from` along the last contact plane) first.
     void listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept;
-    /// Solves, and solves again with each leaf the proxy's way crosses that no span listed;
-    /// pulls the goal back when they run out.
+    /// Solves again with each unlisted leaf the proxy's way crosses; then pulls back.
     void render(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
                 ListedLeaves& listed, TickOutput& out) noexcept;
-    /// Solves again toward goals pulled back from `p` toward `from` until the proxy's way stays
-    /// in the listed leaves (TickOutput::pullBacks).
+    /// Solves toward goals pulled back from `p` toward `from` (TickOutput::pullBacks).
     void pullBack(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
                   const typename Algorithm::State& start, std::span<const std::uint32_t> known,
                   std::uint32_t& tested, TickOutput& out) noexcept;
 
-    /// Places the dynamic bodies near `p` and the proxy (mDynamic) from the table, now and
-    /// `dtS` before, and adds their span to the candidates (HapticTick.cpp).
+    /// Places the dynamic bodies near `p` and the proxy for the renderer and the candidates.
     void placeDynamic(const WorldSnapshot& snapshot, const Vec3& p, double dtS) noexcept;
-    /// Splits the contact part of the force to send among the contact planes and keeps the
-    /// dynamic bodies' shares for handBack() (HapticTick.cpp).
-    void splitReaction(const Scene& scene, const Vec3& nonContactN, TickOutput& out) noexcept;
 
     Cursor mDeviceCursor; ///< The device point's leaf.
     Cursor mProxyCursor;  ///< The proxy's leaf.
@@ -214,17 +206,7 @@ private:
     std::uint64_t mBoundVersion = 0; ///< The snapshot version they were bound for.
     StageStamps* mStamps = nullptr;  ///< Where tick() writes its stage ends, or none.
     bool mFresh = true;              ///< The next tick starts afresh (reset()).
-    BodyPoseTable* mTable = nullptr; ///< The dynamic bodies' poses and impulses, or none.
-    std::uint64_t mBodiesNs = 0;     ///< The time the next tick places them at (ns).
-    DynamicBodySet mDynamic;         ///< The bodies placed this tick.
-    /// A dynamic body's share of the last tick's force, waiting for handBack().
-    struct Share {
-        std::uint32_t body = 0; ///< Its body in the table.
-        Vec3 forceN{0.0};       ///< The share the hand is sent (N).
-        Vec3 armM{0.0};         ///< The contact point from the body's centre of mass (m).
-    };
-    std::array<Share, 3> mShares{}; ///< The first mShareCount wait for handBack().
-    std::uint8_t mShareCount = 0;
+    BodyCoupling mCoupling;          ///< The dynamic bodies placed, and their reaction.
 };
 
 static_assert(ForceAlgorithm<GodObjectRenderer>);
