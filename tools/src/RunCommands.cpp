@@ -127,6 +127,14 @@ void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
     useTraceSettings(configs, !(a.rateHz > 0));
     if (a.stepped) {
         checkSteppable(configs);
+        if (a.view.enabled) {
+            // The view draws what the devices and bodies are now, at the wall clock's pace; a
+            // stepped session is minutes of session time in seconds of CPU, then gone.
+            throw InputError(
+                "--view with --stepped: a stepped session runs on its own clock as fast as the "
+                "CPU allows, not in real time, so a live view cannot follow it; record it "
+                "(--record DIR) and replay it with 'hapto view --trace DIR', or drop --stepped");
+        }
     }
     checkDeviceCount(configs.size(), a.devices);
     checkSpinAgainstRates(a.spinUs, configs);
