@@ -16,6 +16,7 @@
 #include <cmath>
 #include <ctime>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -117,15 +118,35 @@ struct GraspRig {
     }
 };
 
+/// The two windows: slip from the squeeze's end, the force while lifted (from the lift's end).
+struct Probes {
+    GraspProbe slip;
+    GraspProbe force;
+};
+
+/// Feeds the probe; returns the squeeze (N) of the sample that began its window, else none.
+std::optional<double> sample(const Runtime& rt, GraspProbe& probe) {
+    if (const std::optional<GraspSample> s = graspSampleOf(rt, 0, 0, 1)) {
+        if (!probe.begun()) {
+            probe.begin(*s);
+            return 0.5 * (s->forceBN.x - s->forceAN.x); // left (A) is pushed to -x, right to +x
+        } else {
+            probe.add(*s);
+        }
+    }
+    return std::nullopt;
+}
+
 /// Drives the rig to kCarryEnd, measuring; fills `result` but the report's figures.
-void drive(GraspRig& rig, const GraspCellSpec& spec, GraspProbe& probe, GraspCellResult& result) {
+void drive(GraspRig& rig, const GraspCellSpec& spec, Probes& probes, GraspCellResult& result) {
     Runtime& rt = *rig.runtime;
     const std::uint64_t t0 = rig.clock.nowNs();
     const std::uint64_t inc = std::min(periodNs(spec.servoRateHz), periodNs(spec.dynamicsRateHz));
     const auto at = [&](double s) {
         return t0 + static_cast<std::uint64_t>(std::llround(s * 1e9));
     };
-    const std::uint64_t begin = at(GraspTimes::kSqueezeEnd), end = at(GraspTimes::kCarryEnd);
+    const std::uint64_t begin = at(GraspTimes::kSqueezeEnd), lifted = at(GraspTimes::kLiftEnd);
+    const std::uint64_t end = at(GraspTimes::kCarryEnd);
     const std::uint64_t maintainNs = 5'000'000;
     std::uint64_t nextMaintain = t0 + maintainNs;
     for (std::uint64_t t = t0 + inc; t <= end; t += inc) {
@@ -142,15 +163,13 @@ void drive(GraspRig& rig, const GraspCellSpec& spec, GraspProbe& probe, GraspCel
             rt.maintain();
             nextMaintain += maintainNs;
         }
-        if (t < begin) {
-            continue;
-        }
-        if (const std::optional<GraspSample> s = graspSampleOf(rt, 0, 0, 1)) {
-            if (!probe.begun()) {
-                probe.begin(*s);
-            } else {
-                probe.add(*s);
+        if (t >= begin) {
+            if (const std::optional<double> squeeze = sample(rt, probes.slip)) {
+                result.squeezeFeltN = *squeeze;
             }
+        }
+        if (t >= lifted) {
+            (void)sample(rt, probes.force);
         }
     }
 }
@@ -189,6 +208,10 @@ void checkGraspCellSpec(const GraspCellSpec& spec) {
     }
 }
 
+double graspElasticSlipM(const GraspCellSpec& spec, double gravityMPerS2) {
+    return spec.massKg * gravityMPerS2 / (2.0 * spec.stiffnessNPerM);
+}
+
 double graspHoldMargin(const GraspCellSpec& spec, double gravityMPerS2) {
     return spec.staticFriction * 2.0 * spec.squeezeN / (spec.massKg * gravityMPerS2);
 }
@@ -203,10 +226,13 @@ GraspCellResult runGraspCell(const GraspCellSpec& spec) {
     GraspProbeSettings ps;
     ps.massKg = spec.massKg;
     ps.gravityMPerS2 = 9.81; // ScenePhysics' default gravity, the scene's
-    GraspProbe probe(ps);
+    Probes probes{GraspProbe(ps), GraspProbe(ps)};
     GraspCellResult result;
-    drive(rig, spec, probe, result);
-    result.grasp = probe.figures();
+    drive(rig, spec, probes, result);
+    result.grasp = probes.slip.figures();
+    const GraspFigures force = probes.force.figures();
+    result.grasp.forceErrorMedian = force.forceErrorMedian;
+    result.grasp.forceErrorWorst = force.forceErrorWorst;
     result.liftM = rt.bodyPoses()->read(0).centerOfMass.y - spec.halfExtentM;
     rt.stop();
     const RunReport report = rt.report();
@@ -229,8 +255,9 @@ bool sameGraspFigures(const GraspCellResult& a, const GraspCellResult& b) {
            x.samples == y.samples && x.nonFinite == y.nonFinite && x.held == y.held &&
            a.deepestPenetrationM == b.deepestPenetrationM &&
            a.largestEnergyGainJ == b.largestEnergyGainJ && a.liftM == b.liftM &&
-           a.dynamicsSteps == b.dynamicsSteps && a.stable == b.stable &&
-           a.zeroedForMisses == b.zeroedForMisses && a.stepCpuNs.size() == b.stepCpuNs.size();
+           a.squeezeFeltN == b.squeezeFeltN && a.dynamicsSteps == b.dynamicsSteps &&
+           a.stable == b.stable && a.zeroedForMisses == b.zeroedForMisses &&
+           a.stepCpuNs.size() == b.stepCpuNs.size();
 }
 
 } // namespace hapto::experiments

@@ -148,6 +148,10 @@ TEST_CASE("grasp cell: a squeeze above m g / (2 mu_s) lifts the box, one below l
     CHECK(held.grasp.forceErrorMedian < 0.05);
     CHECK(held.stable);
     CHECK(held.stepCpuNs.size() == held.dynamicsSteps);
+    // Held by static friction, the box sits lower against the hands only by the rendered
+    // friction spring's stretch, m g / (2 k) (0.245 mm here), and the hands press as told.
+    CHECK(held.grasp.finalSlipM == Approx(graspElasticSlipM(firm)).epsilon(0.1));
+    CHECK(held.squeezeFeltN == Approx(firm.squeezeN).epsilon(0.1));
 
     GraspCellSpec light = firm;
     light.squeezeN = 0.25; // margin 0.61

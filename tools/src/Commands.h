@@ -62,6 +62,10 @@ void addRunCommands(CLI::App& app);
 /// written as CSV, JSON, markdown and plots. [control]
 void addExperimentCommands(CLI::App& app);
 
+/// `hapto experiment grasp` under `exp` (GraspExperimentCommand.cpp): two simulated hands grasp
+/// a dynamic box in step mode; slip, penetration, energy, force error and step cost. [control]
+void addGraspExperimentCommand(CLI::App* exp);
+
 /// `hapto soak`: a long run with world updates and injected faults; drift, memory, misses.
 /// [control]
 void addSoakCommands(CLI::App& app);

@@ -11,12 +11,12 @@
 /// the servo ticks due at t, so every figure but the step's cost is the same every run. The
 /// session is driven in increments of the shortest period (servo or dynamics; the rates offered
 /// divide 1 s into whole nanoseconds that are multiples of it), so each increment holds at most
-/// one event instant. Measured window: from the end of the squeeze (GraspTimes::kSqueezeEnd)
-/// to the end of the carry (kCarryEnd), sampled after each dynamics step: slip, the hands'
-/// vertical force against m g and held/dropped by GraspProbe; the deepest penetration and the
-/// largest energy gain of the body from the run report. The lift is a minimum-jerk rise of the
-/// scripts' 5 cm in 1 s, whose peak acceleration 5.77 x 0.05 m/s^2 (Flash & Hogan 1985: peak
-/// 10 / sqrt(3) d / T^2) is 2.9 % of g: the force error's worst includes that.
+/// one event instant. Measured after each dynamics step: the slip and held/dropped (GraspProbe)
+/// from the end of the squeeze (GraspTimes::kSqueezeEnd) to the end of the carry (kCarryEnd);
+/// the hands' vertical force against m g while the box is up, from the end of the lift
+/// (kLiftEnd) to kCarryEnd (a horizontal carry: no vertical acceleration asked for, so the hands
+/// should carry exactly m g); the deepest penetration and the largest energy gain of the body
+/// from the run report.
 ///
 /// The step's cost. In step mode the runtime measures its steps on the ManualClock, so its
 /// report says 0; the cell measures instead the CPU time of the stepping thread
@@ -55,12 +55,22 @@ void checkGraspCellSpec(const GraspCellSpec& spec);
 /// mu_s (F1 + F2) / (m g): the analytic hold margin; the box holds iff it is >= 1. [any thread]
 double graspHoldMargin(const GraspCellSpec& spec, double gravityMPerS2 = 9.81);
 
+/// The slip of a held box that the rendering itself predicts (m): each hand carries m g / 2
+/// by static friction, which the god-object renders as the stiffness k times the tangential
+/// offset of the device point from its anchored proxy, so the box settles m g / (2 k) lower
+/// relative to the hands than when it rested. [any thread]
+double graspElasticSlipM(const GraspCellSpec& spec, double gravityMPerS2 = 9.81);
+
 /// What one cell measured.
 struct GraspCellResult {
-    GraspFigures grasp;                ///< Slip, force error, held (GraspProbe).
-    double deepestPenetrationM = 0.0;  ///< The body's deepest overlap with anything (m).
-    double largestEnergyGainJ = 0.0;   ///< The body's largest energy rise with no work (J).
-    double liftM = 0.0;                ///< The body's rise from its rest height at kCarryEnd (m).
+    /// Slip and held over squeeze end..carry end, force error over lift end..carry end.
+    GraspFigures grasp;
+    double deepestPenetrationM = 0.0; ///< The body's deepest overlap with anything (m).
+    double largestEnergyGainJ = 0.0;  ///< The body's largest energy rise with no work (J).
+    double liftM = 0.0;               ///< The body's rise from its rest height at kCarryEnd (m).
+    /// The squeeze the hands exert at the window's start (kSqueezeEnd): the mean of the two sent
+    /// forces' components along the grasp axis, into the box (N).
+    double squeezeFeltN = 0.0;
     std::uint64_t dynamicsSteps = 0;   ///< Dynamics steps run.
     bool stable = false;               ///< The run report's verdict (devices and dynamics).
     std::uint64_t zeroedForMisses = 0; ///< Both hands' ticks zeroed for misses (0 stepped).
