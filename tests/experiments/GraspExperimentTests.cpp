@@ -1,15 +1,25 @@
 // GraspProbe (experiments/GraspProbe.h): slip against the hands' midpoint, the hands' vertical
 // force against m g, held or dropped, on samples whose answers are worked out by hand; and one
 // cell of `hapto experiment grasp` (GraspCell.h) run stepped: a squeeze above the analytic
-// hold rule holds, one below slips, and two runs measure the same figures.
+// hold rule holds, one below slips, and two runs measure the same figures; and the experiment's
+// outputs on its --quick subset.
 
 #include "hapto/experiments/GraspCell.h"
+#include "hapto/experiments/GraspExperiment.h"
 #include "hapto/experiments/GraspProbe.h"
 
 #include <catch2/catch.hpp>
 
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <unistd.h>
+#include <vector>
 
 using namespace hapto;
 using namespace hapto::experiments;
@@ -181,4 +191,47 @@ TEST_CASE("grasp cell: a spec it cannot run is refused naming the field") {
     s = GraspCellSpec{};
     s.squeezeN = std::numeric_limits<double>::quiet_NaN();
     CHECK_THROWS_WITH(checkGraspCellSpec(s), Catch::Contains("squeeze_n"));
+}
+
+// ---- The experiment's outputs (GraspExperiment.h), on the --quick subset.
+
+TEST_CASE("grasp experiment: the quick subset writes its table as CSV, JSON and markdown") {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("hapto-grasp-experiment-" + std::to_string(::getpid()));
+    GraspArgs args;
+    args.common.out = dir.string();
+    const GraspArgs quick = quickGraspArgs(args);
+    REQUIRE(quick.common.quick);
+    REQUIRE(quick.squeezesN == std::vector<double>{0.3, args.base.squeezeN});
+    CHECK(runGrasp(quick) == 0);
+    std::ifstream json(dir / "grasp.json");
+    const auto j = nlohmann::json::parse(json);
+    const auto& rows = j["rows"];
+    REQUIRE(rows.size() == 5); // 2 squeezes, then the default cell once per other factor
+    CHECK(rows[0]["squeeze_n"] == 0.3);
+    CHECK(rows[0]["expected"] == "slip");
+    CHECK(rows[0]["held"] == "dropped");
+    CHECK(rows[1]["expected"] == "hold");
+    CHECK(rows[1]["held"] == "held");
+    for (const auto& row : rows) {
+        CHECK(row["verdict"] == "agrees");
+        CHECK(row["repeatable"] == true);
+    }
+    CHECK(rows[1]["slip_final_mm"] == rows[2]["slip_final_mm"]); // one cell, shown twice
+    std::ifstream md(dir / "grasp.md");
+    const std::string text{std::istreambuf_iterator<char>(md), std::istreambuf_iterator<char>()};
+    CHECK(text.find("QUICK RUN") != std::string::npos);
+    std::ifstream csv(dir / "grasp.csv");
+    std::string header;
+    std::getline(csv, header);
+    CHECK(header.rfind("factor,squeeze_n,", 0) == 0);
+    std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("grasp experiment: a list value no cell can run is refused naming its factor") {
+    GraspArgs args = quickGraspArgs(GraspArgs{});
+    args.common.out = (std::filesystem::temp_directory_path() / "hapto-grasp-refused").string();
+    args.ratesHz = {3000.0};
+    CHECK_THROWS_WITH(runGrasp(args), Catch::Contains("servo rate 3000"));
+    CHECK(!std::filesystem::exists(args.common.out)); // refused before any output
 }
