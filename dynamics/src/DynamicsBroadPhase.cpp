@@ -8,7 +8,14 @@
 // outsideObjects() where the box leaves the index's bounds): items of dynamic objects are
 // skipped, an item met in several leaves is taken once (a stamp per item, sized by the
 // constructor), and each body's candidates are sorted by item, so the contacts and their order
-// do not depend on the index's kind or leaf order. Body pairs are tested in findContacts
+// do not depend on the index's kind or leaf order. The query is cached per body (a cursor of
+// sorts, BodyWork::QueryCache): the index is asked for the swept box grown by kCacheSlackM, its
+// static items kept sorted, and while later swept boxes stay inside that box each step only
+// filters those items by their boxes. Every item a query of the swept box itself would give
+// is in a leaf meeting the larger box, so the candidates are the same items in the same order
+// (a resting body's step no longer walks the index, whose depth grows with the scene). A box
+// whose items do not fit the cache is asked directly each step while the body stays inside
+// it. Body pairs are tested in findContacts
 // (every pair's swept boxes: O(bodies^2), fine for the tens of bodies here). Invariants: no
 // allocation (the candidate list has a fixed capacity; the excess is counted, never stored);
 // a sleeping body gathers nothing.
@@ -100,7 +107,7 @@ void consider(const Scene& scene, Dynamics::Impl& impl, std::uint32_t body,
 }
 
 // Body i's static candidates through the index's box query, in ascending item order.
-void gatherBody(const Scene& scene, Dynamics::Impl& impl, std::uint32_t i) noexcept {
+void gatherDirect(const Scene& scene, Dynamics::Impl& impl, std::uint32_t i) noexcept {
     ++impl.stamp;
     const std::size_t begin = impl.candidates.size();
     const Aabb& box = impl.work[i].sweptBox;
@@ -119,6 +126,78 @@ void gatherBody(const Scene& scene, Dynamics::Impl& impl, std::uint32_t i) noexc
     // Ascending items: the same contacts in the same order whatever the index's leaf order.
     std::sort(impl.candidates.begin() + static_cast<std::ptrdiff_t>(begin), impl.candidates.end(),
               [](const Candidate& a, const Candidate& b) { return a.item < b.item; });
+}
+
+/// How far the cached query's box reaches beyond the swept box it was made for (m): a body
+/// may move this far before its cache is made again.
+constexpr double kCacheSlackM = 0.005;
+
+bool contains(const Aabb& outer, const Aabb& inner) noexcept {
+    return outer.min.x <= inner.min.x && outer.min.y <= inner.min.y && outer.min.z <= inner.min.z &&
+           inner.max.x <= outer.max.x && inner.max.y <= outer.max.y && inner.max.z <= outer.max.z;
+}
+
+// Makes body i's cache for its swept box grown by kCacheSlackM.
+void refillCache(const Scene& scene, Dynamics::Impl& impl, std::uint32_t i) noexcept {
+    BodyWork::QueryCache& c = impl.work[i].cache;
+    c.box = impl.work[i].sweptBox;
+    c.box.min -= Vec3(kCacheSlackM);
+    c.box.max += Vec3(kCacheSlackM);
+    c.count = 0;
+    c.overflow = false;
+    ++impl.stamp;
+    const auto add = [&](std::uint32_t item) {
+        const std::uint32_t dense =
+            isTriangleItem(item) ? scene.size() + (item & ~kTriangleItemBit) : item;
+        if (impl.seenStamp[dense] == impl.stamp ||
+            scene.object(scene.objectSlotOf(item)).body.dynamic) {
+            return;
+        }
+        impl.seenStamp[dense] = impl.stamp;
+        if (c.count == c.items.size()) {
+            c.overflow = true;
+            return;
+        }
+        c.items[c.count++] = item;
+    };
+    auto visit = [&](std::uint32_t leaf) {
+        for (const std::uint32_t item : impl.index->leafObjects(leaf)) {
+            add(item);
+        }
+        return !c.overflow;
+    };
+    impl.index->visitLeavesWith(c.box, visit);
+    if (!c.overflow && impl.index->reachesOutside(c.box)) {
+        for (const std::uint32_t item : impl.index->outsideObjects()) {
+            add(item);
+        }
+    }
+    c.valid = !c.overflow;
+    std::sort(c.items.begin(), c.items.begin() + c.count);
+}
+
+// Body i's static candidates, from its cached query when its swept box is inside the cache's
+// box (made again when not), else asked directly; ascending items either way.
+void gatherBody(const Scene& scene, Dynamics::Impl& impl, std::uint32_t i) noexcept {
+    BodyWork& w = impl.work[i];
+    if (!contains(w.cache.box, w.sweptBox)) {
+        refillCache(scene, impl, i);
+    }
+    if (!w.cache.valid) {
+        gatherDirect(scene, impl, i); // too many items near it to cache
+        return;
+    }
+    for (std::uint32_t k = 0; k < w.cache.count; ++k) {
+        const std::uint32_t item = w.cache.items[k];
+        if (!overlaps(w.sweptBox, itemBox(scene, item))) {
+            continue;
+        }
+        if (impl.candidates.size() == impl.candidates.capacity()) {
+            ++impl.droppedCandidates;
+            continue;
+        }
+        impl.candidates.push_back({i, item});
+    }
 }
 
 } // namespace

@@ -13,6 +13,7 @@
 #include "hapto/dynamics/Contact.h"
 #include "hapto/dynamics/Dynamics.h"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -36,6 +37,19 @@ struct BodyWork {
     double minNetEnergyJ = 0.0; // lowest energy minus hand work seen so far (J)
     bool energySeen = false;
     Aabb sweptBox{}; // this step's broad-phase box (m)
+    /// The broad phase's cached query (DynamicsBroadPhase.cpp): the static items of every leaf
+    /// meeting `box` (plus outsideObjects() when `box` leaves the index's bounds), static
+    /// only, each once, ascending. Valid while `count` <= the capacity and the swept box stays
+    /// inside `box`: a resting or slow body walks the index once, not every step.
+    struct QueryCache {
+        static constexpr std::size_t kItems = 128;
+        Aabb box = Aabb::empty();
+        std::uint32_t count = 0;
+        bool valid = false;    // the items are box's
+        bool overflow = false; // box's items did not fit: the direct query inside box
+
+        std::array<std::uint32_t, kItems> items{};
+    } cache;
 };
 
 /// One contact point's normal constraint between body `a` and either body `b` or a static

@@ -281,6 +281,47 @@ TEST_CASE("the same steps whatever the index", "[dynamics]") {
           0);
 }
 
+/// A floor strewn with a 20 x 20 field of static 5 mm cubes 1 cm apart (401 static items),
+/// a sphere rolling and a box sliding across it, and a sphere dropped onto it.
+std::vector<SceneObject> cubeFieldScene() {
+    std::vector<SceneObject> o{floorBox(1)};
+    for (int i = 0; i < 20; ++i) {
+        for (int k = 0; k < 20; ++k) {
+            o.push_back(makeBox(static_cast<ObjectId>(2 + 20 * i + k),
+                                Vec3(-0.095 + 0.01 * i, 0.0025, -0.095 + 0.01 * k), Vec3(0.0025),
+                                glm::angleAxis(0.1 * (i + k), Vec3(0, 1, 0)),
+                                frictionOf(0.5, 0.4)));
+        }
+    }
+    SceneObject rolling = dynamicSphere(500, Vec3(-0.12, 0.016, 0.0), 0.01, 0.05);
+    rolling.body.velocity = Vec3(0.6, 0.0, 0.15);
+    SceneObject sliding = dynamicBox(501, Vec3(0.0, 0.016, -0.12), Vec3(0.01), 0.1);
+    sliding.body.velocity = Vec3(0.1, 0.0, 0.5);
+    o.push_back(rolling);
+    o.push_back(sliding);
+    o.push_back(dynamicSphere(502, Vec3(0.03, 0.08, 0.03), 0.008, 0.03));
+    return o;
+}
+
+TEST_CASE("a body's cached index query gives the steps a direct query gives", "[dynamics]") {
+    // The octree's bodies keep a cached query (a few dozen items near them, asked again after
+    // moving 5 mm); brute force's one leaf holds all 401 items, more than a cache holds, so
+    // its bodies ask the index directly every step. The candidates must be the same items in
+    // the same order, and so the states the same bits.
+    World cached(cubeFieldScene(), Vec3(0, -kG, 0), awake()),
+        direct(cubeFieldScene(), Vec3(0, -kG, 0), awake(), 1000.0, "brute");
+    const Vec3 start = cached.body(0).position;
+    const std::size_t bytes = sizeof(BodyState) * cached.dynamics->bodyCount();
+    for (int k = 0; k < 1000; ++k) {
+        cached.dynamics->step();
+        direct.dynamics->step();
+        REQUIRE(std::memcmp(cached.dynamics->bodies().data(), direct.dynamics->bodies().data(),
+                            bytes) == 0);
+    }
+    CHECK(glm::length(cached.body(0).position - start) > 0.05); // many caches made, not one
+    CHECK(cached.dynamics->droppedContacts() == 0);
+}
+
 TEST_CASE("a box comes to rest on a closed triangle-mesh floor", "[dynamics]") {
     // The floor is the mesh of a 2 m x 10 cm x 2 m box: its top face is two triangles.
     SceneObject slab = makeBox(1, Vec3(0, -0.05, 0), Vec3(1.0, 0.05, 1.0));
