@@ -12,18 +12,18 @@ constexpr double kSkin = 0.1;
 constexpr double kShrink = 0.01;
 
 /// The unit right triangle in z = 0, counter-clockwise seen from +z (its front).
-const TriangleCorners kTri{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
-const Vec3 kUp(0, 0, 1);
+const TriangleCorners kSweptTri{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+const Vec3 kSweptUp(0, 0, 1);
 
 /// The triangle's front test over a path, counting the corner reads.
 SweptEntry sweepTri(const Vec3& from, const Vec3& to, int* fetched = nullptr) {
     return sweepTriangleFront(
-        kUp, 0.0,
+        kSweptUp, 0.0,
         [&] {
             if (fetched) {
                 ++*fetched;
             }
-            return TriangleGeometry{kTri, triangleEdges(kTri, kUp)};
+            return TriangleGeometry{kSweptTri, triangleEdges(kSweptTri, kSweptUp)};
         },
         from, to, kSkin, kShrink, 1e-9);
 }

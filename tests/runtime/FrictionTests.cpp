@@ -13,15 +13,15 @@ using hapto::test::stroke;
 
 namespace {
 
-constexpr double kK = 1000.0; // N/m
-constexpr double kD = 0.002;  // m
+constexpr double kFrictionK = 1000.0; // N/m
+constexpr double kFrictionD = 0.002;  // m
 constexpr double kMuS = 0.5;
 constexpr double kMuD = 0.3;
-constexpr double kTol = 1e-4; // N (the 10 nm skin adds k x 1e-8 = 1e-5 N to the normal)
+constexpr double kFrictionTol = 1e-4; // N (the 10 nm skin adds k x 1e-8 = 1e-5 N to the normal)
 
 Material rough(double muS = kMuS, double muD = kMuD) {
     Material m;
-    m.stiffness = kK;
+    m.stiffness = kFrictionK;
     m.staticFriction = muS;
     m.dynamicFriction = muD;
     return m;
@@ -32,23 +32,23 @@ Material rough(double muS = kMuS, double muD = kMuD) {
 TEST_CASE("touch: a static press on a rough face gives a pure normal force") {
     const RenderRig rig({makeBox(1, Vec3(0.0), Vec3(0.05), Quat(1, 0, 0, 0), rough())});
     GodObjectRenderer r;
-    RenderOutput out = pressFrom(r, rig, Vec3(0.01, 0.06, 0.0), Vec3(0.01, 0.05 - kD, 0.0));
+    RenderOutput out = pressFrom(r, rig, Vec3(0.01, 0.06, 0.0), Vec3(0.01, 0.05 - kFrictionD, 0.0));
     for (int i = 0; i < 100; ++i) { // hold still
-        out = r.update(rig.scene, rig.all(), Vec3(0.01, 0.05 - kD, 0.0), Vec3(0.0), 1e-3);
+        out = r.update(rig.scene, rig.all(), Vec3(0.01, 0.05 - kFrictionD, 0.0), Vec3(0.0), 1e-3);
     }
     CHECK(out.force.x == Approx(0.0).margin(1e-12));
     CHECK(out.force.z == Approx(0.0).margin(1e-12));
-    CHECK(out.force.y == Approx(kK * kD).margin(kTol));
+    CHECK(out.force.y == Approx(kFrictionK * kFrictionD).margin(kFrictionTol));
     CHECK_FALSE(out.sliding);
 }
 
 TEST_CASE("the proxy sticks until the static cone breaks, then slides at mu_d") {
     const RenderRig rig({makeBox(1, Vec3(0.0), Vec3(0.05), Quat(1, 0, 0, 0), rough())});
     GodObjectRenderer r;
-    const double y = 0.05 - kD;
+    const double y = 0.05 - kFrictionD;
     pressFrom(r, rig, Vec3(0.0, 0.06, 0.0), Vec3(0.0, y, 0.0));
-    const double step = 1.7e-5;         // m per tick: 17 mm/s
-    const double breakAway = kMuS * kD; // 1 mm: where mu_s says the proxy lets go
+    const double step = 1.7e-5;                 // m per tick: 17 mm/s
+    const double breakAway = kMuS * kFrictionD; // 1 mm: where mu_s says the proxy lets go
     double slipAt = -1.0;
     double lastStuckX = 0.0;
     const CandidateSet cands = rig.all();
@@ -56,11 +56,11 @@ TEST_CASE("the proxy sticks until the static cone breaks, then slides at mu_d") 
         const double x = step * i;
         const RenderOutput out =
             r.update(rig.scene, cands, Vec3(x, y, 0.0), Vec3(0.017, 0, 0), 1e-3);
-        CHECK(out.force.y == Approx(kK * kD).margin(kTol));
+        CHECK(out.force.y == Approx(kFrictionK * kFrictionD).margin(kFrictionTol));
         if (slipAt < 0.0 && !out.sliding) {
             // Sticking: the proxy stays where it touched; tangential force is k x, against motion.
             CHECK(out.proxy.x == Approx(0.0).margin(1e-9));
-            CHECK(out.force.x == Approx(-kK * x).margin(kTol));
+            CHECK(out.force.x == Approx(-kFrictionK * x).margin(kFrictionTol));
             lastStuckX = x;
         } else {
             if (slipAt < 0.0) {
@@ -68,8 +68,8 @@ TEST_CASE("the proxy sticks until the static cone breaks, then slides at mu_d") 
             }
             // Sliding: tangential force is mu_d |normal force|, against the motion.
             CHECK(out.sliding);
-            CHECK(out.force.x == Approx(-kMuD * out.force.y).margin(kTol));
-            CHECK(out.proxy.x == Approx(x - kMuD * kD).margin(1e-7));
+            CHECK(out.force.x == Approx(-kMuD * out.force.y).margin(kFrictionTol));
+            CHECK(out.proxy.x == Approx(x - kMuD * kFrictionD).margin(1e-7));
         }
     }
     REQUIRE(slipAt > 0.0);
@@ -81,7 +81,7 @@ TEST_CASE("the proxy sticks until the static cone breaks, then slides at mu_d") 
 TEST_CASE("after sliding stops the proxy sticks again, holding the mu_d offset") {
     const RenderRig rig({makeBox(1, Vec3(0.0), Vec3(0.05), Quat(1, 0, 0, 0), rough())});
     GodObjectRenderer r;
-    const double y = 0.05 - kD;
+    const double y = 0.05 - kFrictionD;
     pressFrom(r, rig, Vec3(0.0, 0.06, 0.0), Vec3(0.0, y, 0.0));
     stroke(r, rig, Vec3(0.0, y, 0.0), Vec3(0.01, y, 0.0), 100);
     RenderOutput out;
@@ -89,11 +89,11 @@ TEST_CASE("after sliding stops the proxy sticks again, holding the mu_d offset")
         out = r.update(rig.scene, rig.all(), Vec3(0.01, y, 0.0), Vec3(0.0), 1e-3);
     }
     CHECK_FALSE(out.sliding);
-    CHECK(out.force.x == Approx(-kMuD * kK * kD).margin(kTol));
+    CHECK(out.force.x == Approx(-kMuD * kFrictionK * kFrictionD).margin(kFrictionTol));
     // Reversing: the proxy stays put until the offset reaches mu_s the other way.
     out = r.update(rig.scene, rig.all(), Vec3(0.0095, y, 0.0), Vec3(0.0), 1e-3);
     CHECK_FALSE(out.sliding);
-    CHECK(out.proxy.x == Approx(0.01 - kMuD * kD).margin(1e-9));
+    CHECK(out.proxy.x == Approx(0.01 - kMuD * kFrictionD).margin(1e-9));
 }
 
 TEST_CASE("sliding on a rotated face in any direction: friction opposes the motion") {
@@ -106,14 +106,15 @@ TEST_CASE("sliding on a rotated face in any direction: friction opposes the moti
     for (const double angle : {0.0, 1.0, 2.5, 4.0}) {
         const Vec3 dir = std::cos(angle) * obb.axes[0] + std::sin(angle) * obb.axes[1];
         GodObjectRenderer r;
-        const Vec3 pressed = face - kD * n;
+        const Vec3 pressed = face - kFrictionD * n;
         pressFrom(r, rig, face + 0.01 * n, pressed);
         const RenderOutput out = stroke(r, rig, pressed, pressed + 0.01 * dir, 200);
         CHECK(out.sliding);
-        CHECK(glm::dot(out.force, n) == Approx(kK * kD).margin(kTol));
-        CHECK(glm::dot(out.force, dir) == Approx(-kMuD * kK * kD).margin(kTol));
+        CHECK(glm::dot(out.force, n) == Approx(kFrictionK * kFrictionD).margin(kFrictionTol));
+        CHECK(glm::dot(out.force, dir) ==
+              Approx(-kMuD * kFrictionK * kFrictionD).margin(kFrictionTol));
         const Vec3 rest = out.force - glm::dot(out.force, n) * n - glm::dot(out.force, dir) * dir;
-        CHECK(glm::length(rest) == Approx(0.0).margin(kTol));
+        CHECK(glm::length(rest) == Approx(0.0).margin(kFrictionTol));
     }
 }
 
@@ -121,7 +122,7 @@ TEST_CASE("friction sliding across the seam of two boxes has no snag") {
     const RenderRig rig({makeBox(1, Vec3(-0.05, 0.0, 0.0), Vec3(0.05), Quat(1, 0, 0, 0), rough()),
                          makeBox(2, Vec3(0.05, 0.0, 0.0), Vec3(0.05), Quat(1, 0, 0, 0), rough())});
     GodObjectRenderer r;
-    const double y = 0.05 - kD;
+    const double y = 0.05 - kFrictionD;
     pressFrom(r, rig, Vec3(-0.02, 0.06, 0.0), Vec3(-0.02, y, 0.0));
     stroke(r, rig, Vec3(-0.02, y, 0.0), Vec3(-0.015, y, 0.0), 50); // break away first
     const CandidateSet cands = rig.all();
@@ -129,21 +130,22 @@ TEST_CASE("friction sliding across the seam of two boxes has no snag") {
         const double x = -0.015 + 1e-4 * i;
         const RenderOutput out = r.update(rig.scene, cands, Vec3(x, y, 0.0), Vec3(0.1, 0, 0), 1e-3);
         CHECK(out.sliding);
-        CHECK(out.force.y == Approx(kK * kD).margin(kTol));
-        CHECK(out.force.x == Approx(-kMuD * kK * kD).margin(kTol));
+        CHECK(out.force.y == Approx(kFrictionK * kFrictionD).margin(kFrictionTol));
+        CHECK(out.force.x == Approx(-kMuD * kFrictionK * kFrictionD).margin(kFrictionTol));
     }
 }
 
 TEST_CASE("the touch and sliding conditions give distinct, correct forces") {
     const RenderRig rig({makeBox(1, Vec3(0.0), Vec3(0.05), Quat(1, 0, 0, 0), rough(0.4, 0.25))});
     GodObjectRenderer touch, slide;
-    const double y = 0.05 - kD;
+    const double y = 0.05 - kFrictionD;
     const RenderOutput t = pressFrom(touch, rig, Vec3(0.0, 0.06, 0.0), Vec3(0.0, y, 0.0));
     pressFrom(slide, rig, Vec3(0.0, 0.06, 0.0), Vec3(0.0, y, 0.0));
     const RenderOutput s = stroke(slide, rig, Vec3(0.0, y, 0.0), Vec3(0.0, y, -0.02), 200);
     CHECK(t.force.z == Approx(0.0).margin(1e-12));
-    CHECK(s.force.z == Approx(0.25 * kK * kD).margin(kTol)); // against motion in -z
-    CHECK(t.force.y == Approx(s.force.y).margin(kTol));
+    CHECK(s.force.z ==
+          Approx(0.25 * kFrictionK * kFrictionD).margin(kFrictionTol)); // against motion in -z
+    CHECK(t.force.y == Approx(s.force.y).margin(kFrictionTol));
     CHECK_FALSE(t.sliding);
     CHECK(s.sliding);
 }
@@ -161,10 +163,10 @@ TEST_CASE("an oblique approach sticks where it first touched") {
 TEST_CASE("a stuck proxy does not hang in the air when its object moves away") {
     RenderRig rig({makeBox(1, Vec3(0.0), Vec3(0.05), Quat(1, 0, 0, 0), rough())});
     GodObjectRenderer r;
-    const Vec3 hand(0.0, 0.05 - kD, 0.0);
+    const Vec3 hand(0.0, 0.05 - kFrictionD, 0.0);
     pressFrom(r, rig, Vec3(0.0, 0.06, 0.0), hand);
     rig.scene.setPose(0, Vec3(0.0003, -0.0005, 0.0), Quat(1, 0, 0, 0)); // drops 0.5 mm
     const RenderOutput out = r.update(rig.scene, rig.all(), hand, Vec3(0.0), 1e-3);
-    CHECK(out.force.y == Approx(kK * (kD - 0.0005)).margin(kTol));
+    CHECK(out.force.y == Approx(kFrictionK * (kFrictionD - 0.0005)).margin(kFrictionTol));
     CHECK(out.proxy.y == Approx(0.0495).margin(1e-7));
 }

@@ -20,7 +20,7 @@ using namespace hapto::test;
 
 namespace {
 
-constexpr double kK = 1000.0; // N/m
+constexpr double kMeshK = 1000.0; // N/m
 constexpr double kSkin = GodObjectRenderer::kSkinM;
 // A mesh face and the box face it replaces compute the same planes through different
 // arithmetic (a triangle's cross product, a box's rotated axes): they agree to rounding,
@@ -90,7 +90,7 @@ void checkSame(const std::vector<RenderOutput>& got, const std::vector<RenderOut
     for (std::size_t i = 0; i < got.size(); ++i) {
         INFO("tick " << i);
         CHECK(glm::length(got[i].force - want[i].force) <= forceTolN);
-        CHECK(glm::length(got[i].proxy - want[i].proxy) <= forceTolN / kK);
+        CHECK(glm::length(got[i].proxy - want[i].proxy) <= forceTolN / kMeshK);
         CHECK(got[i].contactCount == want[i].contactCount);
     }
 }
@@ -107,7 +107,7 @@ TEST_CASE("a flat two-triangle square feels like the box face it replaces, along
     const Quat q = GENERATE(Quat(1, 0, 0, 0), tilt());
     const double muS = GENERATE(0.0, 0.6);
     INFO("rotated " << (q != Quat(1, 0, 0, 0)) << ", mu_s " << muS);
-    const Material m = material(kK, muS, muS * 0.7);
+    const Material m = material(kMeshK, muS, muS * 0.7);
     const Vec3 c(0.01, -0.02, 0.03);
     const Rig box({makeBox(1, c, Vec3(0.05), q, m)});
     const Rig mesh({makeMesh(1, c + q * Vec3(0, 0.05, 0), squareMesh(0.05), q, m)});
@@ -132,7 +132,7 @@ TEST_CASE("a flat two-triangle square feels like the box face it replaces, along
 }
 
 TEST_CASE("sliding across the shared diagonal of two coplanar triangles does not snag") {
-    const Rig rig({makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), material(kK))});
+    const Rig rig({makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), material(kMeshK))});
     // 1 mm deep, across the diagonal x = z at 5 cm/s, 0.05 mm per tick.
     const std::vector<Vec3> path = polyline(
         {Vec3(-0.02, 0.005, 0.01), Vec3(-0.02, -0.001, 0.01), Vec3(0.02, -0.001, -0.01)}, 900);
@@ -142,7 +142,7 @@ TEST_CASE("sliding across the shared diagonal of two coplanar triangles does not
         const Vec3& device = path[i + 1];
         // Frictionless: the proxy is the device point lifted onto the skin, every tick.
         CHECK(outs[i].contactCount == 1);
-        CHECK(outs[i].force.y == Approx(kK * (0.001 + kSkin)).margin(kSameN));
+        CHECK(outs[i].force.y == Approx(kMeshK * (0.001 + kSkin)).margin(kSameN));
         CHECK(std::abs(outs[i].force.x) <= kSameN);
         CHECK(std::abs(outs[i].force.z) <= kSameN);
         CHECK(std::abs(outs[i].proxy.x - device.x) <= 1e-12);
@@ -157,7 +157,7 @@ TEST_CASE("a closed cube mesh holds at its edges and vertices: no pop-through") 
     const Quat q = tilt();
     const Vec3 c(0.02, 0.01, -0.01);
     const Vec3 h(0.03);
-    const Material m = material(kK);
+    const Material m = material(kMeshK);
     const Rig mesh({makeMesh(1, c, boxMesh(h), q, m)});
     const Rig box({makeBox(1, c, h, q, m)});
     const Obb obb = box.scene.object(0).obb();
@@ -185,7 +185,7 @@ TEST_CASE("a closed cube mesh holds at its edges and vertices: no pop-through") 
             if (boxSignedDistance(obb, paths[k][i + 1]) < 0.0) {
                 CHECK(got[i].contactCount > 0);
                 CHECK(glm::length(got[i].force) ==
-                      Approx(kK * glm::length(got[i].proxy - paths[k][i + 1])));
+                      Approx(kMeshK * glm::length(got[i].proxy - paths[k][i + 1])));
             }
         }
         // The same as the box, and the same whether the mesh comes as triangles or as a whole
@@ -196,7 +196,7 @@ TEST_CASE("a closed cube mesh holds at its edges and vertices: no pop-through") 
 }
 
 TEST_CASE("a concave corner holds two and three planes") {
-    const Rig rig({makeMesh(1, Vec3(0.0), cornerMesh(0.05), Quat(1, 0, 0, 0), material(kK))});
+    const Rig rig({makeMesh(1, Vec3(0.0), cornerMesh(0.05), Quat(1, 0, 0, 0), material(kMeshK))});
     SECTION("three: floor and both walls") {
         const Vec3 goal(-0.002, -0.003, -0.001);
         const auto outs =
@@ -204,7 +204,7 @@ TEST_CASE("a concave corner holds two and three planes") {
         const RenderOutput& o = outs.back();
         CHECK(o.contactCount == 3);
         CHECK(glm::length(o.proxy - Vec3(kSkin)) <= 1e-12);
-        CHECK(glm::length(o.force - kK * (Vec3(kSkin) - goal)) <= kSameN);
+        CHECK(glm::length(o.force - kMeshK * (Vec3(kSkin) - goal)) <= kSameN);
     }
     SECTION("two: the crease of the floor and a wall, sliding along it") {
         const auto outs = follow(rig.scene, rig.byItems(),
@@ -216,8 +216,8 @@ TEST_CASE("a concave corner holds two and three planes") {
             CHECK(outs[i].contactCount == 2);
             CHECK(outs[i].proxy.x == Approx(kSkin).margin(1e-12));
             CHECK(outs[i].proxy.y == Approx(kSkin).margin(1e-12));
-            CHECK(outs[i].force.x == Approx(kK * (kSkin + 0.002)).margin(kSameN));
-            CHECK(outs[i].force.y == Approx(kK * (kSkin + 0.003)).margin(kSameN));
+            CHECK(outs[i].force.x == Approx(kMeshK * (kSkin + 0.002)).margin(kSameN));
+            CHECK(outs[i].force.y == Approx(kMeshK * (kSkin + 0.003)).margin(kSameN));
         }
     }
 }
@@ -225,9 +225,9 @@ TEST_CASE("a concave corner holds two and three planes") {
 TEST_CASE("the crease between two separate meshes holds both planes") {
     // A floor square (id 1) and a wall square (id 2) standing on it along x = 0, facing +x.
     const Rig rig(
-        {makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), material(kK)),
+        {makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), material(kMeshK)),
          makeMesh(2, Vec3(0.0, 0.05, 0.0), squareMesh(0.05),
-                  glm::angleAxis(-0.5 * glm::pi<double>(), Vec3(0, 0, 1)), material(kK))});
+                  glm::angleAxis(-0.5 * glm::pi<double>(), Vec3(0, 0, 1)), material(kMeshK))});
     const Vec3 goal(-0.002, -0.003, 0.01);
     const auto outs =
         follow(rig.scene, rig.byItems(), polyline({Vec3(0.02, 0.02, 0.01), goal}, 100));
@@ -235,11 +235,11 @@ TEST_CASE("the crease between two separate meshes holds both planes") {
     REQUIRE(o.contactCount == 2);
     CHECK(o.contacts[0].id != o.contacts[1].id);
     CHECK(glm::length(o.proxy - Vec3(kSkin, kSkin, 0.01)) <= 1e-12);
-    CHECK(glm::length(o.force - kK * (Vec3(kSkin, kSkin, 0.01) - goal)) <= kSameN);
+    CHECK(glm::length(o.force - kMeshK * (Vec3(kSkin, kSkin, 0.01) - goal)) <= kSameN);
 }
 
 TEST_CASE("an open mesh is one-sided: from behind the device passes, from the front it is held") {
-    const Rig rig({makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), material(kK))});
+    const Rig rig({makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), material(kMeshK))});
     // Up through the square from below, then back down onto it from above.
     const std::vector<Vec3> path =
         polyline({Vec3(0.01, -0.02, 0.01), Vec3(0.01, 0.02, 0.01), Vec3(0.01, -0.002, 0.01)}, 100);
@@ -249,12 +249,12 @@ TEST_CASE("an open mesh is one-sided: from behind the device passes, from the fr
         CHECK(outs[i].proxy == path[i + 1]);
     }
     CHECK(outs.back().contactCount == 1);
-    CHECK(outs.back().force.y == Approx(kK * (0.002 + kSkin)).margin(kSameN));
+    CHECK(outs.back().force.y == Approx(kMeshK * (0.002 + kSkin)).margin(kSameN));
     CHECK(outs.back().proxy.y == Approx(kSkin).margin(1e-12));
 }
 
 TEST_CASE("a device that starts inside a closed mesh is neither trapped nor shot out") {
-    const Rig rig({makeMesh(1, Vec3(0.0), boxMesh(Vec3(0.03)), tilt(), material(kK))});
+    const Rig rig({makeMesh(1, Vec3(0.0), boxMesh(Vec3(0.03)), tilt(), material(kMeshK))});
     const Quat q = tilt();
     // Inside, around, out through the +x face, and back in from outside.
     const std::vector<Vec3> path = polyline(
@@ -270,14 +270,14 @@ TEST_CASE("a device that starts inside a closed mesh is neither trapped nor shot
         // Outside it is felt again: pressed 2 mm into the +x face.
         const RenderOutput& o = outs.back();
         CHECK(o.contactCount == 1);
-        CHECK(glm::length(o.force - kK * (0.002 + kSkin) * (q * Vec3(1, 0, 0))) <= kSameN);
+        CHECK(glm::length(o.force - kMeshK * (0.002 + kSkin) * (q * Vec3(1, 0, 0))) <= kSameN);
     }
 }
 
 TEST_CASE("friction on a mesh face matches friction on the equivalent box face") {
     // Stick, then slip, with a rubbery material, over a rotated face.
     const Quat q = tilt();
-    const Material m = material(kK, 0.8, 0.5);
+    const Material m = material(kMeshK, 0.8, 0.5);
     const Rig box({makeBox(1, Vec3(0.0), Vec3(0.05), q, m)});
     const Rig mesh({makeMesh(1, q * Vec3(0, 0.05, 0), squareMesh(0.05), q, m)});
     const auto at = [&](double x, double y, double z) { return q * Vec3(x, 0.05 + y, z); };
@@ -297,7 +297,7 @@ TEST_CASE("friction on a mesh face matches friction on the equivalent box face")
 }
 
 TEST_CASE("a moving mesh carries the proxy like a moving box, from its object slot") {
-    const Material m = material(kK, 1.0, 0.8);
+    const Material m = material(kMeshK, 1.0, 0.8);
     const Rig mesh({makeMesh(1, Vec3(0.0), squareMesh(0.05), Quat(1, 0, 0, 0), m)});
     const Rig box({makeBox(1, Vec3(0, -0.05, 0), Vec3(0.05), Quat(1, 0, 0, 0), m)});
     GodObjectRenderer onMesh;
@@ -326,15 +326,15 @@ TEST_CASE("a moving mesh carries the proxy like a moving box, from its object sl
     }
     CHECK(a.contactCount == 1);
     CHECK(a.proxy.x == Approx(5e-4).margin(1e-9));
-    CHECK(a.force.x == Approx(kK * 5e-4).margin(1e-6));
+    CHECK(a.force.x == Approx(kMeshK * 5e-4).margin(1e-6));
 }
 
 TEST_CASE("a fine mesh under a pressing, sliding tool keeps the near list small") {
     // 0.2 mm triangles (20000 of them); pressed 2 mm deep and slid with friction. The near
     // ball for triangles is the proxy's reach plus 1 µm, so only the few triangles around the
     // contact are tracked: the list never overflows.
-    const Rig rig(
-        {makeMesh(1, Vec3(0.0), gridMesh(0.01, 100), Quat(1, 0, 0, 0), material(kK, 0.5, 0.3))});
+    const Rig rig({makeMesh(1, Vec3(0.0), gridMesh(0.01, 100), Quat(1, 0, 0, 0),
+                            material(kMeshK, 0.5, 0.3))});
     const std::vector<Vec3> path = polyline(
         {Vec3(0.001, 0.003, 0.001), Vec3(0.001, -0.002, 0.001), Vec3(-0.006, -0.002, 0.004)}, 100);
     for (const CandidateSet& c : {rig.byItems(), rig.bySlots()}) {
@@ -347,7 +347,7 @@ TEST_CASE("a fine mesh under a pressing, sliding tool keeps the near list small"
         }
         CHECK(r.counters().nearListFull == 0);
         CHECK(o.contactCount >= 1);
-        CHECK(o.force.y == Approx(kK * (0.002 + kSkin)).margin(1e-6));
+        CHECK(o.force.y == Approx(kMeshK * (0.002 + kSkin)).margin(1e-6));
     }
 }
 
@@ -355,7 +355,8 @@ TEST_CASE("an overflowing near list falls back to the spans and still holds") {
     // Pressing from far above gives the first tick a reach that covers thousands of 0.2 mm
     // triangles: the list overflows, the tick runs on the raw spans (and the mesh slot's
     // triangles near the ball), and the proxy still stops on the surface.
-    const Rig rig({makeMesh(1, Vec3(0.0), gridMesh(0.01, 100), Quat(1, 0, 0, 0), material(kK))});
+    const Rig rig(
+        {makeMesh(1, Vec3(0.0), gridMesh(0.01, 100), Quat(1, 0, 0, 0), material(kMeshK))});
     for (const CandidateSet& c : {rig.byItems(), rig.bySlots()}) {
         GodObjectRenderer r;
         r.reset(Vec3(0.001, 0.008, 0.0));
@@ -363,7 +364,7 @@ TEST_CASE("an overflowing near list falls back to the spans and still holds") {
         CHECK(o.status == RenderStatus::NearListFull);
         CHECK(o.contactCount == 1);
         CHECK(o.proxy.y == Approx(kSkin).margin(1e-12));
-        CHECK(o.force.y == Approx(kK * (0.002 + kSkin)).margin(kSameN));
+        CHECK(o.force.y == Approx(kMeshK * (0.002 + kSkin)).margin(kSameN));
     }
 }
 
@@ -373,11 +374,11 @@ TEST_CASE("random walks around rotated closed meshes: the proxy never inside, al
     const std::uint64_t seed = GENERATE(1, 2);
     hapto::Random rng(seed * 131);
     const Rig rig({makeMesh(1, Vec3(-0.04, 0.0, 0.0), torusMesh(0.02, 0.008, 32, 12),
-                            glm::angleAxis(0.5, glm::normalize(Vec3(1, 1, 0))), material(kK)),
+                            glm::angleAxis(0.5, glm::normalize(Vec3(1, 1, 0))), material(kMeshK)),
                    makeMesh(2, Vec3(0.02, -0.03, 0.0), lPrismMesh(0.02, 0.015), tilt(),
-                            material(kK, 0.5, 0.3)),
+                            material(kMeshK, 0.5, 0.3)),
                    makeMesh(3, Vec3(0.03, 0.06, 0.02), boxMesh(Vec3(0.015, 0.02, 0.01)),
-                            glm::angleAxis(1.1, glm::normalize(Vec3(0, 1, 2))), material(kK))});
+                            glm::angleAxis(1.1, glm::normalize(Vec3(0, 1, 2))), material(kMeshK))});
     for (const SceneObject& o : rig.scene.objects()) {
         REQUIRE(o.mesh->closed());
     }
@@ -422,8 +423,9 @@ TEST_CASE("the near list's copy of a triangle renders exactly as the scene's tri
     // after 40 far triangles of another mesh (rejected, but they take the copied places, so
     // its near triangles are read from the scene). Every output must be the same, bit for bit.
     const Rig rig(
-        {makeMesh(1, Vec3(0.0), torusMesh(0.02, 0.008, 128, 48), tilt(), material(kK, 0.5, 0.3)),
-         makeMesh(2, Vec3(0.5, 0.0, 0.0), gridMesh(0.01, 10), Quat(1, 0, 0, 0), material(kK))});
+        {makeMesh(1, Vec3(0.0), torusMesh(0.02, 0.008, 128, 48), tilt(),
+                  material(kMeshK, 0.5, 0.3)),
+         makeMesh(2, Vec3(0.5, 0.0, 0.0), gridMesh(0.01, 10), Quat(1, 0, 0, 0), material(kMeshK))});
     std::vector<std::uint32_t> far;
     for (const std::uint32_t item : rig.items) {
         if (isTriangleItem(item) && rig.scene.objectSlotOf(item) == 1 && far.size() < 40) {
@@ -476,8 +478,8 @@ TEST_CASE("the near list's copy of a triangle renders exactly as the scene's tri
 TEST_CASE("a renderer put back to its State renders the tick again exactly") {
     // HapticTick solves a tick again from the renderer's State (not a copy of the whole
     // renderer): the second update must give what the first gave.
-    const Rig rig(
-        {makeMesh(1, Vec3(0.0), torusMesh(0.02, 0.008, 64, 24), tilt(), material(kK, 0.5, 0.3))});
+    const Rig rig({makeMesh(1, Vec3(0.0), torusMesh(0.02, 0.008, 64, 24), tilt(),
+                            material(kMeshK, 0.5, 0.3))});
     const CandidateSet c = rig.byItems();
     GodObjectRenderer r;
     // Down onto the tube's top (the torus stands in its local x-y plane), 4 mm in, and along

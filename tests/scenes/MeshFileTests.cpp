@@ -5,6 +5,7 @@
 #include "hapto/io/InputError.h"
 #include "hapto/scenes/MeshFile.h"
 
+#include "TestMeshes.h"
 #include "TestSupport.h"
 
 #include <catch2/catch.hpp>
@@ -21,6 +22,7 @@
 #include <vector>
 
 using namespace hapto;
+using hapto::test::signedVolume;
 
 namespace {
 
@@ -139,16 +141,6 @@ std::string binaryPly(const Corners& v, const Faces& f) {
     return s;
 }
 
-/// The volume the triangles enclose (divergence theorem): positive when they face outward.
-double signedVolume(const TriangleMesh& m) {
-    double v = 0.0;
-    for (std::uint32_t t = 0; t < m.triangleCount(); ++t) {
-        const auto c = m.corners(t);
-        v += glm::dot(c[0], glm::cross(c[1], c[2])) / 6.0;
-    }
-    return v;
-}
-
 /// True when every given corner, times `scale`, is a vertex of the mesh.
 bool hasCorners(const TriangleMesh& m, const Corners& corners, double scale) {
     for (const auto& p : corners) {
@@ -164,7 +156,7 @@ bool hasCorners(const TriangleMesh& m, const Corners& corners, double scale) {
     return true;
 }
 
-std::string errorOf(const std::filesystem::path& path, double scale = 1.0) {
+std::string meshFileErrorOf(const std::filesystem::path& path, double scale = 1.0) {
     try {
         loadMeshFile(path, MeshSource{path.filename().string(), scale});
     } catch (const InputError& e) {
@@ -414,7 +406,7 @@ TEST_CASE("bad model files are refused with the file and the place") {
     for (const Case& c : cases) {
         INFO(c.file);
         test::writeFile(dir / c.file, c.bytes);
-        const std::string message = errorOf(dir / c.file);
+        const std::string message = meshFileErrorOf(dir / c.file);
         CHECK_THAT(message,
                    Catch::StartsWith((dir / c.file).string()) && Catch::Contains(c.expected));
         CHECK(parseErrorOf(c.bytes, dir / c.file) == message);
@@ -425,18 +417,18 @@ TEST_CASE("bad model files are refused with the file and the place") {
         const std::size_t at = plyHeader("binary_little_endian", 4, 4).size() + 12;
         std::memcpy(&nanPly[at], &nan, 4); // vertex 1, x
         test::writeFile(dir / "nan-binary.ply", nanPly);
-        CHECK_THAT(errorOf(dir / "nan-binary.ply"),
+        CHECK_THAT(meshFileErrorOf(dir / "nan-binary.ply"),
                    Catch::Contains(": byte " + std::to_string(at) +
                                    ": vertex element 1: x is not finite"));
     }
     // A scale that takes a vertex farther than a mesh vertex may be, and one so small that
     // every triangle's area underflows (which once read as "all 4 were degenerate").
     test::writeFile(dir / "big.obj", "v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n");
-    CHECK_THAT(errorOf(dir / "big.obj", 1e10),
+    CHECK_THAT(meshFileErrorOf(dir / "big.obj", 1e10),
                Catch::Contains("big.obj:2: vertex coordinate '1e30' times the scale 1e+10 is "
                                "1e+40 m, beyond the 1e+09 m a mesh vertex may lie"));
     test::writeFile(dir / "tet.obj", objText(kTet, kTetFaces));
-    CHECK_THAT(errorOf(dir / "tet.obj", 1e-320),
+    CHECK_THAT(meshFileErrorOf(dir / "tet.obj", 1e-320),
                Catch::Contains("tet.obj: the mesh is ") &&
                    Catch::Contains(" m across (after the scale ") &&
                    Catch::Contains("less than the 1e-09 m a mesh must span"));
@@ -492,7 +484,7 @@ TEST_CASE("a 2 GB model file its first bytes refuse is refused without being rea
         test::writeFile(dir / file, "");
         std::filesystem::resize_file(dir / file, size);
         const std::uint64_t before = peakResidentBytes();
-        const std::string message = errorOf(dir / file);
+        const std::string message = meshFileErrorOf(dir / file);
         CHECK(peakResidentBytes() - before < (std::uint64_t(64) << 20));
         CHECK_THAT(message, Catch::StartsWith((dir / file).string()));
         if (std::string(file) == "zeros.stl") {
@@ -509,18 +501,18 @@ TEST_CASE("a 2 GB model file its first bytes refuse is refused without being rea
     putU32(header, 20000000);
     test::writeFile(dir / "many.stl", header);
     std::filesystem::resize_file(dir / "many.stl", 84 + 50 * std::uint64_t(20000000));
-    CHECK_THAT(errorOf(dir / "many.stl"), Catch::Contains("more than 16777216 triangles"));
+    CHECK_THAT(meshFileErrorOf(dir / "many.stl"), Catch::Contains("more than 16777216 triangles"));
 }
 
 TEST_CASE("a model file that is missing, a folder or a FIFO is refused without blocking") {
     test::TempDir dir;
-    CHECK_THAT(errorOf(dir / "missing.obj"),
+    CHECK_THAT(meshFileErrorOf(dir / "missing.obj"),
                Catch::Contains("missing.obj: cannot open the model file"));
     std::filesystem::create_directory(dir / "folder.obj");
-    CHECK_THAT(errorOf(dir / "folder.obj"),
+    CHECK_THAT(meshFileErrorOf(dir / "folder.obj"),
                Catch::Contains("folder.obj: is a directory, not a regular file"));
     REQUIRE(::mkfifo((dir / "pipe.stl").c_str(), 0600) == 0);
-    CHECK_THAT(errorOf(dir / "pipe.stl"), Catch::Contains("pipe.stl: is a FIFO"));
+    CHECK_THAT(meshFileErrorOf(dir / "pipe.stl"), Catch::Contains("pipe.stl: is a FIFO"));
 }
 
 TEST_CASE("a model's material libraries are never opened, so a FIFO or a stray file named there "

@@ -3,6 +3,8 @@
 #include "hapto/scenes/MeshGenerators.h"
 #include "hapto/scenes/SceneFile.h"
 
+#include "TestMeshes.h"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -14,18 +16,9 @@
 #include <string>
 
 using namespace hapto;
+using hapto::test::signedVolume;
 
 namespace {
-
-// (1/6) sum v0 . (v1 x v2): the enclosed volume, positive when the triangles face outward.
-double signedVolume(const TriangleMesh& m) {
-    double v = 0.0;
-    for (std::uint32_t t = 0; t < m.triangleCount(); ++t) {
-        const auto c = m.corners(t);
-        v += glm::dot(c[0], glm::cross(c[1], c[2]));
-    }
-    return v / 6.0;
-}
 
 Vec3 normalOf(const TriangleMesh& m, std::uint32_t t) {
     const auto c = m.corners(t);

@@ -28,7 +28,7 @@ std::string scene2(const std::string& objects) {
     return R"({"format": "hapto-scene", "version": 2, "objects": [)" + objects + "]}";
 }
 
-std::string errorOf(const std::string& text, const std::filesystem::path& base = {}) {
+std::string meshSceneErrorOf(const std::string& text, const std::filesystem::path& base = {}) {
     try {
         parseScene(text, "bad.json", base);
     } catch (const InputError& e) {
@@ -116,7 +116,7 @@ TEST_CASE("inline arrays stream in any field order, and each object gets its own
     CHECK_FALSE(s.object(1).mesh->closed());
     CHECK(s.triangleCount() == 5);
     // An index beyond 32 bits is named with its own value.
-    CHECK_THAT(errorOf(scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0],
+    CHECK_THAT(meshSceneErrorOf(scene2(R"({"id": 0, "shape": "mesh", "center": [0,0,0],
                    "triangles": [[0,1,2],[0,99999999999,1]], "vertices": [[0,0,0],[1,0,0],[0,1,0]]})")),
                Catch::Contains("objects[0].triangles[1][1]: vertex index 99999999999 is out of "
                                "range (the mesh has 3 vertices)"));
@@ -295,7 +295,7 @@ TEST_CASE("bad mesh objects are refused with the file, the JSON path and the pla
     test::writeFile(dir / "bad.json", "{}");
     for (const Case& c : cases) {
         INFO(c.name);
-        CHECK_THAT(errorOf(c.text, dir.path()), Catch::Contains(c.expected));
+        CHECK_THAT(meshSceneErrorOf(c.text, dir.path()), Catch::Contains(c.expected));
     }
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 /// Meshes built in test code (the index, BVH and timing tests): an icosphere and an open,
-/// wavy sheet, made with TriangleMesh::make so they are validated like loaded ones.
+/// wavy sheet, made with TriangleMesh::make so they are validated like loaded ones; and the
+/// volume a mesh encloses (the mesh reader and generator tests).
 
 #include "hapto/scenes/TriangleMesh.h"
 
@@ -75,6 +76,17 @@ inline std::shared_ptr<const TriangleMesh> makeWavySheet(int n, double size, dou
         }
     }
     return TriangleMesh::make(std::move(v), std::move(f), {}, "test sheet");
+}
+
+/// The volume the triangles enclose, (1/6) sum v0 . (v1 x v2) (divergence theorem), in m^3:
+/// positive when they face outward.
+inline double signedVolume(const TriangleMesh& m) {
+    double v = 0.0;
+    for (std::uint32_t t = 0; t < m.triangleCount(); ++t) {
+        const auto c = m.corners(t);
+        v += glm::dot(c[0], glm::cross(c[1], c[2]));
+    }
+    return v / 6.0;
 }
 
 } // namespace hapto::test
