@@ -7,6 +7,7 @@
 #include "hapto/experiments/HandWalk.h"
 #include "hapto/experiments/Plot.h"
 #include "hapto/experiments/Progress.h"
+#include "hapto/experiments/Stats.h"
 #include "hapto/experiments/Sweep.h"
 #include "hapto/experiments/Table.h"
 
@@ -85,7 +86,12 @@ std::vector<Vec3> clearStarts(const Scene& scene, const SpatialIndex& index, int
     return starts;
 }
 
-std::vector<int> deviceCounts(int maxDevices) {
+/// The device counts to run: those asked, else 1, 2, 4, ... up to maxDevices and it.
+std::vector<int> deviceCounts(const DevicesArgs& args) {
+    if (!args.deviceCounts.empty()) {
+        return args.deviceCounts;
+    }
+    const int maxDevices = args.maxDevices;
     std::vector<int> counts;
     for (int d = 1; d <= maxDevices; d *= 2) {
         counts.push_back(d);
@@ -105,10 +111,13 @@ struct ScalingRow {
     double loadPerCorePct = 0;    ///< loadSum / cores (%), median.
     double deviceMeanLoadPct = 0; ///< Mean over devices of their mean load (%), median.
     double worstP50Pct = 0, worstP99Pct = 0, worstP999Pct = 0, worstMaxPct = 0; ///< Worst (%).
-    double worstMissedPct = 0; ///< Worst device's missed deadlines (% of ticks), median.
-    double lateWakeups = 0;    ///< Late wake-ups over all devices, median.
-    int stableRuns = 0;        ///< Repeats in which every device was stable.
-    bool realtime = true;      ///< SCHED_FIFO granted to every servo thread.
+    double worstMissedPct = 0;       ///< Worst device's missed deadlines (% of ticks), median.
+    double lateWakeups = 0;          ///< Late wake-ups over all devices, median.
+    int stableRuns = 0;              ///< Repeats in which every device was stable.
+    MedianInterval loadSum;          ///< loadSumPct's median and interval over repeats (%).
+    MedianInterval medianDeviceP999; ///< The median device's p99.9 load over repeats (%).
+    MedianInterval worstP999;        ///< The worst device's p99.9 load over repeats (%).
+    bool realtime = true;            ///< SCHED_FIFO granted to every servo thread.
     int cores = 1;
     std::string note;
     Tail tail = Tail::P999; ///< The percentile the verdict reads.
@@ -259,9 +268,10 @@ struct RepeatFigures {
     double loadSumPct = 0, loadPerCorePct = 0, deviceMeanLoadPct = 0;
     double worstP50Pct = 0, worstP99Pct = 0, worstP999Pct = 0, worstMaxPct = 0;
     double worstMissedPct = 0, lateWakeups = 0;
-    bool allStable = true; ///< The run was stable and so was every device.
-    bool realtime = true;  ///< Every device got SCHED_FIFO.
-    std::string fault;     ///< The last device fault, or empty.
+    double medianDeviceP999Pct = 0; ///< The median over devices of their p99.9 load (%).
+    bool allStable = true;          ///< The run was stable and so was every device.
+    bool realtime = true;           ///< Every device got SCHED_FIFO.
+    std::string fault;              ///< The last device fault, or empty.
 };
 
 /// Folds one run's per-device figures into the repeat's figures. [control]
@@ -286,16 +296,27 @@ RepeatFigures repeatFigures(const RunReport& r, const std::vector<LoadFigures>& 
     x.loadSumPct = 100.0 * r.loadSum;
     x.loadPerCorePct = 100.0 * r.loadPerCore;
     x.deviceMeanLoadPct = mean / std::max<std::size_t>(1, devices.size());
+    std::vector<double> p999;
+    for (const LoadFigures& f : devices) {
+        p999.push_back(f.p999Pct);
+    }
+    x.medianDeviceP999Pct = median(p999);
     return x;
 }
 
-/// The median over repeats of one figure.
-double medianOver(const std::vector<RepeatFigures>& runs, double RepeatFigures::*figure) {
+/// One figure of every repeat.
+std::vector<double> valuesOver(const std::vector<RepeatFigures>& runs,
+                               double RepeatFigures::*figure) {
     std::vector<double> values;
     for (const RepeatFigures& x : runs) {
         values.push_back(x.*figure);
     }
-    return median(values);
+    return values;
+}
+
+/// The median over repeats of one figure.
+double medianOver(const std::vector<RepeatFigures>& runs, double RepeatFigures::*figure) {
+    return median(valuesOver(runs, figure));
 }
 
 /// Fills a cell's row from its repeats: medians of every figure, stable repeats counted,
@@ -317,6 +338,9 @@ void concludeScalingRow(ScalingRow& row, const std::vector<RepeatFigures>& runs)
     row.worstMaxPct = medianOver(runs, &RepeatFigures::worstMaxPct);
     row.worstMissedPct = medianOver(runs, &RepeatFigures::worstMissedPct);
     row.lateWakeups = medianOver(runs, &RepeatFigures::lateWakeups);
+    row.loadSum = medianInterval(valuesOver(runs, &RepeatFigures::loadSumPct));
+    row.medianDeviceP999 = medianInterval(valuesOver(runs, &RepeatFigures::medianDeviceP999Pct));
+    row.worstP999 = medianInterval(valuesOver(runs, &RepeatFigures::worstP999Pct));
 }
 
 /// `devices` simulated hands at `rateHz`, hand i from starts[i] with seed i + 1.
@@ -384,16 +408,27 @@ Table scalingTable(const std::vector<ScalingRow>& rows, bool quick) {
         {"rate_hz", "Hz", -1, "", ColumnIn::Data},
         {"devices", "", -1, "devices"},
         {"repeats", "", -1, "", ColumnIn::Data},
-        {"load_sum_pct", "%", 2, "load sum % (one core)"},
+        {"load_sum_pct", "%", -1, "", ColumnIn::Data},
+        {"load_sum_lo_pct", "%", -1, "", ColumnIn::Data},
+        {"load_sum_hi_pct", "%", -1, "", ColumnIn::Data},
+        {"load_sum_cell", "", -1, "load sum % (one core), median [interval]", ColumnIn::Markdown},
         {"load_per_core_pct", "%", 2, "per core %"},
         {"device_load_mean_pct", "%", 2, "per device mean %"},
         {"worst_load_p50_pct", "%", 2, "worst p50 %"},
         {"worst_load_p99_pct", "%", 1, "worst p99 %", quick ? ColumnIn::All : ColumnIn::Data},
-        {"worst_load_p999_pct", "%", 1, "worst p99.9 %"},
+        {"median_device_p999_pct", "%", -1, "", ColumnIn::Data},
+        {"median_device_p999_lo_pct", "%", -1, "", ColumnIn::Data},
+        {"median_device_p999_hi_pct", "%", -1, "", ColumnIn::Data},
+        {"median_device_p999_cell", "", -1, "median device p99.9 % [interval]", ColumnIn::Markdown},
+        {"worst_load_p999_pct", "%", -1, "", ColumnIn::Data},
+        {"worst_load_p999_lo_pct", "%", -1, "", ColumnIn::Data},
+        {"worst_load_p999_hi_pct", "%", -1, "", ColumnIn::Data},
+        {"worst_p999_cell", "", -1, "worst device p99.9 % [interval]", ColumnIn::Markdown},
         {"worst_load_max_pct", "%", 1, "worst max %"},
         {"worst_missed_pct", "%", 2, "worst missed %"},
         {"late_wakeups", "", -1, "", ColumnIn::Data},
         {"stable_runs", "", -1, "", ColumnIn::Data},
+        {"interval_coverage", "", -1, "", ColumnIn::Data},
         {"stable", "", -1, "", ColumnIn::Data},
         {"realtime", "", -1, "", ColumnIn::Data},
         {"cores", "", -1, "", ColumnIn::Data},
@@ -401,10 +436,34 @@ Table scalingTable(const std::vector<ScalingRow>& rows, bool quick) {
         {"verdict", "", -1, "verdict", ColumnIn::Markdown},
     });
     for (const ScalingRow& r : rows) {
-        t.add({r.rateHz, whole(r.devices), whole(r.repeats), r.loadSumPct, r.loadPerCorePct,
-               r.deviceMeanLoadPct, r.worstP50Pct, r.worstP99Pct, r.worstP999Pct, r.worstMaxPct,
-               r.worstMissedPct, r.lateWakeups, whole(r.stableRuns), r.stable(), r.realtime,
-               whole(r.cores), r.note,
+        t.add({r.rateHz,
+               whole(r.devices),
+               whole(r.repeats),
+               r.loadSumPct,
+               r.loadSum.lo,
+               r.loadSum.hi,
+               intervalText(r.loadSum, 2),
+               r.loadPerCorePct,
+               r.deviceMeanLoadPct,
+               r.worstP50Pct,
+               r.worstP99Pct,
+               r.medianDeviceP999.median,
+               r.medianDeviceP999.lo,
+               r.medianDeviceP999.hi,
+               intervalText(r.medianDeviceP999, 1),
+               r.worstP999Pct,
+               r.worstP999.lo,
+               r.worstP999.hi,
+               intervalText(r.worstP999, 1),
+               r.worstMaxPct,
+               r.worstMissedPct,
+               r.lateWakeups,
+               whole(r.stableRuns),
+               r.loadSum.coverage,
+               r.stable(),
+               r.realtime,
+               whole(r.cores),
+               r.note,
                std::string(r.stable() ? "stable" : "UNSTABLE") + " (" +
                    std::to_string(r.stableRuns) + "/" + std::to_string(r.repeats) + " runs)"});
     }
@@ -473,20 +532,25 @@ Json scalingJson(const ScalingSetup& setup, const ScalingResults& results, const
     Json j;
     j["experiment"] = "devices";
     j["machine"] = machineJson();
-    j["options"] = {{"rates_hz", args.ratesHz},
-                    {"max_devices", args.maxDevices},
-                    {"scene", args.scene.empty() ? "(embedded default scene)" : args.scene},
-                    {"objects", setup.scene.size()},
-                    {"index", setup.spec.toString()},
-                    {"script", args.script},
-                    {"duration_s", args.common.durationS},
-                    {"repeats", args.common.repeats},
-                    {"realtime_requested", args.common.realtime},
-                    {"quick", args.common.quick},
-                    {"verdict_percentile", tailName(setup.servo.tail)},
-                    {"cursor_index", setup.cursorSpec.toString()},
-                    {"cursor_objects", args.cursorObjects},
-                    {"walk_steps", args.walkSteps}};
+    j["options"] = {
+        {"rates_hz", args.ratesHz},
+        {"device_counts", deviceCounts(args)},
+        {"scene", args.scene.empty() ? "(embedded default scene)" : args.scene},
+        {"objects", setup.scene.size()},
+        {"index", setup.spec.toString()},
+        {"script", args.script},
+        {"duration_s", args.common.durationS},
+        {"repeats", args.common.repeats},
+        {"realtime_requested", args.common.realtime},
+        {"quick", args.common.quick},
+        {"verdict_percentile", tailName(setup.servo.tail)},
+        {"interval", "order statistics of the median over repeats"},
+        {"interval_coverage",
+         medianInterval(std::vector<double>(static_cast<std::size_t>(args.common.repeats), 0.0))
+             .coverage},
+        {"cursor_index", setup.cursorSpec.toString()},
+        {"cursor_objects", args.cursorObjects},
+        {"walk_steps", args.walkSteps}};
     j["realtime_note"] = results.realtimeNote;
     Json jd = scaling.json();
     for (std::size_t i = 0; i < results.rows.size(); ++i) {
@@ -504,52 +568,60 @@ Json scalingJson(const ScalingSetup& setup, const ScalingResults& results, const
     return j;
 }
 
-/// devices-load: total load and the worst device's p99.9 and p50 against the device count, a
-/// series per rate, rings where a cell was unstable.
+/// A series of one figure of the rows at `rate`: the medians, their intervals as error bars,
+/// rings where the cell was unstable; drawn `shift` devices right of its count (so the bars of
+/// two series at one count do not hide each other).
+PlotSeries intervalSeries(std::string title, int style, bool dashed,
+                          const std::vector<ScalingRow>& rows, double rate,
+                          MedianInterval ScalingRow::*figure, double shift = 0.0) {
+    PlotSeries s{std::move(title), {}, {}, dashed, style};
+    for (const ScalingRow& r : rows) {
+        if (r.rateHz == rate) {
+            const MedianInterval& m = r.*figure;
+            s.points.emplace_back(r.devices + shift, m.median);
+            s.errors.emplace_back(m.lo, m.hi);
+            s.unstable.push_back(!r.stable());
+        }
+    }
+    return s;
+}
+
+/// devices-load: total load against the device count on linear axes (a linear law shows as a
+/// line), and per device: the median device's p99.9 (solid) beside the worst device's (dashed;
+/// a maximum over more devices grows with their count by itself), a colour per rate, the
+/// intervals across repeats as bars, rings where a cell was unstable.
 PlotSpec scalingPlot(const ScalingSetup& setup, const std::vector<ScalingRow>& rows,
                      const std::vector<int>& counts) {
     PlotSpec p;
     p.name = "devices-load";
     p.title = "Haptic load against devices over one world (" + setup.spec.toString() + ", " +
               std::to_string(setup.scene.size()) + " objects, script " + setup.args.script + ")";
+    p.caption = repeatsCaption(setup.args.common);
     // Two quantities (% of one core, % of the period), so each panel keeps its own scale.
     p.unstableTitle = "unstable (" + std::string(tailName(setup.servo.tail)) +
                       " load >= 100 % or > 0.1 % missed)";
-    PlotPanel total{
-        "total: sum of mean loads", "devices", "load (% of one core)", true, false, {}, {}, {}, {}};
-    PlotPanel worst{"worst device: p99.9 solid, p50 dashed",
-                    "devices",
-                    "load (% of the period)",
-                    true,
-                    true,
-                    {},
-                    100.0,
-                    "100 % (one period)",
-                    {}};
+    PlotPanel total =
+        panel("total: sum of the devices' mean loads", "devices (linear)", "load (% of one core)");
+    PlotPanel tail = panel("per device p99.9: median device solid, worst device dashed",
+                           "devices (linear)", "p99.9 load (% of the period)");
+    tail.logY = true;
+    tail.limitY = 100.0;
+    tail.limitTitle = "100 % (one period)";
     for (const int d : counts) {
         total.xTics.push_back(d);
-        worst.xTics.push_back(d);
+        tail.xTics.push_back(d);
     }
     int style = 1;
     for (const double rate : setup.args.ratesHz) {
-        PlotSeries a{rateText(rate), {}, {}, false, style};
-        PlotSeries b{rateText(rate) + " p99.9", {}, {}, false, style};
-        PlotSeries c{rateText(rate) + " p50", {}, {}, true, style};
-        for (const ScalingRow& r : rows) {
-            if (r.rateHz == rate) {
-                a.points.emplace_back(r.devices, r.loadSumPct);
-                a.unstable.push_back(!r.stable());
-                b.points.emplace_back(r.devices, r.worstP999Pct);
-                b.unstable.push_back(!r.stable());
-                c.points.emplace_back(r.devices, r.worstP50Pct);
-            }
-        }
-        total.series.push_back(a);
-        worst.series.push_back(b);
-        worst.series.push_back(c);
+        total.series.push_back(
+            intervalSeries(rateText(rate), style, false, rows, rate, &ScalingRow::loadSum));
+        tail.series.push_back(intervalSeries(rateText(rate) + " median device", style, false, rows,
+                                             rate, &ScalingRow::medianDeviceP999));
+        tail.series.push_back(intervalSeries(rateText(rate) + " worst device", style, true, rows,
+                                             rate, &ScalingRow::worstP999, 0.06));
         ++style;
     }
-    p.panels = {total, worst};
+    p.panels = {total, tail};
     return p;
 }
 
@@ -597,12 +669,25 @@ PlotSpec cursorPlot(const ScalingSetup& setup, const std::vector<CursorRow>& row
 std::string scalingMarkdown(const ScalingSetup& setup, const ScalingResults& results,
                             const Table& scaling) {
     const DevicesArgs& args = setup.args;
-    std::string md = "## Load against devices: " + std::to_string(setup.scene.size()) +
-                     " objects, " + setup.spec.toString() + ", script " + args.script + "\n\n" +
-                     "Every device has its own servo thread over one shared World. Loads in % "
-                     "(wake-up to force written over the period); medians of " +
-                     std::to_string(args.common.repeats) + " run(s) of " +
-                     fmt(args.common.durationS, 2) + " s. " + verdictNote(setup.servo.tail) + "\n";
+    std::string md =
+        "## Load against devices: " + std::to_string(setup.scene.size()) + " objects, " +
+        setup.spec.toString() + ", script " + args.script + "\n\n" +
+        (args.common.quick
+             ? smokeTestHeader(args.common,
+                               "how load grows with devices (few counts, one rate), p99.9 load "
+                               "(a run of a few hundred ticks has none but its maximum), the "
+                               "spread across runs, or the cursor's steps at large N",
+                               "design, on p99 (every device: p99 load < 100 % and <= 0.1 % "
+                               "deadlines missed)")
+             : std::string()) +
+        "Every device has its own servo thread over one shared World. Loads in % (wake-up to "
+        "force written over the period). " +
+        intervalNote(static_cast<std::size_t>(args.common.repeats)) +
+        " Load sum: the devices' mean loads added (% of one core). Per device p99.9: the "
+        "median device (the middle one of the cell's devices, a typical device) beside the "
+        "worst device (the largest of the cell's devices: it grows with the device count by "
+        "itself, as a maximum over more samples). " +
+        verdictNote(setup.servo.tail) + "\n";
     for (const double rate : args.ratesHz) {
         md += "\n### " + rateText(rate) + "\n\n";
         md += scaling.markdown([&](std::size_t i) { return results.rows[i].rateHz == rate; });
@@ -694,7 +779,7 @@ int runDevices(const DevicesArgs& args) {
     const auto shared = std::make_shared<const Scene>(
         args.scene.empty() ? makeDefaultScene() : loadSceneFile(args.scene));
     const Scene& scene = *shared; // the world shares it: one copy
-    const std::vector<int> counts = deviceCounts(args.maxDevices);
+    const std::vector<int> counts = deviceCounts(args);
 
     Progress progress("devices", args.ratesHz.size() * counts.size() *
                                          static_cast<std::size_t>(args.common.repeats) +
@@ -702,7 +787,8 @@ int runDevices(const DevicesArgs& args) {
     progress.show("building " + spec.toString() + " over " + std::to_string(scene.size()) +
                   " objects");
     World world(shared, spec);
-    const std::vector<Vec3> starts = clearStarts(scene, *world.current().index, args.maxDevices);
+    const std::vector<Vec3> starts =
+        clearStarts(scene, *world.current().index, *std::max_element(counts.begin(), counts.end()));
 
     ScalingSetup setup{args, scene, spec, cursorSpec, {}};
     setup.servo.durationS = args.common.durationS;

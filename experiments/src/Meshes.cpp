@@ -67,7 +67,8 @@ int runMeshes(const MeshesArgs& args) {
         {octreeName, IndexSpec::octree(args.octreeMaxItems, args.octreeMinLeafM), "-"},
     };
     std::vector<SweepStep> steps;
-    for (const std::size_t n : triangleSweep(args.maxTriangles)) {
+    for (const std::size_t n :
+         args.triangles.empty() ? triangleSweep(args.maxTriangles) : args.triangles) {
         const MeshOptions options = meshOptions(args, n);
         SweepStep step;
         step.objects = generatedTriangleCount(options);
@@ -93,13 +94,14 @@ int runMeshes(const MeshesArgs& args) {
                                        args.common, args.maxIndexMb, renderers, args.ratesHz, rows,
                                        args.verdict, "triangles_asked", progress);
 
-    std::string md = "## Load against triangle count: one " +
-                     std::string(meshShapeName(args.shape)) + " of " + fmt(args.sizeM, 3) +
-                     " m\n\n" +
-                     loadNote(args.common, options.servo.tail, ": p50 / p99.9 / max,", "") +
-                     " A renderer stops growing after its first unstable size, and a cell whose "
-                     "probed tick takes more than 10 periods is skipped: that is what caps brute "
-                     "force.\n";
+    std::string md =
+        "## Load against triangle count: one " + std::string(meshShapeName(args.shape)) + " of " +
+        fmt(args.sizeM, 3) + " m\n\n" +
+        sweepSmokeHeader(args.common, args.verdict, steps.empty() ? 0 : steps.back().objects) +
+        loadNote(args.common, options.servo.tail, ": p50 / p99.9 / max,", "") +
+        " A renderer stops growing after its first unstable size, and a cell whose "
+        "probed tick takes more than 10 periods is skipped: that is what caps brute "
+        "force.\n";
     md += "\n" + platformNote(rows, args.verdict);
     const auto lines = [&](const SweepRenderer& r, double rate) {
         std::vector<std::vector<std::string>> table;

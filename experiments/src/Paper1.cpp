@@ -68,7 +68,7 @@ int runPaper1(const Paper1Args& args) {
         {"octree M=5", IndexSpec::octree(5, 0.005), ">= 8000 (stopped; load < 40 %)"},
     };
     std::vector<SweepStep> steps;
-    for (const int k : perSideSweep(args.maxPerSide)) {
+    for (const int k : args.perSide.empty() ? perSideSweep(args.maxPerSide) : args.perSide) {
         SweepStep step;
         step.objects = static_cast<std::size_t>(k) * k * k;
         step.size = k;
@@ -91,8 +91,10 @@ int runPaper1(const Paper1Args& args) {
                                        args.verdict, "per_side", progress);
 
     // Tables.
-    std::string md = "## Experiment 1: K x K x K lattices of 5 cm cubes\n\n" +
-                     loadNote(args.common, options.servo.tail, ": p50 / p99.9 / max,", "") + "\n";
+    std::string md =
+        "## Experiment 1: K x K x K lattices of 5 cm cubes\n\n" +
+        sweepSmokeHeader(args.common, args.verdict, steps.empty() ? 0 : steps.back().objects) +
+        loadNote(args.common, options.servo.tail, ": p50 / p99.9 / max,", "") + "\n";
     md += "\n" + platformNote(rows, args.verdict);
     const auto lines = [&](const SweepRenderer& r, double rate) {
         std::vector<std::vector<std::string>> table;

@@ -166,8 +166,10 @@ int runPaper2(const Paper2Args& args) {
                                        args.common, args.maxIndexMb, renderers, args.ratesHz, rows,
                                        args.verdict, "count", progress);
 
-    std::string md = "## Experiment 2: random scenes of 5 cm cubes in a 25 cm cube\n\n" +
-                     loadNote(args.common, options.servo.tail, ";", " per scene") + "\n";
+    std::string md =
+        "## Experiment 2: random scenes of 5 cm cubes in a 25 cm cube\n\n" +
+        sweepSmokeHeader(args.common, args.verdict, counts.empty() ? 0 : counts.back()) +
+        loadNote(args.common, options.servo.tail, ";", " per scene") + "\n";
     md += "\n" + platformNote(rows, args.verdict);
     const bool hasTable2 = std::find(counts.begin(), counts.end(), kTable2Count) != counts.end();
     for (const double rate : args.ratesHz) {

@@ -59,9 +59,17 @@ std::optional<std::pair<double, double>> dataRange(const std::vector<const PlotP
     };
     for (const PlotPanel* p : panels) {
         for (const PlotSeries& series : p->series) {
-            for (const auto& xy : series.points) {
+            for (std::size_t q = 0; q < series.points.size(); ++q) {
+                const auto& xy = series.points[q];
                 if (usable(*p, xy)) {
                     take(xy.second);
+                    if (q < series.errors.size()) { // the bars' ends too, where the axis shows them
+                        for (const double e : {series.errors[q].first, series.errors[q].second}) {
+                            if (usable(*p, {xy.first, e})) {
+                                take(e);
+                            }
+                        }
+                    }
                 }
             }
         }
@@ -87,9 +95,109 @@ std::string number(double v) {
     return text;
 }
 
+/// " LO HI" for point q of a series with error bars (the point itself where it has none, or
+/// where a log axis cannot show the end); empty for a series without bars.
+std::string errorColumns(const PlotPanel& p, const PlotSeries& series, std::size_t q) {
+    if (series.errors.empty()) {
+        return {};
+    }
+    const double y = series.points[q].second;
+    double lo = y, hi = y;
+    if (q < series.errors.size()) {
+        lo = series.errors[q].first;
+        hi = series.errors[q].second;
+    }
+    if (!std::isfinite(lo) || (p.logY && lo <= 0)) {
+        lo = y;
+    }
+    if (!std::isfinite(hi)) {
+        hi = y;
+    }
+    return " " + number(lo) + " " + number(hi);
+}
+
 /// A data block's name: panel i, series k ("$d0_1"), or the unstable marks of panel i ("$u0").
 std::string blockName(std::size_t i, std::size_t k) {
     return "$d" + std::to_string(i) + "_" + std::to_string(k);
+}
+
+/// `title` (a quoted gnuplot string) followed by the spec's caption on a line of its own.
+std::string withCaption(const std::string& title, const PlotSpec& spec) {
+    return spec.caption.empty() ? title : title + ".\"\\n\"." + quoted(spec.caption);
+}
+
+/// How many key entries the panel's spans add.
+std::size_t spanKeys(const PlotPanel& p) {
+    if (p.spans.empty()) {
+        return 0;
+    }
+    if (p.spanStyles.empty()) {
+        return p.spanTitle.empty() ? 0 : 1;
+    }
+    std::vector<int> styles(p.spanStyles);
+    std::sort(styles.begin(), styles.end());
+    styles.erase(std::unique(styles.begin(), styles.end()), styles.end());
+    return static_cast<std::size_t>(std::count_if(styles.begin(), styles.end(), [&](int st) {
+        return st >= 1 && static_cast<std::size_t>(st) <= p.spanStyleTitles.size();
+    }));
+}
+
+/// Sets the panel's shaded spans as rectangles behind the data (grey, or per style a
+/// translucent colour) and returns their key entries (boxes of their colour drawn nowhere).
+std::vector<std::string> spanPlots(std::ostringstream& s, const PlotPanel& p) {
+    std::vector<std::string> keys;
+    for (std::size_t k = 0; k < p.spans.size(); ++k) {
+        const bool styled = k < p.spanStyles.size();
+        s << "set object " << k + 1 << " rect from " << number(p.spans[k].first) << ", graph 0 to "
+          << number(p.spans[k].second) << ", graph 1 behind fillcolor rgb '"
+          << (styled ? plotColour(p.spanStyles[k]) : std::string("#dddddd"))
+          << (styled ? "' fillstyle transparent solid 0.18 noborder\n"
+                     : "' fillstyle solid 1.0 noborder\n");
+    }
+    if (p.spans.empty()) {
+        return keys;
+    }
+    if (p.spanStyles.empty()) {
+        if (!p.spanTitle.empty()) {
+            keys.push_back("keyentry with boxes fillcolor rgb '#dddddd' fillstyle solid 1.0 "
+                           "title " +
+                           quoted(p.spanTitle));
+        }
+        return keys;
+    }
+    for (std::size_t st = 1; st <= p.spanStyleTitles.size(); ++st) {
+        if (std::find(p.spanStyles.begin(), p.spanStyles.end(), static_cast<int>(st)) !=
+            p.spanStyles.end()) {
+            keys.push_back(
+                "keyentry with boxes fillcolor rgb '" + plotColour(static_cast<int>(st)) +
+                "' fillstyle transparent solid 0.18 title " + quoted(p.spanStyleTitles[st - 1]));
+        }
+    }
+    return keys;
+}
+
+/// The plot clause of series k of a panel, drawn from `block`: colour and point type by style
+/// (or position), so a series keeps its look in every panel even when another has no points
+/// there; error bars when it has them; joined unless points only.
+std::string seriesPlot(const std::string& block, const PlotSeries& series, std::size_t k) {
+    const int style = series.style > 0 ? series.style : static_cast<int>(k) + 1;
+    const bool bars = !series.errors.empty();
+    std::string with;
+    if (series.linesOnly) {
+        with = "lines";
+    } else if (bars) {
+        with = series.pointsOnly ? "yerrorbars" : "yerrorlines";
+    } else {
+        with = series.pointsOnly ? "points" : "linespoints";
+    }
+    return block + (bars ? " using 1:2:3:4" : " using 1:2") + " with " + with + " lc rgb '" +
+           plotColour(style) + "'" +
+           (series.linesOnly ? "" : " pt " + std::to_string((style - 1) % 13 + 1) + " ps 1.3") +
+           " lw 1.5 dt " +
+           std::to_string(series.dash > 0 ? series.dash
+                          : series.dashed ? 2
+                                          : 1) +
+           " title " + quoted(series.title);
 }
 
 std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string>>& blocks,
@@ -102,14 +210,17 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
                          : std::max<std::size_t>(1, spec.panels.size());
     const std::size_t rows = (spec.panels.size() + columns - 1) / columns;
     if (multi) {
-        s << "set multiplot layout " << rows << "," << columns << " title " << quoted(spec.title)
-          << "\n";
+        s << "set multiplot layout " << rows << "," << columns << " title "
+          << withCaption(quoted(spec.title), spec) << "\n";
     }
     const std::optional<std::pair<double, double>> shared = sharedYRange(spec);
     for (std::size_t i = 0; i < spec.panels.size(); ++i) {
         const PlotPanel& p = spec.panels[i];
         s << "set title "
-          << quoted(multi ? p.title : spec.title + (p.title.empty() ? "" : ": ") + p.title) << "\n";
+          << (multi
+                  ? quoted(p.title)
+                  : withCaption(quoted(spec.title + (p.title.empty() ? "" : ": ") + p.title), spec))
+          << "\n";
         s << "set xlabel " << quoted(p.xLabel) << "\nset ylabel " << quoted(p.yLabel) << "\n";
         s << (p.logX ? "set logscale x\n" : "unset logscale x\n");
         s << (p.logY ? "set logscale y\n" : "unset logscale y\n");
@@ -123,8 +234,18 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
                 s << (k ? ", " : "") << quoted(label) << " " << number(p.xTics[k]);
             }
             s << ")\n";
+            if (!p.logX) {
+                // Half a step of room either side, so the outer points and their bars show whole.
+                const auto [lo, hi] = std::minmax_element(p.xTics.begin(), p.xTics.end());
+                const double pad = *hi > *lo ? 0.05 * (*hi - *lo) : 0.5;
+                s << "set xrange [" << number(*lo - pad) << ":" << number(*hi + pad) << "]\n";
+            } else {
+                const auto [lo, hi] = std::minmax_element(p.xTics.begin(), p.xTics.end());
+                s << (*lo > 0 ? "set xrange [" + number(*lo / 1.4) + ":" + number(*hi * 1.4) + "]\n"
+                              : std::string("set xrange [*:*]\n"));
+            }
         } else {
-            s << "set xtics autofreq\n";
+            s << "set xtics autofreq\nset xrange [*:*]\n";
         }
         std::optional<std::pair<double, double>> range = spec.shareY ? shared : dataRange({&p});
         if (range) {
@@ -134,29 +255,12 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
             s << "set yrange [*:*]\n";
         }
         s << "unset object\n";
-        for (std::size_t k = 0; k < p.spans.size(); ++k) {
-            s << "set object " << k + 1 << " rect from " << number(p.spans[k].first)
-              << ", graph 0 to " << number(p.spans[k].second)
-              << ", graph 1 behind fillcolor rgb '#dddddd' fillstyle solid 1.0 noborder\n";
-        }
-        std::vector<std::string> plots;
-        if (!p.spans.empty() && !p.spanTitle.empty()) {
-            // A key entry for the shading (a box of its colour drawn nowhere).
-            plots.push_back("keyentry with boxes fillcolor rgb '#dddddd' fillstyle solid 1.0 "
-                            "title " +
-                            quoted(p.spanTitle));
-        }
+        std::vector<std::string> plots = spanPlots(s, p);
         for (std::size_t k = 0; k < blocks[i].size(); ++k) {
             if (!blocks[i][k].empty()) {
                 // Colour and point type by style (or series position), so a series keeps its
                 // look in every panel even when another series has no points there.
-                const PlotSeries& series = p.series[k];
-                const int style = series.style > 0 ? series.style : static_cast<int>(k) + 1;
-                plots.push_back(
-                    blocks[i][k] + " using 1:2 with " +
-                    (series.linesOnly ? "lines" : "linespoints") + " lc " + std::to_string(style) +
-                    (series.linesOnly ? "" : " pt " + std::to_string(style)) +
-                    (series.dashed ? " dt 2" : " dt 1") + " title " + quoted(series.title));
+                plots.push_back(seriesPlot(blocks[i][k], p.series[k], k));
             }
         }
         if (!unstableBlocks[i].empty()) {
@@ -168,8 +272,7 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
             plots.push_back(number(*p.limitY) + " with lines dt 3 lc rgb 'red' title " +
                             quoted(p.limitTitle));
         }
-        const std::size_t decorations =
-            (p.limitY ? 1u : 0u) + (!p.spans.empty() && !p.spanTitle.empty() ? 1u : 0u);
+        const std::size_t decorations = (p.limitY ? 1u : 0u) + spanKeys(p);
         if (plots.empty() || plots.size() == decorations) {
             s << "set label 1 'no data' at graph 0.5, 0.5 center\n";
             plots = {"[1:10] [1:2] 3 notitle"}; // above the range (log axes too): nothing drawn
@@ -254,6 +357,14 @@ std::string temporaryStem() {
 
 } // namespace
 
+std::string plotColour(int style) {
+    static constexpr const char* kPalette[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728",
+                                               "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+                                               "#bcbd22", "#17becf"};
+    const int n = static_cast<int>(std::size(kPalette));
+    return kPalette[((style - 1) % n + n) % n];
+}
+
 bool gnuplotAvailable() {
     return gnuplotPath().has_value();
 }
@@ -282,11 +393,11 @@ std::string plotScript(const PlotSpec& spec) {
             for (std::size_t q = 0; q < p.series[k].points.size(); ++q) {
                 const auto& xy = p.series[k].points[q];
                 if (usable(p, xy)) {
-                    const std::string line = number(xy.first) + " " + number(xy.second) + "\n";
-                    data << line;
+                    const std::string line = number(xy.first) + " " + number(xy.second);
+                    data << line << errorColumns(p, p.series[k], q) << "\n";
                     ++n;
                     if (q < p.series[k].unstable.size() && p.series[k].unstable[q]) {
-                        marks << line;
+                        marks << line << "\n";
                     }
                 }
             }

@@ -188,6 +188,45 @@ void measureRenderer(SweepState& state, const PreparedScene& p, const SweepScene
 
 } // namespace
 
+MedianInterval SweepRow::interval(double LoadFigures::*figure) const {
+    std::vector<double> values;
+    for (const LoadFigures& f : runs) {
+        values.push_back(f.*figure);
+    }
+    return medianInterval(std::move(values));
+}
+
+Verdict sweepVerdict(bool quick, bool verdictGiven, Verdict given) {
+    return quick && !verdictGiven ? Verdict::Load : given;
+}
+
+std::string smokeTestHeader(const CommonArgs& common, const std::string& cannotJudge,
+                            const std::string& verdict) {
+    return "> **Smoke test (--quick)**: " + std::to_string(common.repeats) + " run(s) of " +
+           fmt(common.durationS, 2) +
+           " s per cell, small sizes. It shows that the experiment runs and writes its files; "
+           "it cannot judge " +
+           cannotJudge + ". Verdict in this table: " + verdict +
+           ". Run without --quick for results.\n\n";
+}
+
+std::string sweepSmokeHeader(const CommonArgs& common, Verdict verdict, std::size_t largest) {
+    if (!common.quick) {
+        return {};
+    }
+    const std::string which =
+        verdict == Verdict::Load
+            ? "load (p99 load < 100 %: the renderer's own time against the period, as the "
+              "paper judged its renderers; deadlines missed are reported, not counted)"
+            : "design (p99 load < 100 % and <= 0.1 % deadlines missed)";
+    return smokeTestHeader(common,
+                           "the paper's max-stable claims (it stops at " + std::to_string(largest) +
+                               " objects, below most of the paper's limits), p99.9 load (a run "
+                               "of a few hundred ticks has no p99.9 but its maximum) or the "
+                               "spread across runs",
+                           which);
+}
+
 std::string rateText(double rateHz) {
     char text[32];
     if (rateHz >= 1000.0) {
@@ -327,7 +366,12 @@ Table sweepTable(const std::vector<SweepRow>& rows, const std::string& sizeColum
                                    {sizeColumn, ""},  {"objects", ""}, {"seed", ""},
                                    {"condition", ""}, {"script", ""},  {"repeats", ""}};
     columns.insert(columns.end(), kFigureColumns.begin(), kFigureColumns.end());
-    for (const Column& c : std::vector<Column>{{"stable", ""},
+    for (const Column& c : std::vector<Column>{{"load_p50_lo_pct", "%"},
+                                               {"load_p50_hi_pct", "%"},
+                                               {"load_p999_lo_pct", "%"},
+                                               {"load_p999_hi_pct", "%"},
+                                               {"interval_coverage", ""},
+                                               {"stable", ""},
                                                {"load_stable", ""},
                                                {"skipped", ""},
                                                {"reached_phase", ""},
@@ -352,9 +396,12 @@ Table sweepTable(const std::vector<SweepRow>& rows, const std::string& sizeColum
         for (Cell& c : figureCells(r.median)) {
             cells.push_back(std::move(c));
         }
+        const MedianInterval p50 = r.interval(&LoadFigures::p50Pct);
+        const MedianInterval p999 = r.interval(&LoadFigures::p999Pct);
         for (Cell c :
-             std::vector<Cell>{r.stable(), r.loadStable(), r.skipped, r.reachedPhase,
-                               r.median.realtime, r.buildS, r.indexMb, r.probeTickUs, r.note}) {
+             std::vector<Cell>{p50.lo, p50.hi, p999.lo, p999.hi, p999.coverage, r.stable(),
+                               r.loadStable(), r.skipped, r.reachedPhase, r.median.realtime,
+                               r.buildS, r.indexMb, r.probeTickUs, r.note}) {
             cells.push_back(std::move(c));
         }
         table.add(std::move(cells));
@@ -496,9 +543,14 @@ std::string loadCell(const SweepRow& row) {
         return "skipped";
     }
     const LoadFigures& m = row.median;
-    std::string cell = fmt(m.p50Pct, m.p50Pct < 10 ? 2 : 1) + " / " +
-                       fmt(m.p999Pct, m.p999Pct < 10 ? 2 : 1) + " / " +
-                       fmt(m.maxPct, m.maxPct < 10 ? 2 : 0);
+    std::string cell =
+        fmt(m.p50Pct, m.p50Pct < 10 ? 2 : 1) + " / " + fmt(m.p999Pct, m.p999Pct < 10 ? 2 : 1);
+    if (row.runs.size() > 1) { // the p99.9's interval across repeats
+        const MedianInterval p999 = row.interval(&LoadFigures::p999Pct);
+        cell += " [" + fmt(p999.lo, p999.lo < 10 ? 2 : 1) + ", " +
+                fmt(p999.hi, p999.hi < 10 ? 2 : 1) + "]";
+    }
+    cell += " / " + fmt(m.maxPct, m.maxPct < 10 ? 2 : 0);
     if (!row.loadStable()) {
         cell += " UNSTABLE (load)";
     } else if (!row.stable()) {
@@ -537,7 +589,9 @@ std::string loadNote(const CommonArgs& common, Tail tail, const std::string& fig
                      const std::string& per) {
     return "Load = wake-up to force written, % of the servo period" + figures + " median of " +
            std::to_string(common.repeats) + " run(s) of " + fmt(common.durationS, 2) + " s" + per +
-           ". UNSTABLE: " + std::string(tailName(tail)) + " >= 100 % or > 0.1 % deadlines missed.";
+           "; [lo, hi] after p99.9: its interval across the runs. " +
+           intervalNote(static_cast<std::size_t>(common.repeats)) +
+           " UNSTABLE: " + std::string(tailName(tail)) + " >= 100 % or > 0.1 % deadlines missed.";
 }
 
 PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRenderer>& renderers,
@@ -547,8 +601,8 @@ PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRendere
     std::snprintf(name, sizeof name, "%s-load-%gHz", experiment.c_str(), rateHz);
     spec.name = name;
     spec.title = experiment + ": haptic load against objects, " + rateText(rateHz) +
-                 ", p99.9 solid, p50 dashed (median over repeats" +
-                 (experiment == "paper2" ? std::string(" and scenes)") : std::string(")"));
+                 ", p99.9 solid with its interval, p50 dashed (medians over the runs" +
+                 (experiment == "paper2" ? std::string(" of every scene)") : std::string(")"));
     spec.shareY = true; // the three conditions side by side on one scale
     spec.unstableTitle = "unstable (" + std::string(verdictName(verdict)) + " verdict)";
     for (const Condition c : kConditions) {
@@ -569,8 +623,13 @@ PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRendere
             for (const SweepRow& row : rows) {
                 if (row.renderer == r.name && row.rateHz == rateHz && row.condition == c &&
                     !row.skipped) {
-                    p999[row.objects].push_back(row.median.p999Pct);
-                    p50[row.objects].push_back(row.median.p50Pct);
+                    // Every run of every scene (a row without runs: its medians).
+                    const std::vector<LoadFigures> runs =
+                        row.runs.empty() ? std::vector<LoadFigures>{row.median} : row.runs;
+                    for (const LoadFigures& f : runs) {
+                        p999[row.objects].push_back(f.p999Pct);
+                        p50[row.objects].push_back(f.p50Pct);
+                    }
                     unstable[row.objects] = unstable[row.objects] || !row.stable(verdict);
                     sizes.insert(row.objects);
                 }
@@ -578,7 +637,9 @@ PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRendere
             PlotSeries tail{r.name + " p99.9", {}, {}, false, static_cast<int>(k) + 1};
             PlotSeries mid{r.name + " p50", {}, {}, true, static_cast<int>(k) + 1};
             for (const auto& [n, loads] : p999) {
-                tail.points.emplace_back(static_cast<double>(n), median(loads));
+                const MedianInterval t = medianInterval(loads);
+                tail.points.emplace_back(static_cast<double>(n), t.median);
+                tail.errors.emplace_back(t.lo, t.hi);
                 tail.unstable.push_back(unstable[n]);
                 mid.points.emplace_back(static_cast<double>(n), median(p50[n]));
             }
@@ -600,15 +661,34 @@ void drawPlotNoting(const std::filesystem::path& dir, const PlotSpec& spec, Prog
     files.insert(files.end(), pr.files.begin(), pr.files.end());
 }
 
-std::vector<std::filesystem::path>
-plotSweep(const std::filesystem::path& dir, const std::string& experiment,
-          const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
-          const std::vector<SweepRow>& rows, Verdict verdict, Progress& progress) {
+std::vector<std::filesystem::path> plotSweep(const std::filesystem::path& dir,
+                                             const std::string& experiment,
+                                             const std::vector<SweepRenderer>& renderers,
+                                             const std::vector<double>& ratesHz,
+                                             const std::vector<SweepRow>& rows, Verdict verdict,
+                                             Progress& progress, const std::string& caption) {
     std::vector<std::filesystem::path> files;
     for (const double rate : ratesHz) {
-        drawPlotNoting(dir, sweepPlot(experiment, renderers, rate, rows, verdict), progress, files);
+        PlotSpec spec = sweepPlot(experiment, renderers, rate, rows, verdict);
+        spec.caption = caption;
+        drawPlotNoting(dir, spec, progress, files);
     }
     return files;
+}
+
+std::string repeatsCaption(const CommonArgs& common) {
+    const MedianInterval m =
+        medianInterval(std::vector<double>(static_cast<std::size_t>(common.repeats), 0.0));
+    char coverage[32];
+    std::snprintf(coverage, sizeof coverage, "%.4g %%", 100.0 * m.coverage);
+    const std::string runs = std::to_string(common.repeats) + " run(s) of " +
+                             fmt(common.durationS, 2) + " s per cell" +
+                             (common.quick ? " (--quick: a smoke test)" : "");
+    if (common.repeats < 2) {
+        return runs + "; one run per point: no interval";
+    }
+    return runs + "; points: medians over the runs; bars: order-statistic interval of the " +
+           "median, coverage " + coverage;
 }
 
 std::vector<std::filesystem::path>
@@ -635,7 +715,8 @@ writeSweepFiles(const std::filesystem::path& out, const std::string& name, Json 
         j[key] = body[key];
     }
     writeText(out / (name + ".json"), j.dump(2) + "\n");
-    return plotSweep(out, name, renderers, ratesHz, rows, verdict, progress);
+    return plotSweep(out, name, renderers, ratesHz, rows, verdict, progress,
+                     repeatsCaption(common));
 }
 
 void finishSweepReport(const std::filesystem::path& out, const std::string& name,

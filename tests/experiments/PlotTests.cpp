@@ -218,3 +218,59 @@ TEST_CASE("gnuplot draws hostile names as text and runs none of them") {
     CHECK(names == std::set<std::string>{"plot.png", "plot.svg", "plot.gp", "hostile.gp",
                                          "hostile.png", "hostile.svg"});
 }
+
+TEST_CASE("error bars, points-only series, dash types, a caption and per-style spans") {
+    PlotSpec spec;
+    spec.name = "bars";
+    spec.title = "load";
+    spec.caption = "5 run(s) of 0.5 s per cell";
+    PlotPanel p = panel("per device", "devices", "load (%)");
+    PlotSeries joined{"joined", {{1, 2}, {2, 4}}, {}, false, 1};
+    joined.errors = {{1.5, 2.5}, {3, 5}};
+    PlotSeries points{"points", {{1, 3}, {2, 6}}, {}, false, 2};
+    points.errors = {{2, 4}}; // the second point has no bar: drawn at its value
+    points.pointsOnly = true; // categories: not joined
+    PlotSeries dotted{"dotted", {{1, 1}}, {}, false, 3};
+    dotted.dash = 3;
+    p.series = {joined, points, dotted};
+    p.xTics = {1, 2};
+    p.spans = {{1.1, 1.2}, {1.5, 1.9}};
+    p.spanStyles = {1, 2};
+    p.spanStyleTitles = {"a in contact", "b in contact"};
+    spec.panels = {p};
+    const std::string script = plotScript(spec);
+    // Bars: four columns per point, the ends as given, or the value where none is.
+    CHECK(script.find("$d0_0 << EOD\n1 2 1.5 2.5\n2 4 3 5\nEOD\n") != std::string::npos);
+    CHECK(script.find("$d0_1 << EOD\n1 3 2 4\n2 6 6 6\nEOD\n") != std::string::npos);
+    CHECK(script.find("$d0_0 using 1:2:3:4 with yerrorlines lc rgb '" + plotColour(1) + "'") !=
+          std::string::npos);
+    CHECK(script.find("$d0_1 using 1:2:3:4 with yerrorbars lc rgb '" + plotColour(2) + "'") !=
+          std::string::npos);
+    CHECK(script.find("$d0_2 using 1:2 with linespoints") != std::string::npos);
+    CHECK(script.find("dt 3 title \"dotted\"") != std::string::npos);
+    // The y range holds the bars' ends (the widest: 1.5 .. 6), not only the medians.
+    const auto range = sharedYRange(spec);
+    REQUIRE(range);
+    CHECK(range->first == Approx(1.0));
+    CHECK(range->second == Approx(6.0));
+    // The caption is a line of the title.
+    CHECK(script.find("set title \"load: per device\".\"\\n\".\"5 run(s) of 0.5 s per cell\"") !=
+          std::string::npos);
+    // Each span in its style's colour, each style once in the key.
+    CHECK(script.find("to 1.2, graph 1 behind fillcolor rgb '" + plotColour(1) + "'") !=
+          std::string::npos);
+    CHECK(script.find("to 1.9, graph 1 behind fillcolor rgb '" + plotColour(2) + "'") !=
+          std::string::npos);
+    CHECK(count(script, "title \"a in contact\"") == 2); // PNG and SVG
+    CHECK(count(script, "title \"b in contact\"") == 2);
+}
+
+TEST_CASE("the palette's colours are distinct and cycle") {
+    std::set<std::string> colours;
+    for (int s = 1; s <= 10; ++s) {
+        colours.insert(plotColour(s));
+    }
+    CHECK(colours.size() == 10);
+    CHECK(plotColour(11) == plotColour(1));
+    CHECK(plotColour(0) == plotColour(10));
+}

@@ -191,10 +191,41 @@ TEST_CASE("loadNote: the load, the runs behind each cell and what UNSTABLE reads
     common.durationS = 0.5;
     CHECK(loadNote(common, Tail::P999, ": p50 / p99.9 / max,", "") ==
           "Load = wake-up to force written, % of the servo period: p50 / p99.9 / max, median of "
-          "3 run(s) of 0.50 s. UNSTABLE: p99.9 >= 100 % or > 0.1 % deadlines missed.");
+          "3 run(s) of 0.50 s; [lo, hi] after p99.9: its interval across the runs. " +
+              intervalNote(3) + " UNSTABLE: p99.9 >= 100 % or > 0.1 % deadlines missed.");
     common.repeats = 1;
     common.durationS = 0.15;
     CHECK(loadNote(common, Tail::P99, ";", " per scene") ==
           "Load = wake-up to force written, % of the servo period; median of 1 run(s) of 0.15 s "
-          "per scene. UNSTABLE: p99 >= 100 % or > 0.1 % deadlines missed.");
+          "per scene; [lo, hi] after p99.9: its interval across the runs. " +
+              intervalNote(1) + " UNSTABLE: p99 >= 100 % or > 0.1 % deadlines missed.");
+}
+
+TEST_CASE("a sweep row's interval across its runs is in the CSV and JSON and holds the median") {
+    SweepRow r;
+    r.renderer = "standard";
+    r.index = "brute";
+    r.rateHz = 1000;
+    for (const double p999 : {5.0, 1.0, 3.0, 2.0, 4.0}) {
+        LoadFigures f;
+        f.ticks = 100;
+        f.p50Pct = p999 / 10;
+        f.p999Pct = p999;
+        f.maxPct = p999;
+        r.runs.push_back(f);
+    }
+    concludeRow(r);
+    const MedianInterval m = r.interval(&LoadFigures::p999Pct);
+    CHECK(m.median == 3.0);
+    CHECK(m.lo == 1.0);
+    CHECK(m.hi == 5.0);
+    const Json j =
+        sweepJson({{"standard", IndexSpec::brute(), ""}}, {1000}, {r}, Verdict::Load, "count");
+    const Json& row = j["rows"][0];
+    CHECK(row["load_p999_pct"] == 3.0);
+    CHECK(row["load_p999_lo_pct"] == 1.0);
+    CHECK(row["load_p999_hi_pct"] == 5.0);
+    CHECK(row["load_p50_lo_pct"] == Approx(0.1));
+    CHECK(row["interval_coverage"] == Approx(0.9375));
+    CHECK_THAT(loadCell(r), Catch::Contains("3.00 [1.00, 5.00]"));
 }

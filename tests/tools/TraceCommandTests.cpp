@@ -166,10 +166,16 @@ TEST_CASE("hapto trace plot draws traces as PNG and SVG, a line per device, cont
         for (const char* series : {"left x", "right z", "left |F|", "right |F|", "left Fy"}) {
             CHECK_THAT(gp, Catch::Contains(std::string("title \"") + series + "\""));
         }
-        // The contact span: ticks 100..199 of both devices, 0.1 s to 0.199 s.
+        // The contact spans, one per device in its own colour: ticks 100..199 of each, 0.1 s to
+        // 0.199 s, keyed by device.
         CHECK_THAT(gp, Catch::Contains("set object 1 rect from 0.1, graph 0 to 0.199, graph 1"));
-        CHECK_THAT(gp, Catch::Contains("\"in contact\""));
-        CHECK_THAT(gp, !Catch::Contains("set object 2 rect"));
+        CHECK_THAT(gp, Catch::Contains("set object 2 rect from 0.1, graph 0 to 0.199, graph 1"));
+        CHECK_THAT(gp, !Catch::Contains("set object 3 rect"));
+        CHECK_THAT(gp, Catch::Contains("\"left in contact\""));
+        CHECK_THAT(gp, Catch::Contains("\"right in contact\""));
+        // Two colours, the palette's first two (tab10: blue, orange), not two shades of one.
+        CHECK_THAT(gp, Catch::Contains("fillcolor rgb '#1f77b4'"));
+        CHECK_THAT(gp, Catch::Contains("fillcolor rgb '#ff7f0e'"));
         // The data: tick 150 of "left" (y = -0.005 m, |F| = 1.5 N, 1.15 us).
         CHECK_THAT(gp, Catch::Contains("\n0.15 -0.005\n"));
         CHECK_THAT(gp, Catch::Contains("\n0.15 1.5\n"));

@@ -116,7 +116,17 @@ experiments::PlotSpec reportPlot(const std::string& path, const std::vector<Repo
         missed.points.emplace_back(x, 100.0 * devs[i].missedDeadlines / n);
     }
     ticks.series = {contact, missed};
+    double most = 0;
+    for (const ReportDevice& d : devs) {
+        most = std::max(most, d.ticks);
+    }
+    spec.caption = "one run, " + std::to_string(devs.size()) + " device(s), up to " +
+                   std::to_string(static_cast<long long>(most)) +
+                   " ticks each; devices are categories: points, not joined";
     for (PlotPanel* p : {&tick, &late, &ticks}) {
+        for (PlotSeries& s : p->series) {
+            s.pointsOnly = true; // devices are categories: no line joins them
+        }
         for (std::size_t i = 0; i < devs.size(); ++i) {
             p->xTics.push_back(static_cast<double>(i + 1));
             p->xTicLabels.push_back(devs[i].name);

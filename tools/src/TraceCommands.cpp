@@ -133,10 +133,14 @@ experiments::PlotSpec tracePlot(const std::vector<std::string>& paths) {
     PlotPanel proxy = panel("proxy (device frame)", "time (s)", "proxy (m)");
     PlotPanel force = panel("force written (device frame)", "time (s)", "force (N)");
     PlotPanel tick = panel("tick time (wake-up to force written)", "time (s)", "tick time (us)");
-    std::vector<std::pair<double, double>> contact;
+    std::vector<std::pair<double, double>> spans; // every device's contact spans
+    std::vector<int> spanStyles;                  // the device (style) of each
+    std::vector<std::string> spanTitles;          // per device: its key text
+    double endS = 0;
     const char* axes[3] = {"x", "y", "z"};
     int style = 0;
     for (const std::string& path : paths) {
+        std::vector<std::pair<double, double>> contact;
         TraceHeader h;
         const std::vector<TraceSample> samples = TraceReader::load(path, &h);
         const std::string device = h.name.empty() ? path : h.name;
@@ -182,38 +186,45 @@ experiments::PlotSpec tracePlot(const std::vector<std::string>& paths) {
             f[3].points.emplace_back(x, glm::length(s.forceN));
             t.points.emplace_back(x, static_cast<double>(s.computeNs) * 1e-3);
         }
-        // One colour per device: its |F| and tick time solid, the components beside them.
+        // One colour per device (plotColour): x, y and z told apart by dash type, |F| solid.
         ++style;
-        const int base = (style - 1) * 4;
+        if (!samples.empty()) {
+            endS = std::max(endS, seconds(samples.back()));
+        }
+        for (const auto& span : contact) {
+            spans.push_back(span);
+            spanStyles.push_back(style);
+        }
+        spanTitles.push_back(device + " in contact");
         for (int a = 0; a < 3; ++a) {
             for (PlotSeries* series : {&pos[a], &prox[a], &f[a]}) {
                 series->linesOnly = true;
-                series->style = base + a + 2;
+                series->style = style;
+                series->dash = a + 2;
             }
+            pos[a].dash = prox[a].dash = a + 1;
             position.series.push_back(pos[a]);
             proxy.series.push_back(prox[a]);
             force.series.push_back(f[a]);
         }
         f[3].linesOnly = true;
-        f[3].style = base + 1;
+        f[3].style = style;
         force.series.push_back(f[3]);
         t.linesOnly = true;
-        t.style = base + 1;
+        t.style = style;
         tick.series.push_back(t);
     }
-    // Overlapping spans of several devices: merged, in time order.
-    std::sort(contact.begin(), contact.end());
-    std::vector<std::pair<double, double>> merged;
-    for (const auto& span : contact) {
-        if (!merged.empty() && span.first <= merged.back().second) {
-            merged.back().second = std::max(merged.back().second, span.second);
-        } else {
-            merged.push_back(span);
-        }
-    }
+    char caption[160];
+    std::snprintf(caption, sizeof caption,
+                  "%zu device(s), one run of %.3g s; shading: each device's contact spans in "
+                  "its colour",
+                  paths.size(), endS);
+    spec.caption = caption;
+    // Each device's spans in its own translucent colour: overlaps show both.
     for (PlotPanel* p : {&position, &proxy, &force, &tick}) {
-        p->spans = merged;
-        p->spanTitle = "in contact";
+        p->spans = spans;
+        p->spanStyles = spanStyles;
+        p->spanStyleTitles = spanTitles;
         spec.panels.push_back(*p);
     }
     return spec;

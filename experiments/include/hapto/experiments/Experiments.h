@@ -18,15 +18,17 @@ struct CommonArgs {
     std::string out;        ///< Output folder.
     bool quick = false;     ///< Seconds, small sizes (explicit options still win).
     double durationS = 0.5; ///< Timed run per repeat (s).
-    int repeats = 3;        ///< Runs per cell; medians are reported.
-    bool realtime = true;   ///< Ask for SCHED_FIFO and pinning.
+    /// Runs per cell; the median and its order-statistic interval are reported (Stats.h).
+    int repeats = 5;
+    bool realtime = true; ///< Ask for SCHED_FIFO and pinning.
 };
 
 /// `hapto experiment paper1`: the paper's experiment 1 (lattices of K^3 cubes).
 struct Paper1Args {
     CommonArgs common;                   ///< Options every experiment takes (--out, --quick, ...).
     std::vector<double> ratesHz{1000.0}; ///< Servo rates (Hz).
-    int maxPerSide = 100;                ///< Largest K.
+    int maxPerSide = 100;                ///< Largest K (sizes 2, 3, 4, 5, 6, 8, ... up to it).
+    std::vector<int> perSide{};          ///< K values to run, ascending (empty: from maxPerSide).
     double maxIndexMb = 3000.0;          ///< Largest index the sweep builds (MB).
     Verdict verdict = Verdict::Design;   ///< What stops a renderer's growth.
 };
@@ -54,6 +56,7 @@ struct MeshesArgs {
     double sizeM = 0.2;                   ///< The mesh's extent along x (m).
     std::uint64_t seed = 1;               ///< Generator seed.
     std::size_t maxTriangles = 1'000'000; ///< Largest triangle count (sizes 1, 3 per decade).
+    std::vector<std::size_t> triangles{}; ///< Triangle counts to run (empty: from maxTriangles).
     int gridCells = 32;                   ///< The grid renderer's cells per side.
     int octreeMaxItems = 8;               ///< The octree renderer's items per leaf (M).
     double octreeMinLeafM = 0.0005;       ///< The octree renderer's smallest leaf (m).
@@ -65,8 +68,10 @@ int runMeshes(const MeshesArgs& args);
 
 /// `hapto experiment scaling`: load against device count, and cursor steps against N.
 struct DevicesArgs {
-    CommonArgs common;  ///< Options every experiment takes (--out, --quick, ...).
-    int maxDevices = 8; ///< Largest device count (1, 2, 4, ... up to it).
+    CommonArgs common; ///< Options every experiment takes (--out, --quick, ...).
+    int maxDevices =
+        8; ///< Largest device count (1, 2, 4, ... up to it) when deviceCounts is empty.
+    std::vector<int> deviceCounts{}; ///< Device counts to run, in order (empty: from maxDevices).
     std::vector<double> ratesHz{1000.0, 4000.0}; ///< Servo rates (Hz).
     std::string scene;                           ///< Scene file; empty = the default scene.
     std::string index{kDefaultIndexSpec};        ///< Index spec.

@@ -18,7 +18,20 @@ struct PlotSeries {
     bool dashed = false;    ///< A dashed line (e.g. p50 beside the solid p99.9).
     int style = -1;         ///< Colour and point type (1, 2, ...); -1: the series' position + 1.
     bool linesOnly = false; ///< A plain line, no point marks (a time series of many points).
+    /// Per point: the (low, high) ends of an error bar in y (e.g. a 95 % interval across
+    /// repeats); empty: no bars. Shorter than `points`: the rest have none.
+    std::vector<std::pair<double, double>> errors{};
+    /// Points (with their error bars) not joined by lines: for categorical x (device names) or
+    /// cells that are not a curve.
+    bool pointsOnly = false;
+    /// gnuplot dash type (1 solid, 2 dashed, 3 dotted, 4 dash-dot, 5 dash-dot-dot); 0: from
+    /// `dashed`. Tells the lines of one colour apart (a device's x, y and z).
+    int dash = 0;
 };
+
+/// The colour of a series or span style 1, 2, ...: ten distinct colours (matplotlib's "tab10",
+/// Vega's category10), cycling; no two neighbours are shades of one hue. [any thread]
+std::string plotColour(int style);
 
 /// One set of axes.
 struct PlotPanel {
@@ -35,6 +48,11 @@ struct PlotPanel {
     /// Shaded x intervals [from, to] behind the lines (e.g. when a device was in contact).
     std::vector<std::pair<double, double>> spans{};
     std::string spanTitle{}; ///< Legend text of the shading (empty: none).
+    /// Per span: its style (colour by plotColour, translucent); empty: every span grey under
+    /// `spanTitle`. Spans of several devices then overlap visibly.
+    std::vector<int> spanStyles{};
+    /// With spanStyles: the key text of style s at [s - 1] (e.g. "hand0 in contact").
+    std::vector<std::string> spanStyleTitles{};
 };
 
 /// An empty panel with its title and axis labels (units in the labels).
@@ -58,6 +76,8 @@ struct PlotSpec {
     int columns = 0; ///< Panels per row (0: all in one row); the image grows by rows.
     bool png = true; ///< Draw NAME.png.
     bool svg = true; ///< Draw NAME.svg.
+    /// A line under the title (e.g. "5 runs of 0.5 s per cell; bars: 95 % interval"); empty: none.
+    std::string caption{};
 };
 
 /// What drawPlot made.

@@ -15,6 +15,7 @@
 #include "hapto/experiments/Experiments.h"
 #include "hapto/experiments/Plot.h"
 #include "hapto/experiments/Progress.h"
+#include "hapto/experiments/Stats.h"
 
 #include "hapto/index/IndexSpec.h"
 
@@ -99,6 +100,8 @@ struct SweepRow {
     bool loadStable() const { return !skipped && median.loadStable(); }
     /// The verdict asked for. [any thread]
     bool stable(Verdict v) const { return v == Verdict::Design ? stable() : loadStable(); }
+    /// One figure's median over the repeats and its order-statistic interval. [any thread]
+    MedianInterval interval(double LoadFigures::*figure) const;
 };
 
 /// Per renderer and rate: how far it went.
@@ -194,16 +197,40 @@ PlotSpec sweepPlot(const std::string& experiment, const std::vector<SweepRendere
 /// (no gnuplot, a failed run) is noted on `progress`, not thrown. [control]
 void drawPlotNoting(const std::filesystem::path& dir, const PlotSpec& spec, Progress& progress,
                     std::vector<std::filesystem::path>& files);
-/// One sweepPlot() per rate, drawn. Returns the files drawn; notes problems. [control]
-std::vector<std::filesystem::path>
-plotSweep(const std::filesystem::path& dir, const std::string& experiment,
-          const std::vector<SweepRenderer>& renderers, const std::vector<double>& ratesHz,
-          const std::vector<SweepRow>& rows, Verdict verdict, Progress& progress);
+/// One sweepPlot() per rate with `caption` under its title, drawn. Returns the files drawn;
+/// notes problems. [control]
+std::vector<std::filesystem::path> plotSweep(const std::filesystem::path& dir,
+                                             const std::string& experiment,
+                                             const std::vector<SweepRenderer>& renderers,
+                                             const std::vector<double>& ratesHz,
+                                             const std::vector<SweepRow>& rows, Verdict verdict,
+                                             Progress& progress, const std::string& caption = {});
+
+/// The caption of a figure of medians over repeats: the runs per point and their duration, a
+/// smoke-test mark for --quick, and what the bars are (with their coverage). [any thread]
+std::string repeatsCaption(const CommonArgs& common);
 
 /// A paragraph on how the cells were measured: the verdict driving the sweep, whether
 /// SCHED_FIFO was granted, and the platform's wake-up lateness and misses (medians over the
 /// measured cells), so that misses can be told apart from overload. [control]
 std::string platformNote(const std::vector<SweepRow>& rows, Verdict verdict);
+
+/// The verdict a sweep uses: the one --verdict names; a --quick run without it uses the load
+/// verdict (`quickDefault`), the renderer's own time against the period, which is what the
+/// paper judged (its limits are servo-loop load, e.g. "load < 40 %"), while the design verdict
+/// would also count the deadlines a short run on a shared machine misses by late wake-ups.
+/// [any thread]
+Verdict sweepVerdict(bool quick, bool verdictGiven, Verdict given);
+
+/// The header a --quick run's report opens with: that it is a smoke test (the experiment runs
+/// and writes every file), the runs it made, which claims it `cannotJudge`, and the verdict
+/// its table uses (`verdict`, said in full). [any thread]
+std::string smokeTestHeader(const CommonArgs& common, const std::string& cannotJudge,
+                            const std::string& verdict);
+/// smokeTestHeader for a sweep: the paper's limits cannot be judged below `largest` objects,
+/// nor p99.9 from a few hundred ticks; the verdict is `verdict` read on the quick tail (p99).
+/// Empty for a full run. [any thread]
+std::string sweepSmokeHeader(const CommonArgs& common, Verdict verdict, std::size_t largest);
 
 /// "1 kHz", "20 kHz", "500 Hz". [any thread]
 std::string rateText(double rateHz);
