@@ -20,73 +20,22 @@
 namespace hapto::experiments {
 namespace {
 
+/// A factor swept: its name, its axis label, the cell's field it sets, the list it takes.
+struct Factor {
+    const char* name;
+    const char* axis;
+    double GraspCellSpec::*field;
+    std::vector<double> GraspArgs::*values;
+};
+
 /// The factors swept, in table order.
-enum class Factor { Squeeze, Mass, Stiffness, Rate };
-constexpr Factor kFactors[] = {Factor::Squeeze, Factor::Mass, Factor::Stiffness, Factor::Rate};
-
-const char* factorName(Factor f) {
-    switch (f) {
-    case Factor::Squeeze:
-        return "squeeze";
-    case Factor::Mass:
-        return "mass";
-    case Factor::Stiffness:
-        return "stiffness";
-    case Factor::Rate:
-        return "servo rate";
-    }
-    return "?";
-}
-
-const char* factorAxis(Factor f) {
-    switch (f) {
-    case Factor::Squeeze:
-        return "squeeze force, each hand (N)";
-    case Factor::Mass:
-        return "mass (kg)";
-    case Factor::Stiffness:
-        return "surface stiffness (N/m)";
-    case Factor::Rate:
-        return "servo rate (Hz)";
-    }
-    return "?";
-}
-
-double factorValue(Factor f, const GraspCellSpec& s) {
-    switch (f) {
-    case Factor::Squeeze:
-        return s.squeezeN;
-    case Factor::Mass:
-        return s.massKg;
-    case Factor::Stiffness:
-        return s.stiffnessNPerM;
-    case Factor::Rate:
-        return s.servoRateHz;
-    }
-    return 0.0;
-}
-
-const std::vector<double>& factorValues(Factor f, const GraspArgs& a) {
-    switch (f) {
-    case Factor::Squeeze:
-        return a.squeezesN;
-    case Factor::Mass:
-        return a.massesKg;
-    case Factor::Stiffness:
-        return a.stiffnessesNPerM;
-    case Factor::Rate:
-        break;
-    }
-    return a.ratesHz;
-}
-
-GraspCellSpec withFactor(GraspCellSpec s, Factor f, double v) {
-    (f == Factor::Squeeze     ? s.squeezeN
-     : f == Factor::Mass      ? s.massKg
-     : f == Factor::Stiffness ? s.stiffnessNPerM
-                              : s.servoRateHz) = v;
-    return s;
-}
+constexpr Factor kFactors[] = {
+    {"squeeze", "squeeze force, each hand (N)", &GraspCellSpec::squeezeN, &GraspArgs::squeezesN},
+    {"mass", "mass (kg)", &GraspCellSpec::massKg, &GraspArgs::massesKg},
+    {"stiffness", "surface stiffness (N/m)", &GraspCellSpec::stiffnessNPerM,
+     &GraspArgs::stiffnessesNPerM},
+    {"servo rate", "servo rate (Hz)", &GraspCellSpec::servoRateHz, &GraspArgs::ratesHz},
+};
 
 bool sameCell(const GraspCellSpec& a, const GraspCellSpec& b) {
     return a.squeezeN == b.squeezeN && a.massKg == b.massKg &&
@@ -104,7 +53,7 @@ struct CellRun {
 
 /// One table row: a factor and the cell it points at.
 struct RowRef {
-    Factor factor;
+    const Factor* factor;
     std::size_t cell;
 };
 
@@ -112,14 +61,15 @@ struct RowRef {
 /// cell cannot run, naming its factor.
 std::vector<RowRef> planCells(const GraspArgs& a, std::vector<CellRun>& cells) {
     std::vector<RowRef> rows;
-    for (const Factor f : kFactors) {
-        for (const double v : factorValues(f, a)) {
-            const GraspCellSpec spec = withFactor(a.base, f, v);
+    for (const Factor& f : kFactors) {
+        for (const double v : a.*f.values) {
+            GraspCellSpec spec = a.base;
+            spec.*f.field = v;
             try {
                 checkGraspCellSpec(spec);
             } catch (const std::invalid_argument& e) {
-                throw InputError("experiment grasp: " + std::string(factorName(f)) + " " +
-                                 fmt(v, 6) + ": " + e.what());
+                throw InputError("experiment grasp: " + std::string(f.name) + " " + fmt(v, 6) +
+                                 ": " + e.what());
             }
             std::size_t k = 0;
             while (k < cells.size() && !sameCell(cells[k].spec, spec)) {
@@ -128,7 +78,7 @@ std::vector<RowRef> planCells(const GraspArgs& a, std::vector<CellRun>& cells) {
             if (k == cells.size()) {
                 cells.push_back({spec, {}, true, {}, {}});
             }
-            rows.push_back({f, k});
+            rows.push_back({&f, k});
         }
     }
     return rows;
@@ -197,11 +147,11 @@ double couplingA(const GraspCellSpec& s) {
     return 2.0 * s.stiffnessNPerM * h * h / s.massKg;
 }
 
-void addRow(Table& t, Factor f, const CellRun& c) {
+void addRow(Table& t, const Factor& f, const CellRun& c) {
     const GraspCellSpec& s = c.spec;
     const GraspCellResult& r = c.result;
     const bool expected = expectHold(s);
-    t.add({std::string(factorName(f)),
+    t.add({std::string(f.name),
            s.squeezeN,
            s.massKg,
            s.stiffnessNPerM,
@@ -242,13 +192,13 @@ PlotSpec graspPlot(const std::string& name, const std::string& title, const std:
     spec.title = title;
     spec.columns = 2;
     spec.unstableTitle = "held/dropped disagrees with mu_s(F1+F2) >= m g";
-    for (const Factor f : kFactors) {
-        PlotPanel p = panel(factorName(f), factorAxis(f), yLabel);
+    for (const Factor& f : kFactors) {
+        PlotPanel p = panel(f.name, f.axis, yLabel);
         p.logX = true;
         p.logY = logY;
         std::vector<const CellRun*> mine;
         for (const RowRef& r : rows) {
-            if (r.factor == f) {
+            if (r.factor == &f) {
                 mine.push_back(&cells[r.cell]);
             }
         }
@@ -262,13 +212,13 @@ PlotSpec graspPlot(const std::string& name, const std::string& title, const std:
 
 /// A line of `value(cell)` against the factor, each point marked when the verdict disagrees.
 template <class Value>
-PlotSeries line(const std::string& title, Factor f, const std::vector<const CellRun*>& cells,
+PlotSeries line(const std::string& title, const Factor& f, const std::vector<const CellRun*>& cells,
                 Value value, bool dashed = false) {
     PlotSeries s;
     s.title = title;
     s.dashed = dashed;
     for (const CellRun* c : cells) {
-        s.points.emplace_back(factorValue(f, c->spec), value(*c));
+        s.points.emplace_back(c->spec.*f.field, value(*c));
         s.unstable.push_back(expectHold(c->spec) != c->result.grasp.held);
     }
     return s;
@@ -284,7 +234,7 @@ std::vector<std::filesystem::path> drawGraspPlots(const std::filesystem::path& o
         out,
         graspPlot("grasp-slip", "Grasp: slip of the box against the hands, and its penetration",
                   "mm", true, rows, cells,
-                  [&](Factor f, const std::vector<const CellRun*>& c) {
+                  [&](const Factor& f, const std::vector<const CellRun*>& c) {
                       return std::vector<PlotSeries>{
                           line("max slip", f, c,
                                [&](const CellRun& r) {
@@ -303,7 +253,7 @@ std::vector<std::filesystem::path> drawGraspPlots(const std::filesystem::path& o
         graspPlot(
             "grasp-force", "Grasp: |hands' vertical force - m g| / m g while held", "%", false,
             rows, cells,
-            [&](Factor f, const std::vector<const CellRun*>& c) {
+            [&](const Factor& f, const std::vector<const CellRun*>& c) {
                 return std::vector<PlotSeries>{
                     line("worst", f, c,
                          [](const CellRun& r) { return r.result.grasp.forceErrorWorst * 100.0; }),
@@ -317,7 +267,7 @@ std::vector<std::filesystem::path> drawGraspPlots(const std::filesystem::path& o
         out,
         graspPlot("grasp-step", "Grasp: the dynamics step's CPU time (a timing: it varies)", "us",
                   true, rows, cells,
-                  [&](Factor f, const std::vector<const CellRun*>& c) {
+                  [&](const Factor& f, const std::vector<const CellRun*>& c) {
                       return std::vector<PlotSeries>{
                           line("p99.9", f, c, [](const CellRun& r) { return r.stepP999Us.median; }),
                           line(
@@ -389,11 +339,10 @@ std::string graspMarkdown(const GraspArgs& a, const Table& t) {
           intervalNote(a.common.repeats) + " Everything else is the same every run (checked).\n\n" +
           verdictSummary(t);
     const std::size_t factor = t.column("factor");
-    for (const Factor f : kFactors) {
-        md +=
-            "\n### Against " + std::string(factorName(f)) + "\n\n" + t.markdown([&](std::size_t i) {
-                return std::get<std::string>(t.rows()[i][factor]) == factorName(f);
-            });
+    for (const Factor& f : kFactors) {
+        md += "\n### Against " + std::string(f.name) + "\n\n" + t.markdown([&](std::size_t i) {
+            return std::get<std::string>(t.rows()[i][factor]) == f.name;
+        });
     }
     return md;
 }
@@ -428,7 +377,7 @@ int runGrasp(const GraspArgs& a) {
     }
     Table table = graspTable();
     for (const RowRef& r : rows) {
-        addRow(table, r.factor, cells[r.cell]);
+        addRow(table, *r.factor, cells[r.cell]);
     }
     table.writeCsv(out / "grasp.csv");
     Json j;
