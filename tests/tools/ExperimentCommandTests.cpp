@@ -218,13 +218,17 @@ TEST_CASE("hapto experiment paper1 --quick writes Table 1, CSV, JSON and plots",
     CHECK(r.output.find("no touch") != std::string::npos);
     CHECK(r.output.find("### Max stable objects per renderer") != std::string::npos);
     CHECK(r.output.find("octree M=5") != std::string::npos);
+    // A smoke test, said so: what it cannot judge and the verdict its table uses.
+    CHECK(r.output.find("**Smoke test (--quick)**") != std::string::npos);
+    CHECK(r.output.find("cannot judge the paper's max-stable claims") != std::string::npos);
+    CHECK(r.output.find("Verdict in this table: load") != std::string::npos);
 
     const Csv csv = readCsv(dir / "paper1.csv");
     const json j = json::parse(test::readFile(dir / "paper1.json"));
     CHECK(j["experiment"] == "paper1");
     CHECK(j.contains("machine"));
     CHECK(j["options"]["max_per_side"] == 4);
-    checkSweep(csv, j, "per_side", "design");
+    checkSweep(csv, j, "per_side", "load"); // --quick: the load verdict unless --verdict
     // Every renderer is measured at the smallest lattice, in all three conditions.
     std::map<std::string, std::set<std::string>> smallest;
     for (const auto& row : csv.rows) {
@@ -261,7 +265,7 @@ TEST_CASE("hapto experiment meshes --quick: load against triangle count, the pap
     CHECK(j["experiment"] == "meshes");
     CHECK(j["options"]["shape"] == "torus");
     CHECK(j["options"]["max_triangles"] == 300);
-    checkSweep(csv, j, "triangles_asked", "design");
+    checkSweep(csv, j, "triangles_asked", "load"); // --quick: the load verdict
     // The sizes asked for are 100 and 300; the torus has them within 1.15x. Every renderer is
     // measured at the smallest size, in all three conditions.
     std::map<std::string, std::set<std::string>> smallest;
@@ -364,7 +368,7 @@ TEST_CASE("hapto experiment scaling --quick: load against devices and cursor ste
                    : "0"));
     }
     const Csv pd = readCsv(dir / "devices-per-device.csv");
-    CHECK(pd.rows.size() == 3); // one device, then two, one repeat each
+    CHECK(pd.rows.size() == 9); // one device, then two, three repeats each (--quick: 3)
     for (std::size_t i = 0; i < pd.rows.size(); ++i) {
         CHECK(pd.num(i, "load_p50_pct") > 0);
         CHECK(pd.num(i, "ticks") > 0);
@@ -392,7 +396,7 @@ TEST_CASE("hapto experiment scaling --quick: load against devices and cursor ste
     const json j = json::parse(test::readFile(dir / "devices.json"));
     CHECK(j["experiment"] == "devices");
     CHECK(j["devices"].size() == 2);
-    CHECK(j["devices"][1]["per_device"].size() == 2);
+    CHECK(j["devices"][1]["per_device"].size() == 6); // 2 devices x 3 runs
     CHECK(j["cursor"].size() == 6);
     CHECK(j["options"]["verdict_percentile"] == "p99");
     // CSV and JSON come from one column list: the same names, in the same order.

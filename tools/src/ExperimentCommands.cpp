@@ -6,12 +6,17 @@
 
 #include "hapto/experiments/ExperimentSupport.h"
 #include "hapto/experiments/Experiments.h"
+#include "hapto/experiments/Stats.h"
+#include "hapto/experiments/Sweep.h"
+#include "hapto/experiments/Table.h"
 
 #include "hapto/io/InputError.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace hapto::cli {
 namespace {
@@ -24,7 +29,43 @@ struct CommonOptions {
     CLI::Option* duration = nullptr;
     CLI::Option* repeats = nullptr;
     std::string verdict = "design"; ///< --verdict's text (sweeps only), parsed after parsing.
+    CLI::Option* verdictOption = nullptr;
+    int quickRepeats = 1; ///< --repeats under --quick unless given.
 };
+
+/// A sweep list option (--counts, --rates, ...): its text, read by parseSweepList after parsing
+/// so that every list takes the same forms (1,2,4; 1-8; 1:8; 1000:4000:1000).
+struct ListOption {
+    std::string text;
+    CLI::Option* option = nullptr;
+    /// True when the option was given.
+    bool given() const { return option && option->count() > 0; }
+};
+
+/// Adds `name` as a sweep list option; `defaultText` shows in the help.
+CLI::Option* addList(CLI::App* cmd, ListOption& list, const std::string& name,
+                     const std::string& help, const std::string& defaultText) {
+    list.text = defaultText;
+    list.option = cmd->add_option(name, list.text,
+                                  help + "; a list: 1,2,4 or a range 1-8 / 1:8 / 1:8:2 (whole "
+                                         "numbers; A:B:STEP for any number)")
+                      ->capture_default_str();
+    return list.option;
+}
+
+/// The whole numbers of a list option from `min` to `max`, as T, ascending when `sorted`.
+template <class T>
+std::vector<T> countsOf(const ListOption& list, const std::string& name, double min, double max,
+                        bool sorted) {
+    std::vector<T> values;
+    for (const std::int64_t v : parseCountList(list.text, name, min, max)) {
+        values.push_back(static_cast<T>(v));
+    }
+    if (sorted) {
+        std::sort(values.begin(), values.end());
+    }
+    return values;
+}
 
 void addCommon(CLI::App* cmd, CommonArgs& a, CommonOptions& o, const std::string& name) {
     a.out = "out/" + name;
@@ -32,15 +73,18 @@ void addCommon(CLI::App* cmd, CommonArgs& a, CommonOptions& o, const std::string
                             "Folder for the CSV, JSON, markdown and plot files (created)")
                 ->capture_default_str();
     cmd->add_flag("--quick", a.quick,
-                  "A run of seconds: small sizes, 0.15 s per run, one repeat (options given "
-                  "explicitly still apply)");
+                  "A smoke test of seconds: small sizes, 0.15 s per run, few repeats, the "
+                  "report says which claims it cannot judge (options given explicitly still "
+                  "apply)");
     o.duration = cmd->add_option("--duration", a.durationS,
                                  "Timed servo run per measurement (s); --quick: 0.15")
                      ->capture_default_str()
                      ->check(finiteRange(0.02, 60));
     o.repeats = cmd->add_option("--repeats", a.repeats,
-                                "Runs per measurement; every figure is the median over them; "
-                                "--quick: 1")
+                                "Runs per measurement; every figure is the median over them, "
+                                "with its order-statistic interval (5 runs: [min, max], 93.75 % "
+                                "coverage; 6 or more: 95 %); --quick: " +
+                                    std::to_string(o.quickRepeats))
                     ->capture_default_str()
                     ->check(finiteRange(1, 99));
     addRealtimeFlag(cmd, a.realtime, "");
@@ -52,20 +96,33 @@ void applyQuick(CommonArgs& a, const CommonOptions& o) {
             a.durationS = 0.15;
         }
         if (o.repeats->count() == 0) {
-            a.repeats = 1;
+            a.repeats = o.quickRepeats;
         }
     }
 }
 
+/// The text of a list of numbers, as --rates shows its default.
+std::string listText(const std::vector<double>& values) {
+    std::string text;
+    for (const double v : values) {
+        text += (text.empty() ? "" : ",") + csvNumber(v);
+    }
+    return text;
+}
+
 /// `--rates HZ,HZ` (and its deprecated spelling `--rate`): servo rates, 100..100000 Hz each.
-CLI::Option* addRates(CLI::App* cmd, std::vector<double>& ratesHz, const std::string& note) {
-    return cmd
-        ->add_option("--rates,--rate", ratesHz,
-                     "Servo rates (Hz, 100..100000), comma-separated; " + note +
-                         " (--rate: the old spelling)")
-        ->capture_default_str()
-        ->delimiter(',')
-        ->check(finiteRange(100, 100000));
+CLI::Option* addRates(CLI::App* cmd, ListOption& rates, const std::vector<double>& ratesHz,
+                      const std::string& note) {
+    return addList(cmd, rates, "--rates,--rate",
+                   "Servo rates (Hz, 100..100000); " + note + " (--rate: the old spelling)",
+                   listText(ratesHz));
+}
+
+/// The rates --rates gives, when it was given.
+void applyRates(const ListOption& rates, std::vector<double>& ratesHz) {
+    if (rates.given()) {
+        ratesHz = parseSweepList(rates.text, "--rates", {100, 100000, false});
+    }
 }
 
 CLI::Option* addVerdict(CLI::App* cmd, std::string& verdict) {
@@ -74,20 +131,22 @@ CLI::Option* addVerdict(CLI::App* cmd, std::string& verdict) {
                      "What stops a renderer's growth and names the first unstable size: design "
                      "(DESIGN.md: p99.9 load < 100 % and <= 0.1 % deadlines missed) or load "
                      "(p99.9 load < 100 % only, for machines whose wake-ups are late by "
-                     "themselves); both verdicts are reported either way")
+                     "themselves); both verdicts are reported either way; --quick: load (the "
+                     "paper's: the renderer's time against the period)")
         ->capture_default_str();
 }
 
 /// The options of a sweep experiment (paper1, paper2, meshes): the common ones and --verdict.
 void addSweepCommon(CLI::App* cmd, CommonArgs& a, CommonOptions& o, const std::string& name) {
     addCommon(cmd, a, o, name);
-    addVerdict(cmd, o.verdict);
+    o.verdictOption = addVerdict(cmd, o.verdict);
 }
 
 /// After parsing a sweep experiment: applies --quick and returns the verdict --verdict names.
 Verdict applySweepCommon(CommonArgs& a, const CommonOptions& o) {
     applyQuick(a, o);
-    return parseVerdict(o.verdict, "--verdict");
+    return sweepVerdict(a.quick, o.verdictOption->count() > 0,
+                        parseVerdict(o.verdict, "--verdict"));
 }
 
 /// `--max-index-mb` of a sweep: the memory an index may be extrapolated to (MB) from the
@@ -120,8 +179,13 @@ void addPaper1Command(CLI::App* exp) {
         "K. Prints the analogue of the paper's Table 1 and the max stable objects");
     addSweepCommon(cmd, a->common, *o, "paper1");
     setExamples(cmd, {"hapto experiment paper1 --quick",
-                      "hapto experiment paper1 --rates 1000 --max-per-side 20 --out out/p1"});
-    addRates(cmd, a->ratesHz, "e.g. 1000,10000");
+                      "hapto experiment paper1 --rates 1000 --max-per-side 20 --out out/p1",
+                      "hapto experiment paper1 --per-side 2-12 --repeats 9"});
+    auto rates = std::make_shared<ListOption>();
+    addRates(cmd, *rates, a->ratesHz, "e.g. 1000,10000");
+    auto perSide = std::make_shared<ListOption>();
+    addList(cmd, *perSide, "--per-side",
+            "K values to run (2..400, instead of the sizes up to --max-per-side)", "");
     auto* maxK = cmd->add_option("--max-per-side", a->maxPerSide,
                                  "Largest K (cubes per lattice side; K^3 objects); sizes "
                                  "2,3,4,5,6,8,10,13,16,20,25,32,40,50,64,80,100,... up to "
@@ -129,8 +193,12 @@ void addPaper1Command(CLI::App* exp) {
                      ->capture_default_str()
                      ->check(finiteRange(2, 400));
     addSweepIndexLimit(cmd, a->maxIndexMb, "size");
-    cmd->callback([a, o, maxK] {
+    cmd->callback([a, o, maxK, rates, perSide] {
         a->verdict = applySweepCommon(a->common, *o);
+        applyRates(*rates, a->ratesHz);
+        if (perSide->given()) {
+            a->perSide = countsOf<int>(*perSide, "--per-side", 2, 400, true);
+        }
         if (a->common.quick && maxK->count() == 0) {
             a->maxPerSide = 4;
         }
@@ -152,26 +220,34 @@ void addPaper2Command(CLI::App* exp) {
         "the analogue of the paper's Table 2 (200-object scenes) and the max stable objects");
     addSweepCommon(cmd, a->common, *o, "paper2");
     setExamples(cmd, {"hapto experiment paper2 --quick",
-                      "hapto experiment paper2 --counts 100,200,500 --decades"});
-    auto* countsOpt = cmd->add_option("--counts", a->counts,
-                                      "Objects per scene, comma-separated; --quick: 10,20,50")
-                          ->capture_default_str()
-                          ->delimiter(',')
-                          ->transform(wholeNumber(1, 1e8));
+                      "hapto experiment paper2 --counts 100,200,500 --decades",
+                      "hapto experiment paper2 --counts 100:1000:100"});
+    auto counts = std::make_shared<ListOption>();
+    std::string defaultCounts;
+    for (const std::size_t n : a->counts) {
+        defaultCounts += (defaultCounts.empty() ? "" : ",") + std::to_string(n);
+    }
+    auto* countsOpt = addList(cmd, *counts, "--counts",
+                              "Objects per scene (1..1e8); --quick: 10,20,50", defaultCounts);
     cmd->add_flag("--decades", *decades,
                   "Also 1000, 10000, 100000 and 1000000 objects (a renderer still stops "
                   "after its first unstable count)");
     auto* seeds = cmd->add_option("--seeds", a->seeds, "Scenes per count (seeds 1..N); --quick: 2")
                       ->capture_default_str()
                       ->check(finiteRange(1, 100));
-    addRates(cmd, a->ratesHz, "e.g. 1000,10000");
+    auto rates = std::make_shared<ListOption>();
+    addRates(cmd, *rates, a->ratesHz, "e.g. 1000,10000");
     cmd->add_option("--keep-clear", a->keepClearM,
                     "No object within this distance of the centre, where the hand starts (m)")
         ->capture_default_str()
         ->check(finiteRange(0.005, 0.1));
     addSweepIndexLimit(cmd, a->maxIndexMb, "count");
-    cmd->callback([a, o, decades, countsOpt, seeds] {
+    cmd->callback([a, o, decades, countsOpt, counts, seeds, rates] {
         a->verdict = applySweepCommon(a->common, *o);
+        applyRates(*rates, a->ratesHz);
+        if (counts->given()) {
+            a->counts = countsOf<std::size_t>(*counts, "--counts", 1, 1e8, true);
+        }
         if (a->common.quick) {
             if (countsOpt->count() == 0) {
                 a->counts = {10, 20, 50};
@@ -206,7 +282,13 @@ void addMeshesCommand(CLI::App* exp) {
     addSweepCommon(cmd, a->common, *o, "meshes");
     setExamples(cmd, {"hapto experiment meshes --quick",
                       "hapto experiment meshes --shape torus --max-triangles 1e6"});
-    addRates(cmd, a->ratesHz, "e.g. 1000,4000");
+    auto rates = std::make_shared<ListOption>();
+    addRates(cmd, *rates, a->ratesHz, "e.g. 1000,4000");
+    auto triangles = std::make_shared<ListOption>();
+    addList(cmd, *triangles, "--triangles",
+            "Triangle counts to run (1e2..1e7, instead of 1 and 3 per decade up to "
+            "--max-triangles)",
+            "");
     cmd->add_option("--shape", *shape, "sphere or torus")
         ->capture_default_str()
         ->check(CLI::IsMember({"sphere", "torus"}));
@@ -231,8 +313,14 @@ void addMeshesCommand(CLI::App* exp) {
         ->capture_default_str()
         ->check(finiteRange(1e-6, 1));
     addSweepIndexLimit(cmd, a->maxIndexMb, "size");
-    cmd->callback([a, o, shape, maxTriangles] {
+    cmd->callback([a, o, shape, maxTriangles, rates, triangles] {
         a->verdict = applySweepCommon(a->common, *o);
+        applyRates(*rates, a->ratesHz);
+        if (triangles->given()) {
+            a->triangles = countsOf<std::size_t>(*triangles, "--triangles",
+                                                 static_cast<double>(kMinGeneratedTriangles),
+                                                 static_cast<double>(kMaxGeneratedTriangles), true);
+        }
         a->shape = *parseMeshShape(*shape); // CLI11 checked the name
         if (a->common.quick && maxTriangles->count() == 0) {
             a->maxTriangles = 1000;
@@ -254,15 +342,20 @@ void addScalingCommand(CLI::App* exp) {
         "and total load, misses, verdict. Then the three octree cursor strategies (root, "
         "climb, neighbour links) along one hand-speed walk over K^3 lattices: mean steps "
         "per locate against N (the paper's section 2.2.4)");
+    o->quickRepeats = 3; // a cell of 2 devices for 0.15 s: three cost half a second
     addCommon(cmd, a->common, *o, "scaling");
     setExamples(cmd, {"hapto experiment scaling --quick",
-                      "hapto experiment scaling --max-devices 8 --rates 1000,4000 --no-cursor"});
+                      "hapto experiment scaling --max-devices 8 --rates 1000,4000 --no-cursor",
+                      "hapto experiment scaling --counts 1-8 --repeats 9 --no-cursor"});
     auto* maxDevices = cmd->add_option("--max-devices", a->maxDevices,
-                                       "Largest device count; counts 1, 2, 4, ... up to it; "
-                                       "--quick: 2")
+                                       "Largest device count; counts 1, 2, 4, ... up to it "
+                                       "(unless --counts); --quick: 2")
                            ->capture_default_str()
                            ->check(finiteRange(1, 60));
-    auto* ratesOpt = addRates(cmd, a->ratesHz, "--quick: 1000");
+    auto counts = std::make_shared<ListOption>();
+    addList(cmd, *counts, "--counts", "Device counts to run (1..60), e.g. 1-8", "");
+    auto rates = std::make_shared<ListOption>();
+    auto* ratesOpt = addRates(cmd, *rates, a->ratesHz, "--quick: 1000");
     cmd->add_option("--scene", a->scene, "Scene file (default: the embedded default scene)");
     cmd->add_option("--index", a->index,
                     "Spatial index: brute, grid:N, octree:M:MIN (MIN in m), optional :aabb; "
@@ -277,21 +370,31 @@ void addScalingCommand(CLI::App* exp) {
                     "Hand script: walk (random hops through the scene) or slide (slide on "
                     "the nearest surface)")
         ->capture_default_str();
-    auto* objectsOpt = cmd->add_option("--cursor-objects", a->cursorObjects,
-                                       "Cursor part: N values (objects; a K^3 lattice with "
-                                       "K = round(cbrt N)), comma-separated; --quick: "
-                                       "100,1000")
-                           ->capture_default_str()
-                           ->delimiter(',')
-                           ->transform(wholeNumber(1, 1e8));
+    auto objects = std::make_shared<ListOption>();
+    std::string defaultObjects;
+    for (const std::size_t n : a->cursorObjects) {
+        defaultObjects += (defaultObjects.empty() ? "" : ",") + std::to_string(n);
+    }
+    auto* objectsOpt = addList(cmd, *objects, "--cursor-objects",
+                               "Cursor part: N values (1..1e8 objects; a K^3 lattice with K = "
+                               "round(cbrt N)); --quick: 100,1000",
+                               defaultObjects);
     auto* stepsOpt = cmd->add_option("--walk-steps", a->walkSteps,
                                      "Cursor part: walk length (1 ms steps, <= 0.5 mm "
                                      "each), e.g. 2e5; --quick: 20000")
                          ->capture_default_str()
                          ->transform(wholeNumber(1, 4e9));
     cmd->add_flag("--no-cursor", *noCursor, "Skip the cursor part");
-    cmd->callback([a, o, noCursor, maxDevices, ratesOpt, objectsOpt, stepsOpt] {
+    cmd->callback([a, o, noCursor, maxDevices, ratesOpt, objectsOpt, stepsOpt, counts, rates,
+                   objects] {
         applyQuick(a->common, *o);
+        applyRates(*rates, a->ratesHz);
+        if (counts->given()) {
+            a->deviceCounts = countsOf<int>(*counts, "--counts", 1, 60, false);
+        }
+        if (objects->given()) {
+            a->cursorObjects = countsOf<std::size_t>(*objects, "--cursor-objects", 1, 1e8, false);
+        }
         if (a->common.quick) {
             if (maxDevices->count() == 0) {
                 a->maxDevices = 2;
@@ -325,6 +428,7 @@ void addExperimentCommands(CLI::App& app) {
     addPaper2Command(exp);
     addMeshesCommand(exp);
     addScalingCommand(exp);
+    addGraspExperimentCommand(exp);
     // `devices` is the command that lists hardware; the experiment is named for what it does.
     addRenamedCommand(exp, "devices", "hapto experiment scaling");
 }
