@@ -256,12 +256,18 @@ bool reachableSide(const Scene& scene, std::uint32_t slot, const Vec3& surface, 
                                 kFreeMarginM * 0.5, slot);
 }
 
-// Distance from the centre to the object's surface along `out` (m), by bisection on the solid.
+double surfaceAlongFrom(const SceneObject& o, const Vec3& from, const Vec3& out);
+
+// Distance from `from` (the centre by default, inside the solid) to the object's surface along
+// `out` (m), by bisection on the solid.
 double surfaceAlong(const SceneObject& o, const Vec3& out) {
-    double in = 0.0, outT = o.radius() * 1.001 + 1e-6;
+    return surfaceAlongFrom(o, o.center, out);
+}
+double surfaceAlongFrom(const SceneObject& o, const Vec3& from, const Vec3& out) {
+    double in = 0.0, outT = o.radius() * 1.001 + 1e-6 + glm::length(from - o.center);
     for (int i = 0; i < 60; ++i) {
         const double mid = 0.5 * (in + outT);
-        (o.contains(o.center + out * mid) ? in : outT) = mid;
+        (o.contains(from + out * mid) ? in : outT) = mid;
     }
     return outT;
 }
@@ -576,8 +582,57 @@ void graspApproach(Builder& plan, const Scene& scene, const Vec3& startWorld,
     plan.holdUntil(GraspTimes::kApproachEnd, ScriptPhase::Approach);
 }
 
+// Where a grasp holds: a dynamic body on the axis through its centre of mass (squeezing there
+// leaves gravity no lever about the axis between the hands, so two point contacts need no
+// torsional friction to keep it from turning), a static object at its centre.
+Vec3 graspCentre(const SceneObject& o) {
+    return o.body.dynamic ? o.center + o.rotation * o.body.centerOfMassLocal : o.center;
+}
+
+// How far above its start a dynamic body is set down (m, along +y): the top of the highest
+// other object under its footprint once carried, no higher than the lift takes its bottom
+// (the floor under it gives 0). A static object is put back at its own height (0).
+double setDownRaise(const Scene& scene, std::uint32_t slot, const SimConfig& config) {
+    const SceneObject& o = scene.object(slot);
+    if (!o.body.dynamic) {
+        return 0.0;
+    }
+    const Aabb box = o.aabb();
+    const double bottom = box.min.y;
+    const double inset = 1e-4; // touching footprints side by side do not support it
+    double raise = 0.0;
+    for (std::uint32_t i = 0; i < scene.size(); ++i) {
+        const Aabb other = scene.object(i).aabb();
+        const bool under = i != slot && other.max.x > box.min.x + config.carry.x + inset &&
+                           other.min.x < box.max.x + config.carry.x - inset &&
+                           other.max.z > box.min.z + config.carry.z + inset &&
+                           other.min.z < box.max.z + config.carry.z - inset &&
+                           other.max.y <= bottom + config.lift.y;
+        if (under) {
+            raise = std::max(raise, other.max.y - bottom);
+        }
+    }
+    return raise;
+}
+
+// A dynamic body's drop, after the first release: reach its sides where it was set down,
+// squeeze again, lift it GraspTimes::kDropHeightM and open the hands quickly, so it falls.
+void planDrop(Builder& plan, const Vec3& surface, const Vec3& squeezed, const Vec3& standOff) {
+    using G = GraspTimes;
+    const Vec3 up(0.0, G::kDropHeightM, 0.0);
+    plan.moveTo(surface, G::kRegraspEnd - G::kReleaseEnd, ScriptPhase::Reach);
+    plan.moveTo(squeezed, 0.5 * (G::kResqueezeEnd - G::kRegraspEnd), ScriptPhase::Squeeze);
+    plan.holdPress(true);
+    plan.holdUntil(G::kResqueezeEnd, ScriptPhase::Squeeze);
+    plan.moveTo(squeezed + up, G::kDropLiftEnd - G::kResqueezeEnd, ScriptPhase::Lift);
+    plan.holdPress(false);
+    plan.moveTo(standOff + up, G::kDropEnd - G::kDropLiftEnd, ScriptPhase::Drop);
+    plan.hold(0.5, ScriptPhase::Done);
+}
+
 // Grasp (left hand from -x, right from +x): approach the stand-off, reach the surface, squeeze,
-// lift, carry, put down and release on GraspTimes' fixed schedule, so two hands keep step.
+// lift, carry, put down (a dynamic body on what is under it) and release on GraspTimes' fixed
+// schedule, so two hands keep step; a dynamic body is then grasped again and dropped.
 PlanChoice planGrasp(Builder& plan, const SimConfig& config, const Scene& scene,
                      const Vec3& startWorld) {
     PlanChoice choice;
@@ -590,10 +645,12 @@ PlanChoice planGrasp(Builder& plan, const SimConfig& config, const Scene& scene,
     choice.object = o.id;
     const double side = config.script == HandScript::GraspLeft ? -1.0 : 1.0;
     const Vec3 out(side, 0.0, 0.0);
-    const Vec3 surface = o.center + out * surfaceAlong(o, out);
+    const Vec3 centre = graspCentre(o);
+    const Vec3 surface = centre + out * surfaceAlongFrom(o, centre, out);
     choice.contactNormal = out;
     const Vec3 standOff = surface + out * graspStandOff(scene, *slot, surface, out);
     const Vec3 squeezed = surface - out * pressDepth(config);
+    const Vec3 setDown = config.carry + Vec3(0.0, setDownRaise(scene, *slot, config), 0.0);
     graspApproach(plan, scene, startWorld, standOff);
     using G = GraspTimes;
     plan.moveTo(surface, G::kReachEnd - G::kApproachEnd, ScriptPhase::Reach);
@@ -603,9 +660,13 @@ PlanChoice planGrasp(Builder& plan, const SimConfig& config, const Scene& scene,
     plan.moveTo(squeezed + config.lift, G::kLiftEnd - G::kSqueezeEnd, ScriptPhase::Lift);
     plan.moveTo(squeezed + config.lift + config.carry, G::kCarryEnd - G::kLiftEnd,
                 ScriptPhase::Carry);
-    plan.moveTo(squeezed + config.carry, G::kPutDownEnd - G::kCarryEnd, ScriptPhase::PutDown);
+    plan.moveTo(squeezed + setDown, G::kPutDownEnd - G::kCarryEnd, ScriptPhase::PutDown);
     plan.holdPress(false);
-    plan.moveTo(standOff + config.carry, G::kReleaseEnd - G::kPutDownEnd, ScriptPhase::Release);
+    plan.moveTo(standOff + setDown, G::kReleaseEnd - G::kPutDownEnd, ScriptPhase::Release);
+    if (o.body.dynamic) {
+        planDrop(plan, surface + setDown, squeezed + setDown, standOff + setDown);
+        return choice;
+    }
     plan.hold(0.5, ScriptPhase::Done);
     return choice;
 }
@@ -638,6 +699,8 @@ std::string_view scriptPhaseName(ScriptPhase phase) {
         return "release";
     case ScriptPhase::Done:
         return "done";
+    case ScriptPhase::Drop:
+        return "drop";
     }
     return "unknown";
 }

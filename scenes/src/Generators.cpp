@@ -3,6 +3,7 @@
 #include "hapto/core/Random.h"
 #include "hapto/io/InputError.h"
 #include "hapto/io/JsonInput.h"
+#include "hapto/scenes/MassProperties.h"
 
 #include <algorithm>
 #include <cmath>
@@ -189,6 +190,98 @@ Scene makeGraspScene() {
         makeBox(5, Vec3(0.12, -0.05, 0.06), Vec3(0.02, 0.05, 0.02), Quat(1, 0, 0, 0), m),
     };
     return Scene({Vec3(-0.15, -0.10, -0.15), Vec3(0.15, 0.15, 0.15)}, std::move(objects));
+}
+
+std::string_view graspObjectName(GraspObject object) {
+    switch (object) {
+    case GraspObject::Box:
+        return "box";
+    case GraspObject::Sphere:
+        return "sphere";
+    case GraspObject::Mesh:
+        return "mesh";
+    }
+    return "box";
+}
+
+std::optional<GraspObject> parseGraspObject(std::string_view name) {
+    for (const GraspObject o : {GraspObject::Box, GraspObject::Sphere, GraspObject::Mesh}) {
+        if (name == graspObjectName(o)) {
+            return o;
+        }
+    }
+    return std::nullopt;
+}
+
+namespace {
+
+// A closed octagonal prism about the origin, `apothem` (m) from its axis (y) to each of its
+// eight side faces, one facing +x and one -x, and as tall as it is wide across them: 16
+// vertices, 28 triangles (two per side, a fan of six per cap), counter-clockwise outward.
+std::shared_ptr<const TriangleMesh> octagonalPrism(double apothem) {
+    const double pi = std::numbers::pi;
+    const double r = apothem / std::cos(pi / 8.0);
+    std::vector<Vec3> v;
+    for (const double y : {-apothem, apothem}) {
+        for (int i = 0; i < 8; ++i) {
+            const double a = (i + 0.5) * pi / 4.0;
+            v.emplace_back(r * std::cos(a), y, r * std::sin(a));
+        }
+    }
+    std::vector<TriangleIndices> t;
+    for (std::uint32_t i = 0; i < 8; ++i) {
+        const std::uint32_t j = (i + 1) % 8;
+        t.push_back({i, j, j + 8});
+        t.push_back({i, j + 8, i + 8});
+    }
+    for (std::uint32_t i = 1; i + 1 < 8; ++i) {
+        t.push_back({0, i, i + 1});
+        t.push_back({8, 8 + i, 8 + i + 1});
+    }
+    for (TriangleIndices& k : t) { // a convex solid about the origin: outward is away from it
+        const Vec3 n = glm::cross(v[k[1]] - v[k[0]], v[k[2]] - v[k[0]]);
+        if (glm::dot(n, v[k[0]] + v[k[1]] + v[k[2]]) < 0.0) {
+            std::swap(k[1], k[2]);
+        }
+    }
+    return TriangleMesh::make(std::move(v), std::move(t), {}, "the grasp demo's prism");
+}
+
+// The physical demo's object 0, 5 cm across, resting on the floor (y = -0.10 m) at x = -0.05:
+// 100 g (a 5 cm cube of density 800 kg/m^3, a softwood), rubbery, dynamic.
+SceneObject dynamicGraspObject(GraspObject shape, const Material& rubbery) {
+    const double floorY = -0.10;
+    const double half = 0.025;
+    SceneObject o;
+    if (shape == GraspObject::Box) {
+        o = makeBox(0, Vec3(-0.05, floorY + half, 0.0), Vec3(half), Quat(1, 0, 0, 0), rubbery);
+    } else if (shape == GraspObject::Sphere) {
+        o = makeSphere(0, Vec3(-0.05, floorY + half, 0.0), half, rubbery);
+    } else {
+        o = makeMesh(0, Vec3(-0.05, floorY + half, 0.0), octagonalPrism(half), Quat(1, 0, 0, 0),
+                     rubbery);
+    }
+    o.body.dynamic = true;
+    fillMassProperties(o, 0.1, std::nullopt, std::nullopt);
+    return o;
+}
+
+} // namespace
+
+Scene makeDynamicGraspScene(GraspObject shape) {
+    const Scene kinematic = makeGraspScene();
+    std::vector<SceneObject> objects(kinematic.objects().begin(), kinematic.objects().end());
+    objects[0] = dynamicGraspObject(shape, objects[0].material);
+    const Material m = generatedMaterial();
+    objects.push_back(makeBox(6, Vec3(0.0, -0.105, 0.0), Vec3(0.15, 0.005, 0.15), Quat(1, 0, 0, 0),
+                              m)); // the floor, top at y = -0.10
+    objects.push_back(makeBox(7, Vec3(0.05, -0.09, 0.0), Vec3(0.03, 0.01, 0.03), Quat(1, 0, 0, 0),
+                              m)); // the plinth, top at y = -0.08
+    Aabb bounds = kinematic.bounds();
+    bounds.min.y = -0.11;
+    Scene scene(bounds, std::move(objects));
+    scene.setPhysics(ScenePhysics{}); // g = 9.81 m/s^2 along -y, 1 kHz
+    return scene;
 }
 
 Scene makeDefaultScene() {

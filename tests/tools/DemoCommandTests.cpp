@@ -1,8 +1,9 @@
-// `hapto demo grasp` end to end on a mesh: two simulated hands lift, carry and put down a closed
-// mesh object read from a scene file (a cube from an OBJ file beside it), and the command says
-// the rebuilt index finds it at its new place. What the grasp does is checked on the step
-// mode's clock (--stepped: the same every run, however busy the machine); the wall-clock
-// session (about 9 s) is checked only for ending with every device at zero force.
+// `hapto demo grasp --kinematic` end to end on a mesh: two simulated hands lift, carry and put
+// down a closed, static mesh object read from a scene file (the kinematic GraspController; the
+// physical grasp, the default, is PhysicalGraspCommandTests.cpp) (a cube from an OBJ file beside
+// it), and the command says the rebuilt index finds it at its new place. What the grasp does is
+// checked on the step mode's clock (--stepped: the same every run, however busy the machine); the
+// wall-clock session (about 9 s) is checked only for ending with every device at zero force.
 
 #include "TestSupport.h"
 
@@ -54,7 +55,7 @@ std::string graspScene(const std::string& meshFields, double y = -0.075) {
 /// index found the object at its new place, and returns the JSON report.
 nlohmann::json runGraspDemo(const TempDir& dir) {
     const CommandResult r =
-        runHapto("demo grasp --stepped --scene " + (dir / "scene.json").string() +
+        runHapto("demo grasp --kinematic --stepped --scene " + (dir / "scene.json").string() +
                  " --object 0 --report " + (dir / "report.json").string());
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
@@ -88,7 +89,8 @@ nlohmann::json runGraspDemo(const TempDir& dir) {
 
 } // namespace
 
-TEST_CASE("hapto demo grasp --stepped --object on a closed mesh lifts, carries and puts it down, "
+TEST_CASE("hapto demo grasp --kinematic --stepped --object on a closed mesh lifts, carries and "
+          "puts it down, "
           "and the index finds it at its new place") {
     TempDir dir;
     writeFile(dir / "cube.obj", kCubeObj);
@@ -103,9 +105,9 @@ TEST_CASE("hapto demo grasp --stepped --object on a closed mesh lifts, carries a
     CHECK(report["mass_kg"].get<double>() > 0);
 }
 
-TEST_CASE(
-    "hapto demo grasp --stepped --object on a generated torus lying flat on the floor, 1.5 cm "
-    "from a ridge, lifts, carries and puts it down") {
+TEST_CASE("hapto demo grasp --kinematic --stepped --object on a generated torus lying flat on the "
+          "floor, 1.5 cm "
+          "from a ridge, lifts, carries and puts it down") {
     TempDir dir;
     // A 6 cm torus, axis along y (lying flat), 2016 triangles, written beside its own scene.
     const CommandResult made =
@@ -121,7 +123,8 @@ TEST_CASE(
           Approx(report["start_position"][1].get<double>()).margin(0.003));
 }
 
-TEST_CASE("hapto demo grasp --stepped: the same session gives the same report, path and forces") {
+TEST_CASE("hapto demo grasp --kinematic --stepped: the same session gives the same report, path "
+          "and forces") {
     TempDir dir;
     writeFile(dir / "cube.obj", kCubeObj);
     writeFile(dir / "scene.json", graspScene(R"("file": "cube.obj")"));

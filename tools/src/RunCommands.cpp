@@ -8,6 +8,7 @@
 #include "LiveView.h"
 #include "Options.h"
 #include "SessionChecks.h"
+#include "SessionRecorders.h"
 #include "StopSignals.h"
 
 #include "hapto/devices/DeviceConfig.h"
@@ -163,24 +164,6 @@ void prepareSession(const RunArgs& a, std::vector<DeviceConfig>& configs) {
     }
 }
 
-// The recorder of device `c` for --record `folder`: `<folder>/<name>.trace`, its header the
-// device's configuration and the wall-clock time now.
-std::unique_ptr<TraceRecorder> recorderFor(const DeviceConfig& c, const std::string& folder) {
-    TraceHeader header;
-    header.rateHz = c.rateHz;
-    header.kind = std::string(name(c.kind));
-    header.name = c.name;
-    header.transform = c.transform;
-    header.toolTipM = c.toolTipM;
-    header.maxForceN = c.maxForceN;
-    header.startUnixNs =
-        static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                       std::chrono::system_clock::now().time_since_epoch())
-                                       .count());
-    return std::make_unique<TraceRecorder>(std::filesystem::path(folder) / (c.name + ".trace"),
-                                           header);
-}
-
 // The devices: none with --no-devices, else the --devices file's or the two default hands.
 DeviceFile deviceFileFor(const RunArgs& a) {
     if (a.noDevices) {
@@ -205,13 +188,6 @@ void checkAgainstScene(const RunArgs& a, const Scene& scene,
     }
     checkBodyTraceFile({a.scene, a.devices, a.report, a.record}, configs);
 }
-
-// The session's recorders: each device's <folder>/<name>.trace, and <folder>/bodies.trace when
-// the runtime has dynamics.
-struct Recorders {
-    std::vector<std::unique_ptr<TraceRecorder>> devices;
-    std::unique_ptr<BodyTraceRecorder> bodies;
-};
 
 RuntimeOptions runtimeOptionsFor(const RunArgs& a) {
     RuntimeOptions opt;

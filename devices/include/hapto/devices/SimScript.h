@@ -14,8 +14,9 @@
 namespace hapto {
 
 /// What a scripted hand is doing. Grasp scripts go Approach, Reach, Squeeze, Lift, Carry,
-/// PutDown, Release, Done; touch goes Approach, Press, Hold; slide Approach, Press, Slide; free
-/// and walk are always Move.
+/// PutDown, Release, Done; a grasp of a dynamic body (BodyProperties::dynamic) goes on after
+/// Release with Reach, Squeeze, Lift (GraspTimes::kDropHeightM), Drop, Done; touch goes Approach,
+/// Press, Hold; slide Approach, Press, Slide; free and walk are always Move.
 enum class ScriptPhase : std::uint8_t {
     Move,     ///< free, walk: moving between waypoints.
     Approach, ///< Travelling to a stand-off point 2 cm off the chosen surface.
@@ -29,6 +30,7 @@ enum class ScriptPhase : std::uint8_t {
     PutDown,  ///< grasp: lowering it back by -lift.
     Release,  ///< grasp: backing off to the stand-off point.
     Done,     ///< grasp: released, holding still.
+    Drop,     ///< grasp of a dynamic body: opening the hands with it lifted, so it falls.
 };
 
 /// Lower-case name of a phase ("approach", "put-down", ...). [any thread]
@@ -62,7 +64,13 @@ struct GraspTimes {
     static constexpr double kLiftEnd = 5.5;     ///< Lifted.
     static constexpr double kCarryEnd = 7.0;    ///< Carried.
     static constexpr double kPutDownEnd = 8.0;  ///< Put down.
-    static constexpr double kReleaseEnd = 8.5;  ///< Backed off; Done from here on.
+    static constexpr double kReleaseEnd = 8.5;  ///< Backed off; Done from here on (static).
+    // A dynamic body, set down on what is under it, is then grasped again and dropped:
+    static constexpr double kRegraspEnd = 9.0;    ///< Touching its sides again.
+    static constexpr double kResqueezeEnd = 10.0; ///< Pressing again (0.5 s in, 0.5 s holding).
+    static constexpr double kDropLiftEnd = 10.75; ///< Lifted by kDropHeightM.
+    static constexpr double kDropEnd = 10.9;      ///< Hands opened to the stand-off; Done.
+    static constexpr double kDropHeightM = 0.04;  ///< The second lift, the drop's height (m).
 };
 
 /// A plan: keyframes, evaluated by time with a caller-held cursor, looping from `loopStart`

@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string_view>
 
 namespace hapto {
 
@@ -61,6 +63,26 @@ Scene makeClusterScene(const ClusterOptions& options);
 /// 5 cm cube (id 0, mu_s 0.6, mu_d 0.5) resting on the floor at x = -0.05 m, a low bar (id 1,
 /// 2 cm high) in the path of a 10 cm carry along +x, and four more objects around (ids 2-5).
 Scene makeGraspScene();
+
+/// The object the physical grasp demo picks up (makeDynamicGraspScene).
+enum class GraspObject {
+    Box,    ///< A 5 cm cube.
+    Sphere, ///< A 5 cm ball.
+    Mesh,   ///< A closed triangle mesh: an octagonal prism 5 cm across its flats and 5 cm tall
+            ///< (28 triangles), a flat side facing each hand.
+};
+/// "box", "sphere", "mesh". [any thread]
+std::string_view graspObjectName(GraspObject object);
+/// Parses a GraspObject name; nullopt for anything else. [any thread]
+std::optional<GraspObject> parseGraspObject(std::string_view name);
+
+/// The physical grasp demo's scene (format version 3, y up, gravity -9.81 m/s^2 along y,
+/// dynamics at 1 kHz): makeGraspScene's objects, its object 0 now `object`, dynamic, 100 g,
+/// rubbery (mu_s 0.6, mu_d 0.5, 800 N/m), resting on a static floor (id 6, top at y = -0.10 m),
+/// and a 2 cm plinth (id 7, 6 cm square, centred at x = 0.05 m) where the grasp's 10 cm carry
+/// sets it down. Objects 2-5 are static as before. Throws only on a failure to build the mesh
+/// (never for these fixed values). [control]
+Scene makeDynamicGraspScene(GraspObject object);
 
 /// The embedded default scene: the paper's experiment 2 set-up, 200 random 5 cm cubes in a
 /// 25 cm cube (seed 2004), with a 4 cm clear region around the centre where cursors start.
