@@ -5,6 +5,8 @@
 
 #include "hapto/runtime/DeviceFile.h"
 
+#include "hapto/runtime/BodyCoupling.h"
+
 #include "hapto/io/JsonInput.h"
 
 #include <algorithm>
@@ -136,11 +138,21 @@ std::vector<ForceEffect> parseEffects(const Source& w, const Json& j, const Path
 
 RendererSettings parseRenderer(const Source& w, const Json& j, const Path& path) {
     object(w, j, path);
-    checkKeys(w, j, path, {"damping_n_s_per_m"});
+    checkKeys(w, j, path, {"damping_n_s_per_m", "torsion_radius_m"});
     RendererSettings s;
-    s.contactDampingNsPerM =
-        ranged(w, required(w, j, path, "damping_n_s_per_m"), path / "damping_n_s_per_m", 0.0,
-               kMaxDampingNsPerM, false, "the contact damping (N·s/m)");
+    const Json* damping = optional(j, "damping_n_s_per_m");
+    const Json* torsion = optional(j, "torsion_radius_m");
+    if (damping == nullptr && torsion == nullptr) {
+        w.fail(path, "expected 'damping_n_s_per_m' or 'torsion_radius_m' (or both)");
+    }
+    if (damping != nullptr) {
+        s.contactDampingNsPerM = ranged(w, *damping, path / "damping_n_s_per_m", 0.0,
+                                        kMaxDampingNsPerM, false, "the contact damping (N·s/m)");
+    }
+    if (torsion != nullptr) {
+        s.torsionRadiusM = ranged(w, *torsion, path / "torsion_radius_m", 0.0, kMaxTorsionRadiusM,
+                                  false, "the torsional radius (m)");
+    }
     return s;
 }
 

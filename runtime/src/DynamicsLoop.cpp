@@ -103,15 +103,17 @@ void Runtime::publishBodies(DynamicsChannel& dc, std::uint64_t timeNs) noexcept 
 
 namespace {
 
-/// Takes every body's accumulated impulse into the Dynamics (a stopped body's, or every
-/// body's once frozen, is taken and dropped).
+/// Takes every body's accumulated impulse and torsional budget into the Dynamics (a stopped
+/// body's, or every body's once frozen, is taken and dropped).
 void takeImpulses(Dynamics& d, BodyPoseTable& poses, const DynamicsBodyRecord* records,
                   bool frozen) noexcept {
     for (std::size_t i = 0; i < d.bodyCount(); ++i) {
         Vec3 linear(0.0), angular(0.0);
         poses.takeImpulse(i, linear, angular);
+        const Mat3 torsion = poses.takeTorsion(i); // the hands' torsional friction budget
         if (!frozen && !records[i].stopped.load(std::memory_order_relaxed)) {
             d.applyImpulse(i, linear, angular);
+            d.applyHandTorsion(i, torsion); // after the impulses: it stops the spin they leave
         }
     }
 }

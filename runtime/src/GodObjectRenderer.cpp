@@ -80,7 +80,7 @@ namespace hapto {
 
 using namespace godobject;
 
-static_assert(sizeof(GodObjectRenderer) == 10176, "update the size in GodObjectRenderer.h");
+static_assert(sizeof(GodObjectRenderer) == 10240, "update the size in GodObjectRenderer.h");
 static_assert(alignof(GodObjectRenderer) == 64);
 
 namespace {

@@ -32,6 +32,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace hapto {
 
@@ -66,7 +68,7 @@ SegmentWalk firstUnlistedOnPaths(const Cursor& walker, const Algorithm& renderer
 template <ForceAlgorithm Algorithm>
 BasicHapticTick<Algorithm>::BasicHapticTick(const RendererConfig& renderer,
                                             const SafetyConfig& safety)
-    : mRenderer(renderer), mSafety(safety) {}
+    : mRenderer(renderer), mSafety(safety), mCoupling(renderer.torsionRadiusM) {}
 
 template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::stamp(std::size_t i) noexcept {
     if (mStamps != nullptr) {
@@ -272,6 +274,10 @@ constexpr double kMaxExtrapolationS = 0.05;
 constexpr double kPlaceMarginM = 1e-3;
 /// A Gram pivot below this leaves its plane without a normal share.
 constexpr double kPivotEps = 1e-12;
+/// A patch whose rim turns slower than this on the body (m/s) sticks: the torsional limit
+/// takes the static friction, else the dynamic one (DynamicsOptions::stickSpeedMPerS's value,
+/// the rule the dynamics' own friction patches use).
+constexpr double kStickSpeedMPerS = 1e-2;
 
 /// q turned by a constant angular velocity w (rad/s, world) over t seconds.
 Quat advance(const Quat& q, const Vec3& w, double t) noexcept {
@@ -370,6 +376,14 @@ void BasicHapticTick<Algorithm>::placeDynamic(const WorldSnapshot& snapshot, con
 
 template class BasicHapticTick<GodObjectRenderer>;
 
+BodyCoupling::BodyCoupling(double torsionRadiusM) : mTorsionRadiusM(torsionRadiusM) {
+    if (!(torsionRadiusM >= 0.0 && torsionRadiusM <= kMaxTorsionRadiusM)) {
+        throw std::invalid_argument("the torsional radius (m) must be in 0.." +
+                                    std::to_string(kMaxTorsionRadiusM) + " (got " +
+                                    std::to_string(torsionRadiusM) + ")");
+    }
+}
+
 bool BodyCoupling::place(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& proxy,
                          double reachM, double dtS) noexcept {
     mPlaced.clear();
@@ -431,7 +445,12 @@ void BodyCoupling::split(const Scene& scene, const RenderOutput& r, const Vec3& 
         if (e == nullptr) {
             continue;
         }
-        mShares[mShareCount++] = {e->body, share, r.proxy - e->centerOfMass};
+        const Vec3 n = r.contacts[i].normal;
+        const Material& m = scene.object(e->slot).material;
+        const double rim = std::abs(glm::dot(e->angularVelocity, n)) * mTorsionRadiusM;
+        const double mu = rim <= coupling::kStickSpeedMPerS ? m.staticFriction : m.dynamicFriction;
+        mShares[mShareCount++] = {e->body, share, r.proxy - e->centerOfMass, n,
+                                  mu * std::max(lambda[i], 0.0) * mTorsionRadiusM};
         reactionN += share;
     }
 }
@@ -442,12 +461,15 @@ bool BodyCoupling::handBack(double dtS) noexcept {
         const Share& s = mShares[i];
         const Vec3 impulse = -s.forceN * dtS;
         ok = mTable->addImpulse(s.body, impulse, glm::cross(s.armM, impulse)) && ok;
+        if (s.torsionNm > 0.0) {
+            ok = mTable->addTorsion(s.body, s.normal, s.torsionNm * dtS) && ok;
+        }
     }
     mShareCount = 0;
     return ok;
 }
 
-static_assert(sizeof(HapticTick) == 18944, "update the size in HapticTick.h");
+static_assert(sizeof(HapticTick) == 19136, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
 
 } // namespace hapto

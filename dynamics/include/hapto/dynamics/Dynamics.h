@@ -100,6 +100,16 @@ public:
     /// world) and angular about its centre of mass (N m s, world); what the hands hand back
     /// (BodyPoseTable::takeImpulse's sums). Never allocates.
     void applyImpulse(std::size_t i, const Vec3& linearNs, const Vec3& angularNms) noexcept;
+    /// The hands' torsional friction on body i for the next step (their soft-finger patches,
+    /// runtime/BodyCoupling.h): `budgetNms` = sum over the hands' sent ticks of
+    /// mu |Fn| r dt n n^T (N m s; symmetric, positive semidefinite; n a contact normal). Adds
+    /// to the next step's pending angular impulse the impulse that stops the body's spin (after
+    /// the impulses applyImpulse already gave it for that step) about each principal axis of
+    /// the budget, clamped to the budget about that axis: about one axis, or two opposed hands'
+    /// common one, this is Coulomb's torsional friction exactly. It only opposes the spin, so
+    /// it never adds kinetic energy. Call it after the step's applyImpulse. Never allocates.
+    /// (dynamics/src/DynamicsHands.cpp)
+    void applyHandTorsion(std::size_t i, const Mat3& budgetNms) noexcept;
     /// Wakes body i (and it stays awake for at least sleepAfterS).
     void wake(std::size_t i) noexcept;
     /// Candidates and contacts a step had no room for, since the start (0 unless a body

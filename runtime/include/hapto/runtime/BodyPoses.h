@@ -11,8 +11,11 @@
 /// and stores on x86-64. Impulses are summed in fixed point (int64, kImpulseQuantumNs per unit)
 /// by atomic fetch_add and taken by exchange with zero: every servo tick's contribution lands in
 /// exactly one dynamics step whatever the two rates, and integer sums do not depend on the order
-/// in which threads add (the step mode's runs are byte-identical). Nothing here allocates after
-/// construction, locks or throws.
+/// in which threads add (the step mode's runs are byte-identical). The hands' torsional
+/// friction budgets (BodyCoupling.h) are summed the same way, as the six components of a
+/// symmetric tensor sum budget n n^T, which does not depend on a normal's sign: two hands
+/// pressing from opposite sides add their budgets about their common axis. Nothing here
+/// allocates after construction, locks or throws.
 
 #include "hapto/core/Geometry.h"
 
@@ -120,6 +123,48 @@ public:
         }
     }
 
+    /// Adds a torsional-friction budget to body i: `budgetNms` (N m s, >= 0) about the unit
+    /// axis `axis` (world; either sign), summed as budgetNms axis axis^T, rounded to
+    /// kImpulseQuantumNs. Lock-free, any number of adders. Returns false (and adds nothing)
+    /// for a negative, non-finite or out-of-range budget or axis. [servo]
+    bool addTorsion(std::size_t i, const Vec3& axis, double budgetNms) noexcept {
+        if (!(budgetNms >= 0.0)) {
+            return false;
+        }
+        const std::array<double, 6> t{axis.x * axis.x, axis.y * axis.y, axis.z * axis.z,
+                                      axis.x * axis.y, axis.x * axis.z, axis.y * axis.z};
+        std::array<std::int64_t, 6> q{};
+        for (int k = 0; k < 6; ++k) {
+            if (!quantise(budgetNms * t[k], q[k])) {
+                return false;
+            }
+        }
+        Record& r = mRecords[i];
+        for (int k = 0; k < 6; ++k) {
+            r.torsion[k].fetch_add(q[k], std::memory_order_relaxed);
+        }
+        return true;
+    }
+
+    /// Takes body i's accumulated torsional budget (what addTorsion summed since the last
+    /// take: a symmetric tensor, N m s) and resets it to zero. [dynamics]
+    Mat3 takeTorsion(std::size_t i) noexcept {
+        Record& r = mRecords[i];
+        std::array<double, 6> t{};
+        for (int k = 0; k < 6; ++k) {
+            t[k] = static_cast<double>(r.torsion[k].exchange(0, std::memory_order_relaxed)) *
+                   kImpulseQuantumNs;
+        }
+        Mat3 m(0.0);
+        m[0][0] = t[0];
+        m[1][1] = t[1];
+        m[2][2] = t[2];
+        m[0][1] = m[1][0] = t[3];
+        m[0][2] = m[2][0] = t[4];
+        m[1][2] = m[2][1] = t[5];
+        return m;
+    }
+
 private:
     static constexpr std::size_t kFields = 16;
     struct alignas(64) Record {
@@ -129,6 +174,8 @@ private:
         std::atomic<std::uint64_t> step{0};
         std::atomic<bool> sleeping{false};
         std::array<std::atomic<std::int64_t>, 6> impulse{};
+        /// The torsional budget's xx, yy, zz, xy, xz, yz (quanta).
+        std::array<std::atomic<std::int64_t>, 6> torsion{};
     };
 
     static std::array<double, kFields> pack(const BodyPose& p) noexcept {

@@ -19,7 +19,7 @@ namespace hapto {
 /// Ruspini et al. 1997) and Coulomb friction. One instance per device: it holds that device's
 /// proxy and scratch space, shares nothing, and never allocates after construction.
 ///
-/// Size: 10176 bytes (64-byte aligned; checked by a static_assert in the source file), of which
+/// Size: 10240 bytes (64-byte aligned; checked by a static_assert in the source file), of which
 /// 1280 are the near-object scratch list, 6912 the tick's copy of its first 32 candidate
 /// triangles (plane, corners, edges: 216 bytes each) and 1608 the points the proxy visited
 /// (visitedPath). A tick solved again restores only the 296-byte State.

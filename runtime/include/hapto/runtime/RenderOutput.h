@@ -19,6 +19,11 @@ struct RendererConfig {
     /// Proxy solver passes per tick (each pass: one small plane solve + one swept test over the
     /// nearby objects), 1..GodObjectRenderer::kMaxIterations (32).
     std::uint32_t maxIterations = 10;
+    /// The hand's contact patch for the dynamic bodies it touches: its effective torsional
+    /// radius r (m, 0..kMaxTorsionRadiusM; 0: a point contact), so the hand resists a body's
+    /// spin about the contact normal up to mu |Fn| r (BodyCoupling.h). 3 mm by default: a few
+    /// millimetres, a choice (a fingertip-sized patch), not a measured fact.
+    double torsionRadiusM = 0.003;
 };
 
 /// What happened in a tick besides the force.

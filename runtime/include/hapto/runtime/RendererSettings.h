@@ -14,6 +14,10 @@ struct RendererSettings {
     /// The renderer's contact damping b (N·s/m), 0..kMaxDampingNsPerM; none = the runtime's
     /// RuntimeOptions::renderer.damping.
     std::optional<double> contactDampingNsPerM;
+    /// The hand's effective torsional radius (m), 0..kMaxTorsionRadiusM (BodyCoupling.h: the
+    /// soft-finger patch on dynamic bodies; 0 turns it off); none = the runtime's
+    /// RuntimeOptions::renderer.torsionRadiusM.
+    std::optional<double> torsionRadiusM;
 };
 
 /// `runtime` (the settings every device gets) with one device's own `settings` applied.
@@ -23,6 +27,9 @@ inline RendererConfig withDeviceSettings(const RendererConfig& runtime,
     RendererConfig c = runtime;
     if (settings.contactDampingNsPerM) {
         c.damping = *settings.contactDampingNsPerM;
+    }
+    if (settings.torsionRadiusM) {
+        c.torsionRadiusM = *settings.torsionRadiusM;
     }
     return c;
 }
