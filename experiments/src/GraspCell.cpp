@@ -26,6 +26,7 @@ namespace {
 constexpr ObjectId kFloorId = 1;
 constexpr ObjectId kBoxId = 2;
 constexpr double kHandStartGapM = 0.05; // each hand starts this far outside the box's side (m)
+constexpr double kSlipOnsetM = 0.001;   // slip onset: issue 37's 1 mm bound for a held body
 
 std::uint64_t threadCpuNs() noexcept {
     timespec t{};
@@ -167,6 +168,9 @@ void drive(GraspRig& rig, const GraspCellSpec& spec, Probes& probes, GraspCellRe
             if (const std::optional<double> squeeze = sample(rt, probes.slip)) {
                 result.squeezeFeltN = *squeeze;
             }
+            if (result.slipOnsetS < 0.0 && probes.slip.maxSlipM() > kSlipOnsetM) {
+                result.slipOnsetS = static_cast<double>(t - t0) * 1e-9;
+            }
         }
         if (t >= lifted) {
             (void)sample(rt, probes.force);
@@ -255,9 +259,9 @@ bool sameGraspFigures(const GraspCellResult& a, const GraspCellResult& b) {
            x.samples == y.samples && x.nonFinite == y.nonFinite && x.held == y.held &&
            a.deepestPenetrationM == b.deepestPenetrationM &&
            a.largestEnergyGainJ == b.largestEnergyGainJ && a.liftM == b.liftM &&
-           a.squeezeFeltN == b.squeezeFeltN && a.dynamicsSteps == b.dynamicsSteps &&
-           a.stable == b.stable && a.zeroedForMisses == b.zeroedForMisses &&
-           a.stepCpuNs.size() == b.stepCpuNs.size();
+           a.squeezeFeltN == b.squeezeFeltN && a.slipOnsetS == b.slipOnsetS &&
+           a.dynamicsSteps == b.dynamicsSteps && a.stable == b.stable &&
+           a.zeroedForMisses == b.zeroedForMisses && a.stepCpuNs.size() == b.stepCpuNs.size();
 }
 
 } // namespace hapto::experiments

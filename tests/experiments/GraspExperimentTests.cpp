@@ -88,6 +88,7 @@ TEST_CASE("slip that comes back is reported as its largest and its final value")
     probe.add(sampleAt(Vec3(0.0, -0.001, 0.0), Vec3(0.0)));   // 1 mm off
     const GraspFigures f = probe.figures();
     CHECK(f.maxSlipM == Approx(0.005));
+    CHECK(probe.maxSlipM() == f.maxSlipM);
     CHECK(f.finalSlipM == Approx(0.001));
     CHECK(f.held); // 1 mm <= the 10 mm drop slip
     GraspProbeSettings tight = settings();
@@ -162,6 +163,7 @@ TEST_CASE("grasp cell: a squeeze above m g / (2 mu_s) lifts the box, one below l
     // friction spring's stretch, m g / (2 k) (0.245 mm here), and the hands press as told.
     CHECK(held.grasp.finalSlipM == Approx(graspElasticSlipM(firm)).epsilon(0.1));
     CHECK(held.squeezeFeltN == Approx(firm.squeezeN).epsilon(0.1));
+    CHECK(held.slipOnsetS == -1.0); // never 1 mm
 
     GraspCellSpec light = firm;
     light.squeezeN = 0.25; // margin 0.61
@@ -170,6 +172,9 @@ TEST_CASE("grasp cell: a squeeze above m g / (2 mu_s) lifts the box, one below l
     INFO("light: max slip " << slipped.grasp.maxSlipM << " m, lift " << slipped.liftM << " m");
     CHECK(!slipped.grasp.held);
     CHECK(slipped.liftM < 0.025);
+    // It is left behind as the hands start to lift (the lift runs 4.5-5.5 s).
+    CHECK(slipped.slipOnsetS > 4.5);
+    CHECK(slipped.slipOnsetS < 5.5);
 }
 
 TEST_CASE("grasp cell: two runs of one spec measure the same figures, bit for bit") {

@@ -71,6 +71,9 @@ struct GraspCellResult {
     /// The squeeze the hands exert at the window's start (kSqueezeEnd): the mean of the two sent
     /// forces' components along the grasp axis, into the box (N).
     double squeezeFeltN = 0.0;
+    /// When the slip first passed 1 mm (issue 37's bound for a held body), in session time
+    /// (s; the lift starts at GraspTimes::kSqueezeEnd, 4.5 s); -1 when it never did.
+    double slipOnsetS = -1.0;
     std::uint64_t dynamicsSteps = 0;   ///< Dynamics steps run.
     bool stable = false;               ///< The run report's verdict (devices and dynamics).
     std::uint64_t zeroedForMisses = 0; ///< Both hands' ticks zeroed for misses (0 stepped).

@@ -77,6 +77,9 @@ public:
     double slipM(const GraspSample& sample) const;
     /// |-(F_A + F_B) . up - m g| / (m g) of `sample` (unitless). [control]
     double forceError(const GraspSample& sample) const;
+    /// The largest slip so far (m), without the figures' median: cheap enough per step.
+    /// [control]
+    double maxSlipM() const { return mMaxSlipM; }
     /// The window's figures so far. [control]
     GraspFigures figures() const;
 
