@@ -115,8 +115,11 @@ def experiment_scaling(out=None, **options):
     Writes its files into `out` (None: a temporary folder, removed after) and returns its
     tables as dicts of numpy arrays: "devices" (a row per rate and device count),
     "per_device" (a row per device of each cell) and "cursor". Options are the command's, in
-    snake case: max_devices, rates_hz, scene, index, script, cursor_objects, walk_steps,
-    cursor, quick, duration_s, repeats, realtime. It runs real servo threads on the wall clock.
+    snake case: max_devices, counts (device counts, e.g. range(1, 9); default 1, 2, 4, ... up
+    to max_devices), rates_hz, scene, index, script, cursor_objects, walk_steps, cursor, quick,
+    duration_s, repeats (default 5), realtime. Each cell of "devices" holds the median over the
+    repeats and its order-statistic interval (the *_lo_pct and *_hi_pct columns, and
+    interval_coverage). It runs real servo threads on the wall clock.
     """
     with _tempfile.TemporaryDirectory(prefix="hapto-experiment-") as tmp:
         folder = _os.fspath(out) if out is not None else tmp

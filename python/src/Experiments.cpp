@@ -25,10 +25,12 @@ experiments::CommonArgs common(const std::string& out, bool quick, double durati
 int runDevices(const std::string& out, int maxDevices, const std::vector<double>& ratesHz,
                const std::string& scene, const std::string& index, const std::string& script,
                const std::vector<std::size_t>& cursorObjects, std::size_t walkSteps, bool cursor,
-               bool quick, double durationS, int repeats, bool realtime) {
+               bool quick, double durationS, int repeats, bool realtime,
+               const std::vector<int>& counts) {
     experiments::DevicesArgs a;
     a.common = common(out, quick, durationS, repeats, realtime);
     a.maxDevices = maxDevices;
+    a.deviceCounts = counts;
     a.ratesHz = ratesHz;
     a.scene = scene;
     a.index = index.empty() ? a.index : index;
@@ -50,6 +52,7 @@ void bindExperiments(py::module_& m) {
           py::arg("walk_steps") = d.walkSteps, py::arg("cursor") = d.cursor,
           py::arg("quick") = false, py::arg("duration_s") = d.common.durationS,
           py::arg("repeats") = d.common.repeats, py::arg("realtime") = d.common.realtime,
+          py::arg("counts") = d.deviceCounts,
           "hapto experiment scaling into the folder `out`; returns its exit code");
 }
 

@@ -204,3 +204,10 @@ def test_experiment_scaling_returns_its_tables_as_columns(tmp_path):
     per_device = tables["per_device"]
     assert len(next(iter(per_device.values()))) == 3  # 1 + 2 devices
     assert tables["cursor"] == {}
+    counted = hapto.experiment_scaling(tmp_path / "counts", counts=[1, 3], rates_hz=[1000.0],
+                                       duration_s=0.05, repeats=3, cursor=False, realtime=False)
+    cells = counted["devices"]
+    assert list(cells["devices"]) == [1, 3]
+    for name in ("load_sum", "median_device_p999", "worst_load_p999"):
+        assert all(cells[name + "_lo_pct"] <= cells[name + "_pct"])
+        assert all(cells[name + "_pct"] <= cells[name + "_hi_pct"])
