@@ -235,9 +235,16 @@ std::string body(const PlotSpec& spec, const std::vector<std::vector<std::string
             }
             s << ")\n";
             if (!p.logX) {
-                // Half a step of room either side, so the outer points and their bars show whole.
-                const auto [lo, hi] = std::minmax_element(p.xTics.begin(), p.xTics.end());
-                const double pad = *hi > *lo ? 0.05 * (*hi - *lo) : 0.5;
+                // Half the smallest step of room either side: the outer points and bars show whole.
+                std::vector<double> x(p.xTics);
+                std::sort(x.begin(), x.end());
+                double gap = x.size() > 1 ? x.back() - x.front() : 1.0;
+                for (std::size_t k = 1; k < x.size(); ++k) {
+                    gap = x[k] > x[k - 1] ? std::min(gap, x[k] - x[k - 1]) : gap;
+                }
+                const double* lo = &x.front();
+                const double* hi = &x.back();
+                const double pad = 0.5 * gap; // categories (devices) sit half a step in
                 s << "set xrange [" << number(*lo - pad) << ":" << number(*hi + pad) << "]\n";
             } else {
                 const auto [lo, hi] = std::minmax_element(p.xTics.begin(), p.xTics.end());
