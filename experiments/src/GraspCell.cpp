@@ -6,6 +6,7 @@
 #include "hapto/devices/SimDevice.h"
 #include "hapto/devices/SimScript.h"
 #include "hapto/experiments/ExperimentSupport.h"
+#include "hapto/experiments/Table.h"
 #include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/ManualClock.h"
 #include "hapto/runtime/Runtime.h"
@@ -181,7 +182,7 @@ void drive(GraspRig& rig, const GraspCellSpec& spec, Probes& probes, GraspCellRe
 void checkPositive(double v, const char* what) {
     if (!std::isfinite(v) || !(v > 0.0)) {
         throw std::invalid_argument(std::string("grasp cell: ") + what +
-                                    " must be finite and > 0, got " + std::to_string(v));
+                                    " must be finite and > 0, got " + csvNumber(v));
     }
 }
 
@@ -190,7 +191,7 @@ void checkPositive(double v, const char* what) {
 void checkGraspCellSpec(const GraspCellSpec& spec) {
     if (!std::isfinite(spec.squeezeN) || spec.squeezeN < 0.0) {
         throw std::invalid_argument("grasp cell: squeeze_n must be finite and >= 0, got " +
-                                    std::to_string(spec.squeezeN));
+                                    csvNumber(spec.squeezeN));
     }
     checkPositive(spec.massKg, "mass_kg");
     checkPositive(spec.stiffnessNPerM, "stiffness_n_per_m");
@@ -206,8 +207,7 @@ void checkGraspCellSpec(const GraspCellSpec& spec) {
             throw std::invalid_argument(
                 "grasp cell: the servo and dynamics periods must be whole nanoseconds and "
                 "multiples of the shorter (e.g. 500, 1000, 2000, 4000, 8000 Hz), got " +
-                std::to_string(spec.servoRateHz) + " and " + std::to_string(spec.dynamicsRateHz) +
-                " Hz");
+                csvNumber(spec.servoRateHz) + " and " + csvNumber(spec.dynamicsRateHz) + " Hz");
         }
     }
 }

@@ -23,6 +23,7 @@ namespace {
 /// A factor swept: its name, its axis label, the cell's field it sets, the list it takes.
 struct Factor {
     const char* name;
+    const char* option; // the command's option for its list
     const char* axis;
     double GraspCellSpec::*field;
     std::vector<double> GraspArgs::*values;
@@ -30,11 +31,12 @@ struct Factor {
 
 /// The factors swept, in table order.
 constexpr Factor kFactors[] = {
-    {"squeeze", "squeeze force, each hand (N)", &GraspCellSpec::squeezeN, &GraspArgs::squeezesN},
-    {"mass", "mass (kg)", &GraspCellSpec::massKg, &GraspArgs::massesKg},
-    {"stiffness", "surface stiffness (N/m)", &GraspCellSpec::stiffnessNPerM,
+    {"squeeze", "--squeezes", "squeeze force, each hand (N)", &GraspCellSpec::squeezeN,
+     &GraspArgs::squeezesN},
+    {"mass", "--masses", "mass (kg)", &GraspCellSpec::massKg, &GraspArgs::massesKg},
+    {"stiffness", "--stiffnesses", "surface stiffness (N/m)", &GraspCellSpec::stiffnessNPerM,
      &GraspArgs::stiffnessesNPerM},
-    {"servo rate", "servo rate (Hz)", &GraspCellSpec::servoRateHz, &GraspArgs::ratesHz},
+    {"servo rate", "--rates", "servo rate (Hz)", &GraspCellSpec::servoRateHz, &GraspArgs::ratesHz},
 };
 
 bool sameCell(const GraspCellSpec& a, const GraspCellSpec& b) {
@@ -68,7 +70,7 @@ std::vector<RowRef> planCells(const GraspArgs& a, std::vector<CellRun>& cells) {
             try {
                 checkGraspCellSpec(spec);
             } catch (const std::invalid_argument& e) {
-                throw InputError("experiment grasp: " + std::string(f.name) + " " + fmt(v, 6) +
+                throw InputError("experiment grasp: " + std::string(f.option) + " " + csvNumber(v) +
                                  ": " + e.what());
             }
             std::size_t k = 0;

@@ -237,6 +237,6 @@ TEST_CASE("grasp experiment: a list value no cell can run is refused naming its 
     GraspArgs args = quickGraspArgs(GraspArgs{});
     args.common.out = (std::filesystem::temp_directory_path() / "hapto-grasp-refused").string();
     args.ratesHz = {3000.0};
-    CHECK_THROWS_WITH(runGrasp(args), Catch::Contains("servo rate 3000"));
+    CHECK_THROWS_WITH(runGrasp(args), Catch::Contains("--rates 3000: "));
     CHECK(!std::filesystem::exists(args.common.out)); // refused before any output
 }
