@@ -160,3 +160,24 @@ TEST_CASE("hapto demo grasp refuses what cannot work, with exit code 2 and the o
         CHECK(r.output.find(c.says) != std::string::npos);
     }
 }
+
+TEST_CASE("hapto demo grasp --stepped with hands squeezing 0.3 N each (mu_s (F1 + F2) = 0.37 m g) "
+          "does not lift the box: not held, and it stays on the floor") {
+    TempDir dir;
+    const auto hand = [](const char* name, const char* script, double x, int seed) {
+        return std::string(R"({"name": ")") + name +
+               R"(", "kind": "sim", "transform": {"translation": [)" + std::to_string(x) +
+               R"(, -0.04, 0]}, "sim": {"script": ")" + script + R"(", "seed": )" +
+               std::to_string(seed) + R"(, "object": 0, "press_n": 0.3}})";
+    };
+    writeFile(dir / "light.json", R"({"format": "hapto-devices", "version": 1, "devices": [)" +
+                                      hand("left", "grasp-left", -0.12, 1) + ", " +
+                                      hand("right", "grasp-right", 0.04, 2) + "]}");
+    const nlohmann::json r = runPhysical(dir, "--devices " + (dir / "light.json").string());
+    INFO(r.dump(1));
+    CHECK(r["held"] == false);
+    CHECK(r["lift_mm"].get<double>() < 1.0);
+    CHECK(r["slip_max_mm"].get<double>() > 40.0); // the hands rose 5 cm past it
+    CHECK(r["rest"]["support_id"] == 6);          // the floor
+    CHECK(r["at_rest"] == true);
+}

@@ -27,6 +27,7 @@
 #include "hapto/devices/DeviceFactory.h"
 #include "hapto/devices/ReplayDevice.h"
 #include "hapto/devices/SimDevice.h"
+#include "hapto/experiments/GraspProbe.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/index/IndexSpec.h"
 #include "hapto/io/InputError.h"
@@ -288,9 +289,7 @@ struct PhysicalGrasp {
     double gravity = 9.81; // |g| (m/s^2)
     Placement start, setDown, dropFrom, rest;
     // Held (squeeze end to carry end): slip of the centre of mass against the hands' midpoint.
-    bool begun = false;
-    Vec3 offset0{0.0};
-    double maxSlipM = 0.0;
+    experiments::GraspProbe probe{experiments::GraspProbeSettings{}};
     double liftM = 0.0; // highest rise of the centre of mass over its start while held
     // The carry (no vertical acceleration): the hands' vertical support against m g.
     Felt felt[2];
@@ -303,7 +302,9 @@ struct PhysicalGrasp {
 
     void observe(double t, const Scene& scene, const Runtime& runtime);
     bool atRest() const { return restSpeed < 1e-3 && restSpinRadPerS < 0.05; }
-    bool held() const { return begun && maxSlipM <= 0.010 && liftM > 0.9 * 0.05; }
+    // Held: the probe's verdict (final slip <= 10 mm) and lifted with the hands (90 % of 5 cm).
+    bool held() const { return probe.figures().held && liftM > 0.9 * 0.05; }
+    double maxSlipM() const { return probe.maxSlipM(); }
 };
 
 void PhysicalGrasp::observe(double t, const Scene& scene, const Runtime& runtime) {
@@ -312,12 +313,13 @@ void PhysicalGrasp::observe(double t, const Scene& scene, const Runtime& runtime
     ContactReport c[2];
     const bool hands = runtime.lastTick(0, c[0]) && runtime.lastTick(1, c[1]);
     if (hands && t >= G::kSqueezeEnd && t <= G::kCarryEnd) {
-        const Vec3 offset = pose.centerOfMass - 0.5 * (c[0].devicePoint + c[1].devicePoint);
-        if (!begun) {
-            begun = true;
-            offset0 = offset;
+        if (const auto sample = experiments::graspSampleOf(runtime, body, 0, 1)) {
+            if (!probe.begun()) {
+                probe.begin(*sample);
+            } else {
+                probe.add(*sample);
+            }
         }
-        maxSlipM = std::max(maxSlipM, glm::length(offset - offset0));
         liftM = std::max(liftM, pose.centerOfMass.y - start.centerOfMass.y);
     }
     if (hands && t >= G::kLiftEnd + 0.2 && t <= G::kCarryEnd) {
@@ -373,7 +375,7 @@ void reportPhysical(const DemoArgs& a, const Runtime& runtime, const PhysicalGra
     const double n = static_cast<double>(std::max<std::uint64_t>(1, g.carrySamples));
     const double support = g.supportSumN / n;
     std::printf("held: %s; lifted %.1f mm; slip against the hands while held: %.2f mm at most\n",
-                g.held() ? "yes" : "no", 1000.0 * g.liftM, 1000.0 * g.maxSlipM);
+                g.held() ? "yes" : "no", 1000.0 * g.liftM, 1000.0 * g.maxSlipM());
     std::printf("carrying: the hands hold up %.3f N (mean; worst step off by %.3f N), its weight "
                 "m g = %.3f N (%.1f g)\n",
                 support, g.supportWorstN, weight, 1000.0 * g.massKg);
@@ -404,7 +406,7 @@ void reportPhysical(const DemoArgs& a, const Runtime& runtime, const PhysicalGra
                                 {"weight_n", weight},
                                 {"held", g.held()},
                                 {"lift_mm", 1000.0 * g.liftM},
-                                {"slip_max_mm", 1000.0 * g.maxSlipM},
+                                {"slip_max_mm", 1000.0 * g.maxSlipM()},
                                 {"carry_support_mean_n", support},
                                 {"carry_support_worst_error_n", g.supportWorstN},
                                 {"start", placementJson(g.start)},
@@ -518,6 +520,11 @@ PhysicalGrasp physicalGrasp(const Scene& scene, const Runtime& runtime, ObjectId
     g.body = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), object) - ids.begin());
     g.massKg = scene.object(g.slot).body.massKg;
     g.gravity = glm::length(scene.physics().gravity);
+    experiments::GraspProbeSettings settings;
+    settings.massKg = g.massKg;
+    settings.gravityMPerS2 = g.gravity;
+    settings.up = -scene.physics().gravity / g.gravity;
+    g.probe = experiments::GraspProbe(settings);
     g.start = placementOf(scene, g.slot, runtime.bodyPoses()->read(g.body));
     return g;
 }
