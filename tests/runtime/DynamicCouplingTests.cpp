@@ -132,6 +132,22 @@ struct Hand {
     ServoStep step;
     Hand(Vec3 at, const SafetyConfig& safety, const RendererConfig& renderer = {})
         : device(at), step(renderer, safety) {}
+    /// A hand at `at` whose servo step is started on `world`'s clock, every `periodNs`, with
+    /// the bodies of `table`.
+    static std::unique_ptr<Hand> started(Vec3 at, const SafetyConfig& safety,
+                                         const RendererConfig& renderer, World& world,
+                                         ManualClock& clock, BodyPoseTable& table,
+                                         std::uint64_t periodNs) {
+        auto hand = std::make_unique<Hand>(at, safety, renderer);
+        ServoStep& s = hand->step;
+        s.setTiming(periodNs, 3, 0.5, 100'000'000);
+        s.device = &hand->device;
+        s.reader = world.registerReader();
+        s.ports = hand->shared.portsFor(world, &clock);
+        s.ports.bodies = &table;
+        s.start(clock.nowNs());
+        return hand;
+    }
 };
 
 /// The scene, its world and dynamics, the pose table and the hands, on one manual clock.
@@ -154,15 +170,8 @@ struct CouplingRig {
         world.useClock(clock);
         publish();
         for (const Vec3& at : handPoints) {
-            auto hand = std::make_unique<Hand>(at, safety);
-            ServoStep& s = hand->step;
-            s.setTiming(kPeriodNs, 3, 0.5, 100'000'000);
-            s.device = &hand->device;
-            s.reader = world.registerReader();
-            s.ports = hand->shared.portsFor(world, &clock);
-            s.ports.bodies = &table;
-            s.start(clock.nowNs());
-            hands.push_back(std::move(hand));
+            hands.push_back(
+                Hand::started(at, safety, RendererConfig{}, world, clock, table, kPeriodNs));
         }
     }
 
@@ -259,15 +268,8 @@ struct RealRig {
         world.useClock(clock);
         publish();
         for (const Vec3& at : startPoints) {
-            auto hand = std::make_unique<Hand>(at, CouplingRig::unlimitedSafety(), renderer);
-            ServoStep& s = hand->step;
-            s.setTiming(kPeriodNs, 3, 0.5, 100'000'000);
-            s.device = &hand->device;
-            s.reader = world.registerReader();
-            s.ports = hand->shared.portsFor(world, &clock);
-            s.ports.bodies = &table;
-            s.start(clock.nowNs());
-            hands.push_back(std::move(hand));
+            hands.push_back(Hand::started(at, CouplingRig::unlimitedSafety(), renderer, world,
+                                          clock, table, kPeriodNs));
         }
         advance();
         for (std::size_t h = 0; h < hands.size(); ++h) {
