@@ -753,3 +753,23 @@ TEST_CASE("a device file's renderer.torsion_radius_m sets the hand's patch, and 
     CHECK_THROWS_AS(BodyCoupling(0.06), std::invalid_argument);
     CHECK_THROWS_AS(BodyCoupling(std::nan("")), std::invalid_argument);
 }
+
+TEST_CASE("the pose table sums torsional budgets sign-free and exactly, and refuses bad ones") {
+    BodyPoseTable table(2);
+    const Vec3 n = glm::normalize(Vec3(1.0, 2.0, -2.0));
+    REQUIRE(table.addTorsion(1, n, 3e-6));
+    REQUIRE(table.addTorsion(1, -n, 1e-6)); // the opposed hand: the same axis, budgets add
+    CHECK_FALSE(table.addTorsion(1, n, -1e-6));
+    CHECK_FALSE(table.addTorsion(1, n, std::nan("")));
+    CHECK_FALSE(table.addTorsion(1, Vec3(std::numeric_limits<double>::infinity(), 0, 0), 1e-6));
+    CHECK(table.takeTorsion(0) == Mat3(0.0));
+    const Mat3 b = table.takeTorsion(1);
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+            INFO("row " << r << ", column " << c);
+            CHECK(b[c][r] == b[r][c]);
+            CHECK(std::abs(b[c][r] - 4e-6 * n[r] * n[c]) <= BodyPoseTable::kImpulseQuantumNs);
+        }
+    }
+    CHECK(table.takeTorsion(1) == Mat3(0.0)); // taken once
+}
