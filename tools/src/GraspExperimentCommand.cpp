@@ -93,8 +93,7 @@ void addGraspExperimentCommand(CLI::App* exp) {
         "servo rate");
     addGraspOptions(cmd, *a, *o);
     setExamples(cmd, {"hapto experiment grasp --quick",
-                      "hapto experiment grasp --squeezes 0.3,0.4,0.5 --masses 0.05 "
-                      "--stiffnesses 1000 --rates 1000 --repeats 9"});
+                      "hapto experiment grasp --squeezes 0.4:0.5:0.02 --masses 0.05 --repeats 9"});
     cmd->callback([a, o] {
         a->squeezesN = listOf(o->squeezes, "--squeezes", 0.0, 20.0);
         a->massesKg = listOf(o->masses, "--masses", 0.001, 10.0);
