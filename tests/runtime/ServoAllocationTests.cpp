@@ -325,6 +325,60 @@ TEST_CASE("the renderer makes no heap allocation with mesh candidates: triangle 
     CHECK(r.counters().ticks == 600);
 }
 
+TEST_CASE("servo ticks in contact with a dynamic body, torsional patches on, make no heap "
+          "allocation (step mode, the runtime's dynamics step between them)") {
+    // A 100 g box on a static floor under gravity; two simulated hands touch it from above
+    // (press 1.5 N each) with 5 mm torsional patches: every tick places the body, splits the
+    // reaction and hands back impulses and torsional budgets, and the runtime's dynamics step
+    // takes both between the ticks.
+    Material m;
+    m.stiffness = 1000.0;
+    m.staticFriction = 0.6;
+    m.dynamicFriction = 0.4;
+    SceneObject box = makeBox(1, Vec3(0.0, 0.02, 0.0), Vec3(0.02), Quat(1, 0, 0, 0), m);
+    box.body.dynamic = true;
+    box.body.massKg = 0.1;
+    Scene scene(
+        Aabb{Vec3(-0.2), Vec3(0.2)},
+        {box, makeBox(2, Vec3(0.0, -0.01, 0.0), Vec3(0.1, 0.01, 0.1), Quat(1, 0, 0, 0), m)});
+    ManualClock clock;
+    World world(scene, IndexSpec::parse("brute"));
+    world.useClock(clock);
+    std::vector<RuntimeDevice> devices;
+    for (int h = 0; h < 2; ++h) {
+        DeviceConfig c = defaultDeviceConfigs()[static_cast<std::size_t>(h)];
+        c.rateHz = 1000;
+        SimConfig sim;
+        sim.script = HandScript::Touch;
+        sim.object = 1;
+        sim.start = Vec3(h == 0 ? 0.01 : -0.01, 0.06, 0.005);
+        c.params = sim;
+        DeviceRendering rendering;
+        rendering.renderer.torsionRadiusM = 0.005;
+        devices.push_back({makeDevice(c, scene), c, nullptr, rendering});
+    }
+    RuntimeOptions opt;
+    opt.realtime = false;
+    Runtime runtime(world, std::move(devices), opt);
+    REQUIRE(runtime.bodyPoses() != nullptr);
+    const std::uint64_t servoBefore = gServoAllocations.load();
+    const std::uint64_t t0 = clock.nowNs();
+    REQUIRE(runtime.startStepped(clock) == 2);
+    for (int i = 1; i <= 2000; ++i) {
+        runtime.runUntil(t0 + static_cast<std::uint64_t>(i) * 1'000'000);
+        runtime.maintain();
+    }
+    runtime.stop();
+    const RunReport r = runtime.report();
+    INFO("body at " << runtime.bodyPoses()->read(0).center.y << " m");
+    for (const DeviceReport& d : r.devices) {
+        INFO(d.name << ": " << d.contactTicks << " contact ticks of " << d.ticks);
+        CHECK(d.fault.empty());
+        CHECK(d.contactTicks > 100); // the hands pressed on the body
+    }
+    CHECK(gServoAllocations.load() == servoBefore);
+}
+
 TEST_CASE("servo threads make no heap allocation while a viewer follows the live view",
           "[realtime]") {
     const Scene scene = makeDefaultScene();
