@@ -97,7 +97,8 @@ int runMeshes(const MeshesArgs& args) {
     std::string md =
         "## Load against triangle count: one " + std::string(meshShapeName(args.shape)) + " of " +
         fmt(args.sizeM, 3) + " m\n\n" +
-        sweepSmokeHeader(args.common, args.verdict, steps.empty() ? 0 : steps.back().objects) +
+        sweepSmokeHeader(args.common, args.verdict, steps.empty() ? 0 : steps.back().objects,
+                         "where each renderer stops being stable") +
         loadNote(args.common, options.servo.tail, ": p50 / p99.9 / max,", "") +
         " A renderer stops growing after its first unstable size, and a cell whose "
         "probed tick takes more than 10 periods is skipped: that is what caps brute "

@@ -210,7 +210,8 @@ std::string smokeTestHeader(const CommonArgs& common, const std::string& cannotJ
            ". Run without --quick for results.\n\n";
 }
 
-std::string sweepSmokeHeader(const CommonArgs& common, Verdict verdict, std::size_t largest) {
+std::string sweepSmokeHeader(const CommonArgs& common, Verdict verdict, std::size_t largest,
+                             const std::string& limits) {
     if (!common.quick) {
         return {};
     }
@@ -220,8 +221,8 @@ std::string sweepSmokeHeader(const CommonArgs& common, Verdict verdict, std::siz
               "paper judged its renderers; deadlines missed are reported, not counted)"
             : "design (p99 load < 100 % and <= 0.1 % deadlines missed)";
     return smokeTestHeader(common,
-                           "the paper's max-stable claims (it stops at " + std::to_string(largest) +
-                               " objects, below most of the paper's limits), p99.9 load (a run "
+                           limits + " (it stops at " + std::to_string(largest) +
+                               " objects, below the sizes where renderers part), p99.9 load (a run "
                                "of a few hundred ticks has no p99.9 but its maximum) or the "
                                "spread across runs",
                            which);

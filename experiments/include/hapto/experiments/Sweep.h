@@ -227,10 +227,11 @@ Verdict sweepVerdict(bool quick, bool verdictGiven, Verdict given);
 /// its table uses (`verdict`, said in full). [any thread]
 std::string smokeTestHeader(const CommonArgs& common, const std::string& cannotJudge,
                             const std::string& verdict);
-/// smokeTestHeader for a sweep: the paper's limits cannot be judged below `largest` objects,
-/// nor p99.9 from a few hundred ticks; the verdict is `verdict` read on the quick tail (p99).
-/// Empty for a full run. [any thread]
-std::string sweepSmokeHeader(const CommonArgs& common, Verdict verdict, std::size_t largest);
+/// smokeTestHeader for a sweep: `limits` (e.g. "the paper's max-stable claims") cannot be
+/// judged from a sweep that stops at `largest` objects, nor p99.9 from a few hundred ticks; the
+/// verdict is `verdict` read on the quick tail (p99). Empty for a full run. [any thread]
+std::string sweepSmokeHeader(const CommonArgs& common, Verdict verdict, std::size_t largest,
+                             const std::string& limits = "the paper's max-stable claims");
 
 /// "1 kHz", "20 kHz", "500 Hz". [any thread]
 std::string rateText(double rateHz);
