@@ -51,5 +51,7 @@ void bindRender(py::module_& m);
 void bindSession(py::module_& m);
 /// The experiments (Experiments.cpp).
 void bindExperiments(py::module_& m);
+/// The grasp experiment (GraspExperiment.cpp).
+void bindGraspExperiment(py::module_& m);
 
 } // namespace hapto::python

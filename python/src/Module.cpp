@@ -46,4 +46,5 @@ PYBIND11_MODULE(_hapto, m) {
     hp::bindRender(m);
     hp::bindSession(m);
     hp::bindExperiments(m);
+    hp::bindGraspExperiment(m);
 }

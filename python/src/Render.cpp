@@ -1,5 +1,7 @@
 // render() (a point path through the haptic tick, experiments::renderPath) and read_trace()
-// (a trace file as the columns of `hapto trace export`, TraceColumns.h), for Python.
+// (a trace file as the columns of `hapto trace export`: a device's, TraceColumns.h, or the
+// dynamic bodies' bodies.trace, BodyTrace.h, told apart by its magic as the command does), for
+// Python.
 
 #include "Bindings.h"
 
@@ -8,8 +10,10 @@
 #include "hapto/experiments/RenderPath.h"
 #include "hapto/index/DefaultIndex.h"
 #include "hapto/io/InputError.h"
+#include "hapto/runtime/BodyTrace.h"
 #include "hapto/runtime/World.h"
 
+#include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include <cmath>
@@ -87,8 +91,51 @@ py::dict render(const PyScene& scene, const Points& points, const py::object& in
     return renderColumns(renderOver(scene, path, index, rateHz, maxIndexMb));
 }
 
-/// A trace's samples as the columns of `hapto trace export` for its version.
+/// A body trace's samples as the columns of `hapto trace export` for it (bodyTraceCsvHeader:
+/// time_s,id,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz).
+py::dict bodyTraceColumns(const BodyTrace& trace) {
+    const std::size_t n = trace.samples.size();
+    auto time = column<double>(n);
+    auto id = column<std::uint32_t>(n);
+    std::vector<py::array_t<double>> values;
+    for (int k = 0; k < 13; ++k) {
+        values.push_back(column<double>(n));
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        const BodyTraceSample& s = trace.samples[i];
+        time.mutable_at(i) = static_cast<double>(s.timeNs) * 1e-9; // as the export prints it
+        id.mutable_at(i) = trace.ids.at(s.body);
+        const double v[13] = {s.centerOfMass.x,   s.centerOfMass.y,    s.centerOfMass.z,
+                              s.rotation.w,       s.rotation.x,        s.rotation.y,
+                              s.rotation.z,       s.velocity.x,        s.velocity.y,
+                              s.velocity.z,       s.angularVelocity.x, s.angularVelocity.y,
+                              s.angularVelocity.z};
+        for (int k = 0; k < 13; ++k) {
+            values[k].mutable_at(i) = v[k];
+        }
+    }
+    static const char* const kNames[13] = {"x",  "y",  "z",  "qw", "qx", "qy", "qz",
+                                           "vx", "vy", "vz", "wx", "wy", "wz"};
+    py::dict out;
+    out["time_s"] = time;
+    out["id"] = id;
+    for (int k = 0; k < 13; ++k) {
+        out[kNames[k]] = values[k];
+    }
+    return out;
+}
+
+/// A trace's samples as the columns of `hapto trace export` for its version (a body trace:
+/// bodyTraceColumns).
 py::dict readTrace(const std::filesystem::path& path) {
+    if (isBodyTrace(path)) {
+        BodyTrace trace;
+        {
+            py::gil_scoped_release release;
+            trace = readBodyTrace(path);
+        }
+        return bodyTraceColumns(trace);
+    }
     TraceHeader header;
     std::vector<TraceSample> samples;
     {
@@ -123,8 +170,18 @@ py::dict readTrace(const std::filesystem::path& path) {
     return out;
 }
 
-/// What a trace says about itself (`hapto trace info`), as a dict.
+/// What a trace says about itself (`hapto trace info`), as a dict; a body trace's: its
+/// kind "bodies", dynamics rate, body ids and sample count.
 py::dict traceHeader(const std::filesystem::path& path) {
+    if (isBodyTrace(path)) {
+        const BodyTrace trace = readBodyTrace(path);
+        py::dict out;
+        out["kind"] = "bodies";
+        out["rate_hz"] = trace.rateHz;
+        out["ids"] = py::cast(trace.ids);
+        out["samples"] = trace.samples.size();
+        return out;
+    }
     const TraceReader reader(path);
     const TraceHeader& h = reader.header();
     py::dict out;

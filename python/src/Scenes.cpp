@@ -5,6 +5,7 @@
 #include "hapto/index/Cursor.h"
 #include "hapto/index/DefaultIndex.h"
 #include "hapto/index/IndexSpec.h"
+#include "hapto/io/InputError.h"
 #include "hapto/scenes/Generators.h"
 #include "hapto/scenes/SceneFile.h"
 
@@ -12,6 +13,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
+#include <optional>
 #include <utility>
 
 namespace hapto::python {
@@ -112,6 +114,18 @@ void bindGenerators(py::module_& m) {
         py::arg("workspace") = 0.25, py::arg("cube_size") = 0.005, py::arg("spread") = 0.01,
         py::arg("rotate") = false);
     m.def("grasp_scene", [] { return share(makeGraspScene()); });
+    m.def(
+        "dynamic_grasp_scene",
+        [](const std::string& shape) {
+            const std::optional<GraspObject> object = parseGraspObject(shape);
+            if (!object) {
+                throw InputError("shape '" + shape +
+                                 "': expected the object to grasp: box, sphere or mesh");
+            }
+            return share(makeDynamicGraspScene(*object));
+        },
+        py::arg("shape") = "box",
+        "The physical grasp demo's scene: a dynamic 100 g box, sphere or mesh on a floor");
     m.def("default_scene", [] { return share(makeDefaultScene()); });
 }
 
