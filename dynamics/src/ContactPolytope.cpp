@@ -7,9 +7,8 @@
 // origin and axes (the axes are a rotation, so planes move with n' = R n, d' = d + n'.origin);
 // a triangle is a flat polytope with two faces (+n, -n), or one (+n) when one-sided.
 //
-// A hull stores face planes but not face polygons: a face's polygon is the corners lying in
-// its plane (within 1e-6 of the hull's size), sorted by angle about their mean (kFaceMax at
-// most). Cost: O(vertices) per face polygon and per support query.
+// A hull's face polygons are its derived topology (ConvexHull::deriveTopology: the corners in
+// its plane, in angular order), read per call in O(corners); a support query is O(vertices).
 
 #include "ContactInternal.h"
 
@@ -43,42 +42,20 @@ void makeCounterClockwise(Polygon& p, const Vec3& n) noexcept {
     }
 }
 
-// The corners of hull face f (own frame), in angular order about their mean.
+// The corners of hull face f (own frame), in angular order about their mean (ConvexHull's
+// derived topology); a face of more than kFaceMax corners gives kFaceMax of them, evenly spaced.
 void hullFaceLocal(const ConvexHull& hull, int f, Polygon& out) noexcept {
-    const ConvexHull::Face& face = hull.faces[at(f)];
-    double size = 0.0;
-    for (const Vec3& v : hull.vertices) {
-        size = std::max(size, glm::length(v));
-    }
-    const double tol = 1e-6 * size;
     out.count = 0;
-    std::array<double, kClipMax> angle{};
-    Vec3 mean{0.0};
-    for (std::size_t i = 0; i < hull.vertices.size() && out.count < kFaceMax; ++i) {
-        if (std::abs(glm::dot(face.normal, hull.vertices[i]) - face.offset) <= tol) {
-            out.points[at(out.count)] = hull.vertices[i];
-            out.tag[at(out.count++)] = static_cast<std::uint32_t>(i);
-            mean += hull.vertices[i];
-        }
+    if (!hull.hasTopology()) {
+        return; // collide() needs a hull with its topology (ConvexHull::deriveTopology)
     }
-    if (out.count == 0) {
-        return;
-    }
-    mean /= static_cast<double>(out.count);
-    const Vec3 n = face.normal;
-    const Vec3 helper = std::abs(n.x) < 0.6 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-    const Vec3 u = glm::normalize(glm::cross(n, helper));
-    const Vec3 w = glm::cross(n, u);
-    for (int i = 0; i < out.count; ++i) {
-        const Vec3 d = out.points[at(i)] - mean;
-        angle[at(i)] = std::atan2(glm::dot(w, d), glm::dot(u, d));
-    }
-    for (int i = 1; i < out.count; ++i) { // insertion sort: stable, no allocation
-        for (int j = i; j > 0 && angle[at(j)] < angle[at(j - 1)]; --j) {
-            std::swap(angle[at(j)], angle[at(j - 1)]);
-            std::swap(out.points[at(j)], out.points[at(j - 1)]);
-            std::swap(out.tag[at(j)], out.tag[at(j - 1)]);
-        }
+    const std::uint32_t begin = hull.faceCornerBegin[at(f)];
+    const std::uint32_t n = hull.faceCornerBegin[at(f) + 1] - begin;
+    const std::uint32_t take = std::min<std::uint32_t>(n, kFaceMax);
+    for (std::uint32_t c = 0; c < take; ++c) {
+        const std::uint32_t v = hull.faceCorners[begin + (n == take ? c : c * n / take)];
+        out.points[at(out.count)] = hull.vertices[v];
+        out.tag[at(out.count++)] = v;
     }
 }
 

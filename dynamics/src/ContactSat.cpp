@@ -32,8 +32,8 @@
 // corners^2). Between two hulls of at most kGaussEdgeMax edges, Gregorius's Gauss-map pruning
 // ("The Separating Axis Test between Convex Polyhedra", GDC 2013) keeps only the edge pairs
 // that build a face of the Minkowski difference (the others never realise the separation):
-// each edge's two faces are found per call, E F plane tests, since ConvexHull does not store
-// them; larger hulls test every pair.
+// each edge's two faces come from the hull's derived topology (ConvexHull::edgeFaces), turned
+// into the world per call, O(E); larger hulls test every pair.
 //
 // Features: a face point is (side of the reference << 31) | reference face << 23 | incident
 // face << 15 | corner tag (an incident corner, or the clipping plane and the edge it cut); an
@@ -100,34 +100,21 @@ struct EdgeFaces {
     std::array<Vec3, kGaussEdgeMax> n2;
 };
 
-// Fills `out` for a hull of at most kGaussEdgeMax edges each lying on exactly two faces; false
-// otherwise (then every edge pair is tested).
+// Fills `out` for a hull of at most kGaussEdgeMax edges each lying on two faces (its derived
+// topology, ConvexHull::edgeFaces); false otherwise (then every edge pair is tested).
 bool edgeFaces(const Polytope& p, EdgeFaces& out) noexcept {
     const ConvexHull* hull = p.hull();
-    if (hull == nullptr || hull->edges.size() > static_cast<std::size_t>(kGaussEdgeMax)) {
+    if (hull == nullptr || hull->edges.size() > static_cast<std::size_t>(kGaussEdgeMax) ||
+        !hull->hasTopology()) {
         return false;
     }
-    double size = 0.0;
-    for (const Vec3& v : hull->vertices) {
-        size = std::max(size, glm::length(v));
-    }
-    const double tol = 1e-6 * size;
     for (std::size_t e = 0; e < hull->edges.size(); ++e) {
-        const Vec3& s = hull->vertices[hull->edges[e][0]];
-        const Vec3& t = hull->vertices[hull->edges[e][1]];
-        int found = 0;
-        for (const ConvexHull::Face& f : hull->faces) {
-            if (std::abs(glm::dot(f.normal, s) - f.offset) <= tol &&
-                std::abs(glm::dot(f.normal, t) - f.offset) <= tol) {
-                (found == 0 ? out.n1 : out.n2)[e] = p.toWorld(f.normal);
-                if (++found == 2) {
-                    break;
-                }
-            }
-        }
-        if (found != 2) {
+        const auto& f = hull->edgeFaces[e];
+        if (f[0] == ConvexHull::kNoFace) {
             return false;
         }
+        out.n1[e] = p.toWorld(hull->faces[f[0]].normal);
+        out.n2[e] = p.toWorld(hull->faces[f[1]].normal);
     }
     return true;
 }

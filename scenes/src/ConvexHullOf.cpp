@@ -152,6 +152,7 @@ ConvexHullSurface convexHullOf(std::span<const Vec3> points) {
     std::sort(out.hull.edges.begin(), out.hull.edges.end());
     out.hull.edges.erase(std::unique(out.hull.edges.begin(), out.hull.edges.end()),
                          out.hull.edges.end());
+    out.hull.deriveTopology(); // what the narrow phase reads per call, found once
     return out;
 }
 

@@ -1,7 +1,7 @@
 // The narrow phase with convex hulls: a hull made of a box gives the box's contacts (sphere,
 // box and hull partners, random poses); an octahedron's corner and edge on a box; hull-hull
 // depth sign against point sampling; the manifold of two large faces keeps at most kMax points
-// spanning it.
+// spanning it; the topology a hull derives once for the narrow phase.
 
 #include "ContactTestShapes.h"
 
@@ -145,4 +145,52 @@ TEST_CASE("Contact: two large polygon faces keep at most kMax points spanning th
         spread = std::max(spread, std::hypot(p.position.x, p.position.z));
     }
     CHECK(spread > 0.09); // on the rim, not bunched
+}
+
+TEST_CASE("Contact: a hull's derived topology lists each face's corners around it and each "
+          "edge's two faces") {
+    // What collide() reads instead of recomputing (ConvexHull::deriveTopology): every corner of
+    // a face lies on its plane and every vertex on the plane is a corner; going around the
+    // corners turns one way only (angular order about the normal); an edge's two faces both
+    // hold its ends, and they are the first two in face order that do.
+    Random rng(23);
+    for (int trial = 0; trial < 20; ++trial) {
+        std::vector<Vec3> points;
+        for (int k = 0; k < 6 + trial; ++k) {
+            points.push_back(glm::normalize(randomVec(rng, 1.0) + Vec3(1e-3)) * 0.02);
+        }
+        const ConvexHull h = hullOfPoints(points);
+        REQUIRE(h.hasTopology());
+        const double tol = ConvexHull::kOnFaceTolerance * h.radiusM;
+        for (std::size_t f = 0; f < h.faces.size(); ++f) {
+            const ConvexHull::Face& face = h.faces[f];
+            const std::uint32_t b = h.faceCornerBegin[f], e = h.faceCornerBegin[f + 1];
+            std::size_t onPlane = 0;
+            for (const Vec3& v : h.vertices) {
+                onPlane += std::abs(glm::dot(face.normal, v) - face.offset) <= tol ? 1 : 0;
+            }
+            REQUIRE(e - b == onPlane);
+            REQUIRE(e - b >= 3);
+            double turn = 0.0;
+            for (std::uint32_t c = b; c < e; ++c) {
+                const Vec3& p = h.vertices[h.faceCorners[c]];
+                const Vec3& q = h.vertices[h.faceCorners[b + (c - b + 1) % (e - b)]];
+                const Vec3& r = h.vertices[h.faceCorners[b + (c - b + 2) % (e - b)]];
+                const double t = glm::dot(glm::cross(q - p, r - q), face.normal);
+                REQUIRE(t * turn >= 0.0); // never turns back
+                turn = t != 0.0 ? t : turn;
+            }
+        }
+        for (std::size_t k = 0; k < h.edges.size(); ++k) {
+            const auto& faces = h.edgeFaces[k];
+            REQUIRE(faces[0] != ConvexHull::kNoFace);
+            REQUIRE(faces[0] < faces[1]);
+            for (const std::uint32_t f : faces) {
+                for (const std::uint32_t v : h.edges[k]) {
+                    CHECK(std::abs(glm::dot(h.faces[f].normal, h.vertices[v]) -
+                                   h.faces[f].offset) <= tol);
+                }
+            }
+        }
+    }
 }

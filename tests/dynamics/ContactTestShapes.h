@@ -136,6 +136,7 @@ inline ConvexHull hullOfPoints(const std::vector<Vec3>& points) {
             }
         }
     }
+    h.deriveTopology();
     return h;
 }
 
