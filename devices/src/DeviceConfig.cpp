@@ -385,4 +385,20 @@ std::vector<DeviceConfig> defaultDeviceConfigs() {
     return out;
 }
 
+std::vector<DeviceConfig> graspHandConfigs(std::uint32_t object, double pressForceN) {
+    std::vector<DeviceConfig> hands(2);
+    for (int i = 0; i < 2; ++i) {
+        hands[i].name = i == 0 ? "left" : "right";
+        hands[i].kind = DeviceKind::Sim;
+        hands[i].transform.translation = i == 0 ? Vec3(-0.12, -0.04, 0.0) : Vec3(0.04, -0.04, 0.0);
+        SimConfig sim;
+        sim.script = i == 0 ? HandScript::GraspLeft : HandScript::GraspRight;
+        sim.seed = static_cast<std::uint64_t>(i + 1);
+        sim.object = object;
+        sim.pressForceN = pressForceN;
+        hands[i].params = sim;
+    }
+    return hands;
+}
+
 } // namespace hapto

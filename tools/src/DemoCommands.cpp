@@ -68,27 +68,6 @@ struct DemoArgs {
     ViewArgs view;
 };
 
-// Two simulated hands for the grasp scene: left starts at the -x side, right at the +x side,
-// both above the floor, in clear space.
-std::vector<DeviceConfig> graspHands(ObjectId object) {
-    std::vector<DeviceConfig> hands(2);
-    const char* names[2] = {"left", "right"};
-    const HandScript scripts[2] = {HandScript::GraspLeft, HandScript::GraspRight};
-    const Vec3 starts[2] = {Vec3(-0.12, -0.04, 0.0), Vec3(0.04, -0.04, 0.0)};
-    for (int i = 0; i < 2; ++i) {
-        hands[i].name = names[i];
-        hands[i].kind = DeviceKind::Sim;
-        hands[i].transform.translation = starts[i];
-        SimConfig sim;
-        sim.script = scripts[i];
-        sim.seed = static_cast<std::uint64_t>(i + 1);
-        sim.object = object;
-        sim.pressForceN = 2.0;
-        hands[i].params = sim;
-    }
-    return hands;
-}
-
 // Per device: what the hand felt while the object was held.
 struct Felt {
     double maxForceN = 0;
@@ -533,7 +512,7 @@ int runDemo(const DemoArgs& a) {
     checkDemoArgs(a);
     StopSignals signals; // before any thread starts; see `hapto run`
     DeviceFile file =
-        a.devices.empty() ? DeviceFile{graspHands(a.object), {}} : loadDeviceFile(a.devices);
+        a.devices.empty() ? DeviceFile{graspHandConfigs(a.object), {}} : loadDeviceFile(a.devices);
     std::vector<DeviceConfig>& configs = file.devices;
     if (configs.size() != 2) {
         throw InputError(a.devices +

@@ -30,46 +30,26 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <string>
 #include <string_view>
+#include <vector>
 
 using namespace hapto;
 
-// Two simulated hands, left and right of the cube (object 0), on the grasp scripts: approach,
-// squeeze with 2 N each, lift 5 cm, carry 10 cm, put down, let go, grasp again, lift and drop.
-static std::vector<DeviceConfig> simulatedHands() {
-    std::vector<DeviceConfig> hands(2);
-    for (int i = 0; i < 2; ++i) {
-        hands[i].name = i == 0 ? "left" : "right";
-        hands[i].kind = DeviceKind::Sim;
-        hands[i].transform.translation = i == 0 ? Vec3(-0.12, -0.04, 0) : Vec3(0.04, -0.04, 0);
-        SimConfig sim;
-        sim.script = i == 0 ? HandScript::GraspLeft : HandScript::GraspRight;
-        sim.object = 0;
-        sim.pressForceN = 2.0; // squeeze (N): mu_s 0.6 x 4 N = 2.4 N holds 0.98 N of weight
-        hands[i].params = sim;
-    }
-    return hands;
-}
-
 int main(int argc, char** argv) try {
-    bool stepped = false;
-    const char* deviceFile = nullptr;
-    for (int i = 1; i < argc; ++i) {
-        if (std::string_view(argv[i]) == "--stepped") {
-            stepped = true;
-        } else {
-            deviceFile = argv[i];
-        }
-    }
+    // [--stepped] [DEVICES.json]: by default the grasp scripts' two simulated hands, 2 N each
+    // (mu_s 0.6 x 4 N = 2.4 N of friction holds the cube's 0.98 N weight).
+    const std::vector<std::string_view> args(argv + 1, argv + argc);
+    const bool stepped = std::find(args.begin(), args.end(), "--stepped") != args.end();
+    const auto file =
+        std::find_if(args.begin(), args.end(), [](auto a) { return a != "--stepped"; });
     const std::vector<DeviceConfig> hands =
-        deviceFile ? loadDeviceFile(deviceFile).devices : simulatedHands();
-    if (hands.size() != 2) {
-        throw InputError(std::string(deviceFile) + ": two devices, please (left and right hands)");
-    }
-    for (const DeviceConfig& hand : hands) {
-        if (stepped && !runsOnStepClock(hand.kind)) {
-            throw InputError("--stepped: device '" + hand.name + "' keeps real time");
-        }
+        file != args.end() ? loadDeviceFile(std::string(*file)).devices : graspHandConfigs();
+    const bool steppable = std::all_of(hands.begin(), hands.end(), [](const DeviceConfig& h) {
+        return runsOnStepClock(h.kind); // simulated hands and replays
+    });
+    if (hands.size() != 2 || (stepped && !steppable)) {
+        throw InputError("two devices, please, and with --stepped simulated hands or replays");
     }
     ManualClock clock; // stepped: the session's time, for the world and the runtime
     SessionOptions options;

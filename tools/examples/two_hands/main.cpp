@@ -57,22 +57,6 @@ static Vec3 feelTheOtherHand(void* context, const TickHookArgs& tick) noexcept {
     return c.stiffnessNPerM * (length - c.restLengthM) * (d / length); // N, world
 }
 
-// Two simulated hands, left and right of the cube, running the grasp scripts.
-static std::vector<DeviceConfig> simulatedHands() {
-    std::vector<DeviceConfig> hands(2);
-    for (int i = 0; i < 2; ++i) {
-        hands[i].name = i == 0 ? "left" : "right";
-        hands[i].kind = DeviceKind::Sim;
-        hands[i].transform.translation = i == 0 ? Vec3(-0.12, -0.04, 0) : Vec3(0.04, -0.04, 0);
-        SimConfig sim;
-        sim.script = i == 0 ? HandScript::GraspLeft : HandScript::GraspRight;
-        sim.object = 0;        // the cube
-        sim.pressForceN = 2.0; // squeeze (N)
-        hands[i].params = sim;
-    }
-    return hands;
-}
-
 int main(int argc, char** argv) try {
     bool stepped = false;
     const char* deviceFile = nullptr;
@@ -96,7 +80,7 @@ int main(int argc, char** argv) try {
 
     // 2. The devices, from a file (with their force effects and renderer settings) or in code.
     const DeviceFile file =
-        deviceFile ? loadDeviceFile(deviceFile) : DeviceFile{simulatedHands(), {}};
+        deviceFile ? loadDeviceFile(deviceFile) : DeviceFile{graspHandConfigs(), {}}; // 2 N each
     const std::vector<DeviceConfig>& configs = file.devices;
     if (configs.size() != 2) {
         throw InputError(std::string(deviceFile) + ": two devices, please (left and right hands)");

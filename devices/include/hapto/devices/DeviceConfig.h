@@ -175,5 +175,10 @@ std::vector<DeviceConfig> parseDeviceConfig(std::string_view text, std::string_v
 /// scene: "left" at x = -0.02 m sliding on its nearest surface (seed 1), "right" at x = +0.02 m
 /// touching its nearest surface (seed 2): the paper's "sliding" and "touch" cases. [control]
 std::vector<DeviceConfig> defaultDeviceConfigs();
+/// The grasp scene's two simulated hands (makeGraspScene, makeDynamicGraspScene; y up) at 1 kHz:
+/// "left" from x = -0.12 m on the grasp-left script (seed 1), "right" from x = +0.04 m on
+/// grasp-right (seed 2), both at y = -0.04 m, grasping `object` with `pressForceN` each (N).
+/// The hands of `hapto demo grasp` and of the examples. [control]
+std::vector<DeviceConfig> graspHandConfigs(std::uint32_t object = 0, double pressForceN = 2.0);
 
 } // namespace hapto
