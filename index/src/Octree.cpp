@@ -45,6 +45,14 @@ namespace {
 // A node's object list is split over threads only above this many objects.
 constexpr std::size_t kNestedGrain = 4096;
 
+// Frees a vector's array, then allocates exactly `size` value-initialised elements (assign()
+// and resize() would keep a larger array of an earlier level, and a new vector swapped in
+// would hold both at once).
+template <class T> void freshArray(std::vector<T>& v, std::size_t size) {
+    std::vector<T>().swap(v);
+    v.resize(size);
+}
+
 } // namespace
 
 Octree::Octree(const IndexSpec& spec, const Aabb& bounds, std::uint32_t items)
@@ -54,15 +62,20 @@ Octree::Octree(const IndexSpec& spec, const Aabb& bounds, std::uint32_t items)
         mStep[l] = Vec3(std::ldexp(size.x, -l), std::ldexp(size.y, -l), std::ldexp(size.z, -l));
         mInvStep[l] = 1.0 / mStep[l];
     }
+    mSplitLevels = splitLevels(bounds, spec.minLeafSize);
 }
 
-bool Octree::canSplit(int level) const noexcept {
-    if (level >= kMaxDepth) {
-        return false;
+int Octree::splitLevels(const Aabb& bounds, double minLeafSize) noexcept {
+    const Vec3 size = bounds.max - bounds.min;
+    int level = 0;
+    while (level < kMaxDepth) {
+        const double edge = std::ldexp(std::max({size.x, size.y, size.z}), -(level + 1));
+        if (!(edge >= minLeafSize * (1.0 - 1e-12))) {
+            break;
+        }
+        ++level;
     }
-    const Vec3& child = mStep[level + 1];
-    const double edge = std::max({child.x, child.y, child.z});
-    return edge >= spec().minLeafSize * (1.0 - 1e-12);
+    return level;
 }
 
 Aabb Octree::nodeBounds(std::uint32_t node) const noexcept {
@@ -271,6 +284,8 @@ public:
     OctreeBuilder(Octree& tree, const Scene& scene, std::span<const std::uint32_t> items);
     /// Builds the root's list, then every level until no node splits.
     void run();
+    /// The most memory the build held by its accounting (octreeBuildBytes), in bytes.
+    std::uint64_t peakBytes() const { return mPeakBytes; }
 
 private:
     /// Of a node that splits: its eight children's cells, its own cell and its midpoint.
@@ -286,8 +301,7 @@ private:
     SplitCells splitCells(std::uint64_t node) const;
     void classifyObjects(const SplitCells& cells, std::size_t lo, std::size_t hi);
     void allocateLevel();
-    std::uint64_t levelBytes(std::uint64_t nodes, std::uint64_t slots, std::uint64_t next) const;
-    void refuseAbove(std::uint64_t bytes) const;
+    void refuseAbove(std::uint64_t nodes, std::uint64_t slots, std::uint64_t next) const;
     void placeNode(std::size_t k, std::uint64_t& leafTotal, std::uint64_t& nextTotal);
     void fillLists();
     void cutChildLists(std::size_t k, std::uint64_t childBase);
@@ -312,6 +326,7 @@ private:
     std::vector<std::array<std::uint32_t, 8>> mChildCount; // per node that splits, per octant
     std::vector<std::uint64_t> mLeafAt;                    // per node that stays a leaf: 1st slot
     std::uint64_t mSplitCount = 0, mSlotBase = 0;
+    mutable std::uint64_t mPeakBytes = 0; // the largest accounting checked (bytes)
 };
 
 OctreeBuilder::OctreeBuilder(Octree& tree, const Scene& scene, std::span<const std::uint32_t> items)
@@ -332,6 +347,8 @@ void OctreeBuilder::run() {
         linkLevel(newBegin, newEnd);
         mEntries.swap(mNext);
         mStart.swap(mNextStart);
+        freshArray(mNext, 0); // the level above's lists: no longer needed
+        freshArray(mNextStart, 0);
         mLevelBegin = newBegin;
         mLevelEnd = newEnd;
     }
@@ -384,9 +401,9 @@ void OctreeBuilder::listRoot() {
 // each overlaps; then each child's object count.
 void OctreeBuilder::classifyLevel() {
     const bool splittable = mTree.canSplit(mLevel);
-    mChildCount.assign(mWidth, {});
-    mSplits.assign(mWidth, 0);
-    mMasks.assign(mEntries.size(), 0);
+    freshArray(mChildCount, mWidth);
+    freshArray(mSplits, mWidth);
+    freshArray(mMasks, mEntries.size());
     parallel::forEach(0, mWidth, 16, [&](std::size_t k) {
         const std::uint64_t b = mStart[k], e = mStart[k + 1];
         if (!splittable || e - b <= mMaxObjects) {
@@ -458,15 +475,19 @@ void OctreeBuilder::classifyObjects(const SplitCells& cells, std::size_t lo, std
 }
 
 // Step 2, serially: allocate children (eight siblings together) and leaf runs, refusing a
-// level that would pass the memory limit, the node limit or 32-bit slot offsets.
+// level that would pass the memory limit, the node limit or 32-bit slot offsets. The memory
+// check before each allocation counts everything the build then holds (octreeBuildBytes), and
+// the per-level arrays are allocated afresh at their exact size (a reused vector keeps the
+// capacity of an earlier, larger level), so the limit bounds the build's resident memory.
 void OctreeBuilder::allocateLevel() {
     std::vector<OctreeNode>& nodes = mTree.mNodes;
     mSplitCount = 0;
     for (std::size_t k = 0; k < mWidth; ++k) {
         mSplitCount += mSplits[k];
     }
-    refuseAbove(levelBytes(nodes.size() + 8 * mSplitCount, mTree.mSlots.size(), 0));
-    if (nodes.size() + 8 * mSplitCount > Octree::kMaxNodes) {
+    const std::uint64_t newNodes = nodes.size() + 8 * mSplitCount;
+    refuseAbove(newNodes, mTree.mSlots.size(), 0);
+    if (newNodes > Octree::kMaxNodes) {
         throw InputError("octree " + mSpec.toString() + ": more than " +
                          std::to_string(Octree::kMaxNodes) +
                          " nodes needed (too many overlapping objects for this minimum "
@@ -475,11 +496,13 @@ void OctreeBuilder::allocateLevel() {
     mSlotBase = mTree.mSlots.size();
     // Arrays sized exactly: each level reserves what it adds, so no capacity is left over
     // (a reallocation per level copies the nodes so far: a geometric sum, cheap).
-    nodes.reserve(nodes.size() + 8 * mSplitCount);
+    nodes.reserve(newNodes);
     mTree.mGroupParent.reserve(mTree.mGroupParent.size() + mSplitCount);
-    mLeafAt.assign(mWidth, 0);
+    freshArray(mLeafAt, mWidth);
     std::uint64_t leafTotal = 0, nextTotal = 0;
-    mNextStart.assign(1, 0);
+    freshArray(mNextStart, 0);
+    mNextStart.reserve(8 * mSplitCount + 1);
+    mNextStart.push_back(0);
     for (std::size_t k = 0; k < mWidth; ++k) {
         placeNode(k, leafTotal, nextTotal);
     }
@@ -488,29 +511,23 @@ void OctreeBuilder::allocateLevel() {
         throw InputError("octree " + mSpec.toString() +
                          ": more than 2^32 object-leaf pairs; raise MIN or M");
     }
-    refuseAbove(levelBytes(nodes.size(), mSlotBase + leafTotal, nextTotal));
+    refuseAbove(nodes.size(), mSlotBase + leafTotal, nextTotal);
     mTree.mSlots.reserve(mSlotBase + leafTotal);
     mTree.mSlots.resize(mSlotBase + leafTotal);
-    mNext.resize(nextTotal);
+    freshArray(mNext, nextTotal);
 }
 
-// Memory with this many nodes, leaf slots and next-level entries: those, the parents, this
-// level's lists and masks, and the per-object arrays.
-std::uint64_t OctreeBuilder::levelBytes(std::uint64_t nodes, std::uint64_t slots,
-                                        std::uint64_t next) const {
-    const std::uint64_t perObject =
-        std::uint64_t(mCount) * (sizeof(std::uint32_t) + sizeof(OverlapShape));
-    return nodes * sizeof(OctreeNode) + (nodes / 8 + slots + next) * sizeof(std::uint32_t) +
-           mEntries.size() * (sizeof(std::uint32_t) + 1) + perObject;
-}
-
-// Refuses the build (InputError) when `bytes` passes the spec's memory limit.
-void OctreeBuilder::refuseAbove(std::uint64_t bytes) const {
+// Refuses the build (IndexTooLargeError) when the build would hold more than the spec's
+// memory limit with this many nodes, leaf slots and next-level entries (IndexMemory.h).
+void OctreeBuilder::refuseAbove(std::uint64_t nodes, std::uint64_t slots,
+                                std::uint64_t next) const {
+    const std::uint64_t bytes =
+        detail::octreeBuildBytes({mCount, nodes, slots, mWidth, mEntries.size(), next});
+    mPeakBytes = std::max(mPeakBytes, bytes);
     if (bytes > mSpec.maxBytes) {
         detail::refuseIndexMemory(mSpec, bytes,
-                                  std::to_string(mTree.mNodes.size() + 8 * mSplitCount) +
-                                      " nodes by depth " + std::to_string(mLevel + 1) +
-                                      " and still splitting",
+                                  std::to_string(nodes) + " nodes by depth " +
+                                      std::to_string(mLevel + 1) + " and still splitting",
                                   true);
     }
 }
@@ -615,7 +632,9 @@ void OctreeBuilder::linkLevel(std::uint64_t begin, std::uint64_t end) {
 }
 
 void Octree::buildNodes(const Scene& scene, std::span<const std::uint32_t> items) {
-    OctreeBuilder(*this, scene, items).run();
+    OctreeBuilder builder(*this, scene, items);
+    builder.run();
+    mStats.buildPeakBytes = builder.peakBytes();
 }
 
 } // namespace hapto

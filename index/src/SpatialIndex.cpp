@@ -99,75 +99,19 @@ void refuseIndexMemory(const IndexSpec& spec, std::uint64_t bytes, const std::st
 
 } // namespace detail
 
-std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec) {
-    std::uint64_t count = 0;
-    for (std::uint32_t i = 0; i < scene.itemCount(); ++i) {
-        count += scene.isIndexed(scene.item(i));
-    }
-    switch (spec.kind) {
-    case IndexSpec::Kind::BruteForce:
-        return count * sizeof(std::uint32_t);
-    case IndexSpec::Kind::Octree:
-        // Per item: Morton key, id, shape, root flag and list entry; plus the root node; the
-        // enumeration of the items.
-        return count *
-                   (sizeof(std::uint64_t) + 3 * sizeof(std::uint32_t) + sizeof(OverlapShape) + 1) +
-               sizeof(OctreeNode);
-    case IndexSpec::Kind::Grid:
-        break;
-    }
-    const std::uint64_t n = static_cast<std::uint64_t>(std::max(spec.gridCells, 1));
-    const Aabb b = partitionBounds(scene.bounds());
-    const Vec3 step = (b.max - b.min) / static_cast<double>(n);
-    const double last = static_cast<double>(n - 1);
-    // In parallel (a control thread's TBB loop, like the build): each range sums its own.
-    std::atomic<std::uint64_t> pairs{0};
-    parallel::forRanges(0, scene.itemCount(), 4096, [&](std::size_t first, std::size_t end) {
-        std::uint64_t rangePairs = 0;
-        for (std::size_t i = first; i < end; ++i) {
-            const std::uint32_t item = scene.item(static_cast<std::uint32_t>(i));
-            if (!scene.isIndexed(item)) {
-                continue;
-            }
-            const Aabb box = itemAabb(scene, item);
-            const double scale =
-                std::max({std::abs(box.min.x), std::abs(box.min.y), std::abs(box.min.z),
-                          std::abs(box.max.x), std::abs(box.max.y), std::abs(box.max.z)}) +
-                std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z),
-                          std::abs(b.max.x), std::abs(b.max.y), std::abs(b.max.z)});
-            const double tol = 2.0 * kOverlapTolerance * scale;
-            std::uint64_t cells = 1;
-            for (int a = 0; a < 3 && cells > 0; ++a) {
-                const double lo = std::floor((box.min[a] - tol - b.min[a]) / step[a]);
-                const double hi = std::floor((box.max[a] + tol - b.min[a]) / step[a]);
-                if (!(hi >= 0.0) || !(lo <= last)) {
-                    cells = 0; // wholly outside on this axis (or NaN): in no cell
-                    break;
-                }
-                cells *= static_cast<std::uint64_t>(std::min(hi, last) - std::max(lo, 0.0)) + 1;
-            }
-            rangePairs += cells;
-        }
-        pairs.fetch_add(rangePairs, std::memory_order_relaxed);
-    });
-    const std::uint64_t cellCount = n * n * n;
-    // The counting sort (UniformGrid.cpp): cell offsets and the per-cell counters (which become
-    // the stats' counts); per item its id, pair offset, pair count and candidate range (8 bytes
-    // at most); per pair its cell and item.
-    return (2 * cellCount + 1) * sizeof(std::uint32_t) + sizeof(std::uint64_t) +
-           count * (2 * sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t)) +
-           pairs.load() * 2 * sizeof(std::uint32_t);
-}
-
 std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec) {
-    const std::uint64_t need = estimateIndexBytes(scene, spec);
-    if (need > spec.maxBytes) {
+    const IndexMemoryEstimate need = estimateIndexMemory(scene, spec);
+    if (need.atLeastBytes > spec.maxBytes) {
+        const std::string items = std::to_string(scene.itemCount()) + " items";
         const std::string detail =
             spec.kind == IndexSpec::Kind::Grid
                 ? std::to_string(std::uint64_t(spec.gridCells) * spec.gridCells * spec.gridCells) +
-                      " cells over " + std::to_string(scene.itemCount()) + " items"
-                : std::to_string(scene.itemCount()) + " items";
-        detail::refuseIndexMemory(spec, need, detail, spec.kind == IndexSpec::Kind::Octree);
+                      " cells over " + items
+            : spec.kind == IndexSpec::Kind::Octree
+                ? "at least " + std::to_string(need.nodesAtLeast) + " nodes over " + items
+                : items;
+        detail::refuseIndexMemory(spec, need.atLeastBytes, detail,
+                                  spec.kind == IndexSpec::Kind::Octree);
     }
     switch (spec.kind) {
     case IndexSpec::Kind::BruteForce:

@@ -280,8 +280,8 @@ TEST_CASE("an index that would exceed its memory limit is refused before it is b
                           Catch::Contains("more than the 256 MB limit") &&
                           Catch::Contains("--max-index-mb"));
 
-    // The octree's size is known only while it is built: it stops at the level that would pass
-    // the limit. Identical objects never separate, so M = 1 splits them down to MIN.
+    // Identical objects never separate, so M = 1 would split them down to MIN: the estimate's
+    // floor (every cell inside the boxes lists all four) refuses it before building anything.
     std::vector<SceneObject> same;
     for (ObjectId id = 0; id < 4; ++id) {
         same.push_back(makeBox(id, Vec3(0.0123), Vec3(0.03)));
@@ -289,17 +289,94 @@ TEST_CASE("an index that would exceed its memory limit is refused before it is b
     const Scene stacked({Vec3(-0.1), Vec3(0.1)}, std::move(same));
     IndexSpec deep = IndexSpec::octree(1, 1e-9);
     deep.maxBytes = 8ull << 20;
+    CHECK(estimateIndexMemory(stacked, deep).atLeastBytes > deep.maxBytes);
     CHECK_THROWS_WITH(buildIndex(stacked, deep),
                       Catch::StartsWith("index octree:1:1e-09 would need more than ") &&
-                          Catch::Contains("nodes by depth") && Catch::Contains("--max-index-mb"));
+                          Catch::Contains("at least ") && Catch::Contains("nodes over 4 items") &&
+                          Catch::Contains("--max-index-mb"));
 
-    // Within the limit, the estimate bounds what the grid really holds.
+    // Within the limit, the estimate bounds what the index really holds, the octree's from
+    // both sides.
     for (const auto& [name, s] : testScenes()) {
         for (const IndexSpec& spec : testSpecs()) {
             const auto index = buildIndex(s, spec);
-            if (spec.kind != IndexSpec::Kind::Octree) {
-                INFO(name << " " << spec.toString());
-                CHECK(index->stats().bytes <= estimateIndexBytes(s, spec));
+            const IndexMemoryEstimate e = estimateIndexMemory(s, spec);
+            INFO(name << " " << spec.toString());
+            CHECK(index->stats().bytes <= e.atMostBytes);
+            CHECK(e.atLeastBytes <= e.atMostBytes);
+            CHECK(e.atMostBytes == estimateIndexBytes(s, spec));
+            if (spec.kind == IndexSpec::Kind::Octree) {
+                CHECK(e.nodesAtLeast <= index->stats().nodes);
+                CHECK(e.atLeastBytes <= index->stats().buildPeakBytes);
+                CHECK(index->stats().buildPeakBytes <= e.atMostBytes);
+            }
+        }
+    }
+}
+
+namespace {
+
+/// Five boxes, each over most of the bounds, each a little offset: every cell deep inside
+/// lists all five, so a small M splits them down to MIN.
+Scene fiveLargeBoxes() {
+    std::vector<SceneObject> o;
+    const Vec3 offsets[5] = {Vec3(0.0), Vec3(0.005, 0, 0), Vec3(0, 0.005, 0), Vec3(0, 0, 0.005),
+                             Vec3(-0.005, 0, 0)};
+    for (ObjectId id = 0; id < 5; ++id) {
+        o.push_back(makeBox(id, offsets[id], Vec3(0.04)));
+    }
+    return Scene({Vec3(-0.05), Vec3(0.05)}, std::move(o));
+}
+
+} // namespace
+
+TEST_CASE("an octree's memory floor refuses a spec at once and never refuses what fits") {
+    const Scene five = fiveLargeBoxes();
+    // Issue 39: building this one level by level took 14 s and 1.4 GB before its refusal.
+    const IndexSpec huge = IndexSpec::octree(1, 1e-9);
+    const IndexMemoryEstimate e = estimateIndexMemory(five, huge);
+    CHECK(e.atLeastBytes > huge.maxBytes);
+    CHECK(e.nodesAtLeast > (std::uint64_t(1) << 26)); // more than Octree::kMaxNodes
+    CHECK_THROWS_AS(buildIndex(five, huge), IndexTooLargeError);
+
+    // Specs that fit: the build passes with its limit at its own peak accounting, and is
+    // refused one byte below it (by the floor or by the check before a level's allocation,
+    // whose message names the level's nodes once).
+    RandomOptions r;
+    r.count = 2000;
+    r.seed = 11;
+    r.cubeSize = 0.01;
+    r.rotate = true;
+    const std::pair<std::string, Scene> scenes[] = {{"five boxes", fiveLargeBoxes()},
+                                                    {"random", makeRandomScene(r)}};
+    for (const auto& [name, scene] : scenes) {
+        for (const IndexSpec& base :
+             {IndexSpec::octree(1, 0.004), IndexSpec::octree(2, 0.002), IndexSpec::octree(8, 0.001),
+              IndexSpec::octree(1, 0.004, OverlapMode::Aabb)}) {
+            INFO(name << " " << base.toString());
+            const auto index = buildIndex(scene, base);
+            const IndexStats& st = index->stats();
+            const IndexMemoryEstimate bound = estimateIndexMemory(scene, base);
+            CHECK(bound.nodesAtLeast <= st.nodes);
+            CHECK(bound.atLeastBytes <= st.buildPeakBytes);
+            CHECK(st.bytes <= bound.atMostBytes);
+            CHECK(st.buildPeakBytes <= bound.atMostBytes);
+            IndexSpec exact = base;
+            exact.maxBytes = st.buildPeakBytes;
+            CHECK(buildIndex(scene, exact)->stats().nodes == st.nodes);
+            exact.maxBytes = st.buildPeakBytes - 1;
+            try {
+                (void)buildIndex(scene, exact);
+                FAIL("built above its limit");
+            } catch (const IndexTooLargeError& err) {
+                const std::string what = err.what();
+                const auto at = what.find(" nodes by depth ");
+                if (at != std::string::npos) { // the level check: at most the tree's nodes
+                    const auto from = what.rfind('(', at) + 1;
+                    CHECK(std::stoull(what.substr(from, at - from)) <= st.nodes);
+                } else {
+                    CHECK_THAT(what, Catch::Contains("nodes over"));
+                }
             }
         }
     }

@@ -36,6 +36,9 @@ struct IndexStats {
     std::uint64_t bytes = 0;               ///< Memory of the index's arrays (bytes).
     double bytesPerObject = 0.0;           ///< bytes / objects (per item: a mesh's memory
                                            ///< per triangle).
+    std::uint64_t buildPeakBytes = 0;      ///< Octree: the most memory the build held by
+                                           ///< its own accounting (bytes), what the limit
+                                           ///< bounds; else 0.
     double buildSeconds = 0.0;             ///< Wall-clock build time (s).
     double buildCpuSeconds = 0.0;          ///< CPU time of all threads during the build (s).
 

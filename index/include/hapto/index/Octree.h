@@ -87,6 +87,10 @@ public:
     /// Most nodes a build may create (then it throws InputError: raise MIN or M).
     static constexpr std::uint32_t kMaxNodes = 1u << 26;
 
+    /// How many levels of an octree over `bounds` may split (levels 0 .. result - 1): a level
+    /// splits while its children's longest edge is at least `minLeafSize` (m) and it is above
+    /// kMaxDepth. The one rule the build and the memory estimate use. [any thread]
+    static int splitLevels(const Aabb& bounds, double minLeafSize) noexcept;
     /// Builds the tree, level by level, in parallel (TBB inside). [control]
     static std::unique_ptr<Octree> build(const Scene& scene, const IndexSpec& spec);
 
@@ -130,7 +134,7 @@ private:
     double coord(int level, std::uint32_t i, int axis) const noexcept {
         return bounds().min[axis] + static_cast<double>(i) * mStep[level][axis];
     }
-    bool canSplit(int level) const noexcept;
+    bool canSplit(int level) const noexcept { return level < mSplitLevels; }
     std::uint32_t cellIndex(int level, double v, int axis) const noexcept;
     LocateResult descend(std::uint32_t node, const Vec3& p, std::uint32_t steps) const noexcept;
     LocateResult climb(std::uint32_t leaf, const Vec3& p) const noexcept;
@@ -140,6 +144,7 @@ private:
 
     std::array<Vec3, kMaxDepth + 2> mStep{};    // cell size per level (m)
     std::array<Vec3, kMaxDepth + 2> mInvStep{}; // 1 / mStep (1/m)
+    int mSplitLevels = 0;                       // splitLevels(bounds, MIN)
     std::vector<OctreeNode> mNodes;
     std::vector<std::uint32_t> mGroupParent; // per eight siblings (nodes 1 + 8g ...): parent
     std::vector<std::uint32_t> mSlots;

@@ -129,16 +129,33 @@ private:
 
 /// Builds the index a spec asks for (in parallel, with TBB). Throws InputError for a spec
 /// that cannot be built (e.g. an octree that would need too many nodes), and
-/// IndexTooLargeError, before allocating it, for one that would need more than spec.maxBytes.
+/// IndexTooLargeError, before allocating it, for one that would need more than spec.maxBytes
+/// (estimateIndexMemory's floor; an octree checks again before each level's allocations).
 /// [control]
 std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec);
 
-/// The memory a build of this index needs at its peak (bytes), estimated without building it:
-/// brute force exactly; the grid from its cells and, per item, the cells its AABB reaches
-/// (an upper bound on the item-cell pairs: the OBB and triangle tests only remove some); the
-/// octree only its floor (the per-item arrays), since its node count is known only while it is
-/// built: Octree::build checks spec.maxBytes again before allocating each level. O(items).
-/// [control]
+/// What an index build needs at its peak (bytes), bounded from both sides without building.
+struct IndexMemoryEstimate {
+    /// The build holds at least this much: buildIndex refuses a spec whose floor passes
+    /// spec.maxBytes before building anything. Brute force and grid: their exact peak.
+    std::uint64_t atLeastBytes = 0;
+    /// The build holds at most this much (its peak accounting, index/src/IndexMemory.h).
+    /// Brute force and grid: the same as atLeastBytes.
+    std::uint64_t atMostBytes = 0;
+    /// Octree: nodes the tree surely has (a floor); 0 for the others.
+    std::uint64_t nodesAtLeast = 0;
+};
+
+/// The memory a build of this index needs at its peak, bounded without building it: brute
+/// force exactly; the grid from its cells and, per item, the cells its AABB reaches (what the
+/// build allocates: the OBB and triangle tests only remove pairs later); the octree from two
+/// cell counts per item and level (index/src/IndexMemory.cpp's note): a floor from the cells
+/// surely listing more than M items, a ceiling from the cells items reach. Octree::build
+/// checks spec.maxBytes again before allocating each level. O(items * levels), no memory per
+/// item or node. [control]
+IndexMemoryEstimate estimateIndexMemory(const Scene& scene, const IndexSpec& spec);
+
+/// estimateIndexMemory(scene, spec).atMostBytes: no build of this index holds more. [control]
 std::uint64_t estimateIndexBytes(const Scene& scene, const IndexSpec& spec);
 
 /// The bounds an index partitions: the scene's, each upper face moved out by the few ulps
