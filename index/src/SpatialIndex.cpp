@@ -89,10 +89,12 @@ std::string megabytes(std::uint64_t bytes) {
 
 void refuseIndexMemory(const IndexSpec& spec, std::uint64_t bytes, const std::string& detail,
                        bool atLeast) {
-    throw IndexTooLargeError("index " + spec.toString() + " would need " +
-                             (atLeast ? "more than " : "about ") + megabytes(bytes) +
-                             " MB of memory (" + detail + "), more than the " +
-                             megabytes(spec.maxBytes) +
+    // A saturated count (IndexMemory.h) means "more than 2^64 bytes".
+    const std::string need = bytes == std::numeric_limits<std::uint64_t>::max()
+                                 ? "more than 2^64 bytes"
+                                 : (atLeast ? "more than " : "about ") + megabytes(bytes) + " MB";
+    throw IndexTooLargeError("index " + spec.toString() + " would need " + need + " of memory (" +
+                             detail + "), more than the " + megabytes(spec.maxBytes) +
                              " MB limit; choose a coarser index (fewer grid cells, a "
                              "larger octree MIN or M) or raise the limit with --max-index-mb");
 }
