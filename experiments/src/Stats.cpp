@@ -1,6 +1,7 @@
 // The median and its order-statistic interval across repeats, and the sweep-list parser.
 
 #include "hapto/experiments/Stats.h"
+#include "hapto/experiments/Table.h"
 
 #include "hapto/io/InputError.h"
 
@@ -236,6 +237,14 @@ std::vector<std::int64_t> parseCountList(const std::string& text, const std::str
         counts.push_back(static_cast<std::int64_t>(v));
     }
     return counts;
+}
+
+std::string sweepListText(const std::vector<double>& values) {
+    std::string text;
+    for (const double v : values) {
+        text += (text.empty() ? "" : ",") + csvNumber(v);
+    }
+    return text;
 }
 
 } // namespace hapto::experiments

@@ -13,6 +13,7 @@
 
 #include "SceneFileChecks.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <optional>
@@ -324,8 +325,9 @@ void writeBinaryScene(const Scene& scene, std::ostream& os) {
                          "format version 3), which the binary format does not carry: write it "
                          "as JSON (-o F.json)");
     }
-    std::string out;
-    out.reserve(1 << 21);
+    std::string out; // flushed past 1 MB: room for that, or for the whole of a small scene
+    out.reserve(
+        std::min<std::size_t>(std::size_t{1} << 21, 4096 + 512 * std::size_t{scene.size()}));
     const auto flush = [&] {
         os.write(out.data(), static_cast<std::streamsize>(out.size()));
         out.clear();

@@ -101,21 +101,12 @@ void applyQuick(CommonArgs& a, const CommonOptions& o) {
     }
 }
 
-/// The text of a list of numbers, as --rates shows its default.
-std::string listText(const std::vector<double>& values) {
-    std::string text;
-    for (const double v : values) {
-        text += (text.empty() ? "" : ",") + csvNumber(v);
-    }
-    return text;
-}
-
 /// `--rates HZ,HZ` (and its deprecated spelling `--rate`): servo rates, 100..100000 Hz each.
 CLI::Option* addRates(CLI::App* cmd, ListOption& rates, const std::vector<double>& ratesHz,
                       const std::string& note) {
     return addList(cmd, rates, "--rates,--rate",
                    "Servo rates (Hz, 100..100000); " + note + " (--rate: the old spelling)",
-                   listText(ratesHz));
+                   sweepListText(ratesHz));
 }
 
 /// The rates --rates gives, when it was given.

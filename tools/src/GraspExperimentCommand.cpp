@@ -26,17 +26,9 @@ struct GraspOptions {
                 *ratesOpt = nullptr, *repeats = nullptr;
 };
 
-std::string listText(const std::vector<double>& values) {
-    std::string text;
-    for (const double v : values) {
-        text += (text.empty() ? "" : ",") + csvNumber(v);
-    }
-    return text;
-}
-
 CLI::Option* addList(CLI::App* cmd, std::string& text, const std::vector<double>& values,
                      const std::string& name, const std::string& help) {
-    text = listText(values);
+    text = sweepListText(values);
     return cmd->add_option(name, text, help + "; a list: 1,2,4 or A:B:STEP")->capture_default_str();
 }
 

@@ -64,6 +64,10 @@ struct SweepListRule {
 std::vector<double> parseSweepList(const std::string& text, const std::string& option,
                                    const SweepListRule& rule);
 
+/// The text parseSweepList reads back as `values` ("1000,4000"; each number as csvNumber writes
+/// it): how a list option shows its default. [any thread]
+std::string sweepListText(const std::vector<double>& values);
+
 /// parseSweepList for whole counts from `min` to `max`. [any thread]
 std::vector<std::int64_t> parseCountList(const std::string& text, const std::string& option,
                                          double min, double max);
