@@ -211,3 +211,30 @@ def test_experiment_scaling_returns_its_tables_as_columns(tmp_path):
     for name in ("load_sum", "median_device_p999", "worst_load_p999"):
         assert all(cells[name + "_lo_pct"] <= cells[name + "_pct"])
         assert all(cells[name + "_pct"] <= cells[name + "_hi_pct"])
+
+
+def test_device_dicts_carry_force_effects_as_the_device_file_does(cli, tmp_path):
+    # A free hand with a device file's effects (a constant pull and a plane spring): a stepped
+    # Python session reports exactly what `hapto run --stepped` reports for the same file, and
+    # the effects reach the device (its safety filter acts on them; without them it never does).
+    effects = [{"type": "constant", "force_n": [0, -0.5, 0]},
+               {"type": "spring", "anchor": [0, 0.05, 0], "stiffness_n_per_m": 200,
+                "normal": [0, 1, 0]}]
+    hand = {"name": "left", "kind": "sim", "sim": {"script": "free"}, "effects": effects}
+    path = tmp_path / "hands.json"
+    path.write_text(json.dumps({"format": "hapto-devices", "version": 1, "devices": [hand]}))
+    cli.run("run", "--devices", path, "--stepped", "--duration", 0.3, "--quiet", "--report",
+            tmp_path / "r.json")
+    with open(tmp_path / "r.json") as f:
+        expected = json.load(f)["devices"][0]
+    with hapto.Session(hapto.default_scene(), devices=[hand], stepped=True) as session:
+        session.run(0.3)
+        got = session.stop()["devices"][0]
+    assert got == expected
+    assert got["safety"]["clamped"] + got["safety"]["rate_limited"] > 0
+    plain = dict(hand)
+    del plain["effects"]
+    with hapto.Session(hapto.default_scene(), devices=[plain], stepped=True) as session:
+        session.run(0.3)
+        without = session.stop()["devices"][0]
+    assert without["safety"]["clamped"] + without["safety"]["rate_limited"] == 0
