@@ -7,6 +7,7 @@ the built-in physical grasp scenes against `hapto demo grasp --shape`, experimen
 import json
 import os
 import threading
+import time
 
 import numpy
 import pytest
@@ -127,15 +128,19 @@ def test_stepped_sessions_with_hands_and_a_body_repeat_exactly():
 def test_the_gil_is_released_while_a_session_runs(box_scene_file):
     session = hapto.Session(hapto.load_scene(box_scene_file), devices=[], stepped=True)
     session.step(1)
-    worker = threading.Thread(target=session.run, args=(60.0,))
+    worker = threading.Thread(target=session.run, args=(5.0,))
     seen = []
     worker.start()
     while worker.is_alive():  # Python code runs here only while run() has the GIL released
         seen.append(int(session.bodies()["step"][0]))
+        # Give the GIL back at once: run() takes it for a moment once per control step (to look
+        # for a signal), and a poller that kept it would make each step wait for Python's switch
+        # interval (5 ms): 5000 steps would take 25 s instead of a fraction of one.
+        time.sleep(0.0002)
     worker.join()
     final = int(session.bodies()["step"][0])
     session.stop()
-    assert final == 60001
+    assert final == 5001
     assert any(1 < s < final for s in seen), "no step seen while run() was running"
 
 
