@@ -38,17 +38,7 @@ Runtime::DynamicsChannel::DynamicsChannel(const WorldSnapshot& snapshot,
     }
 }
 
-namespace {
-
-bool finitePose(const BodyPose& p) noexcept {
-    return finite(p.center) && finite(p.centerOfMass) && finite(p.velocity) &&
-           finite(p.angularVelocity) && std::isfinite(p.rotation.w) &&
-           std::isfinite(p.rotation.x) && std::isfinite(p.rotation.y) &&
-           std::isfinite(p.rotation.z);
-}
-
-/// Body i's state as the table publishes it.
-BodyPose poseOf(const Dynamics& d, std::size_t i, std::uint64_t timeNs) noexcept {
+BodyPose bodyPoseOf(const Dynamics& d, std::size_t i, std::uint64_t timeNs) noexcept {
     const BodyState& b = d.bodies()[i];
     BodyPose p;
     d.objectPose(i, p.center, p.rotation);
@@ -59,6 +49,15 @@ BodyPose poseOf(const Dynamics& d, std::size_t i, std::uint64_t timeNs) noexcept
     p.step = d.stepCount();
     p.sleeping = b.sleeping;
     return p;
+}
+
+namespace {
+
+bool finitePose(const BodyPose& p) noexcept {
+    return finite(p.center) && finite(p.centerOfMass) && finite(p.velocity) &&
+           finite(p.angularVelocity) && std::isfinite(p.rotation.w) &&
+           std::isfinite(p.rotation.x) && std::isfinite(p.rotation.y) &&
+           std::isfinite(p.rotation.z);
 }
 
 BodyTraceSample sampleOf(const BodyPose& p, std::uint32_t body, std::uint64_t sinceStartNs) {
@@ -78,7 +77,7 @@ void Runtime::publishBodies(DynamicsChannel& dc, std::uint64_t timeNs) noexcept 
     const Dynamics& d = *dc.dynamics;
     for (std::size_t i = 0; i < d.bodyCount(); ++i) {
         DynamicsBodyRecord& r = dc.records[i];
-        BodyPose p = poseOf(d, i, timeNs);
+        BodyPose p = bodyPoseOf(d, i, timeNs);
         if (r.stopped.load(std::memory_order_relaxed) || !finitePose(p)) {
             if (!r.stopped.exchange(true, std::memory_order_relaxed)) {
                 dc.metrics.stoppedBodies.fetch_add(1, std::memory_order_relaxed);

@@ -278,16 +278,7 @@ struct RealRig {
     }
     void publish() {
         for (std::size_t i = 0; i < dynamics.bodyCount(); ++i) {
-            const BodyState& b = dynamics.bodies()[i];
-            BodyPose pose;
-            dynamics.objectPose(i, pose.center, pose.rotation);
-            pose.centerOfMass = b.position;
-            pose.velocity = b.velocity;
-            pose.angularVelocity = b.angularVelocity;
-            pose.timeNs = clock.nowNs();
-            pose.step = dynamics.stepCount();
-            pose.sleeping = b.sleeping;
-            table.publish(i, pose);
+            table.publish(i, bodyPoseOf(dynamics, i, clock.nowNs())); // as the dynamics thread
         }
     }
     /// The dynamics step due one period on, then every hand's tick at that instant.

@@ -27,6 +27,8 @@
 
 namespace hapto {
 
+class Dynamics;
+
 /// One body's state as published (world frame).
 struct BodyPose {
     Vec3 center{0.0};          ///< The scene object's centre (SceneObject::center) (m).
@@ -205,5 +207,11 @@ private:
     std::size_t mCount;
     std::unique_ptr<Record[]> mRecords;
 };
+
+/// Body i of `dynamics` as the dynamics thread publishes it: its object's pose, centre of
+/// mass, velocities, sleep flag and step count, stamped `timeNs` (the runtime's clock). The one
+/// conversion from a dynamics state to a table record (the dynamics thread and test rigs that
+/// step a Dynamics themselves use it). [dynamics]
+BodyPose bodyPoseOf(const Dynamics& dynamics, std::size_t i, std::uint64_t timeNs) noexcept;
 
 } // namespace hapto
