@@ -165,6 +165,11 @@ void Dynamics::objectPose(std::size_t i, Vec3& center, Quat& rotation) const noe
 }
 
 void Dynamics::applyImpulse(std::size_t i, const Vec3& linearNs, const Vec3& angularNms) noexcept {
+    // A zero impulse (the runtime hands every body its sum each step, most often nothing)
+    // changes nothing and wakes nothing: a body the hands leave alone may fall asleep.
+    if (linearNs == Vec3(0.0) && angularNms == Vec3(0.0)) {
+        return;
+    }
     mImpl->work[i].pendingLinear += linearNs;
     mImpl->work[i].pendingAngular += angularNms;
     wake(i);

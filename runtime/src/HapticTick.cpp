@@ -146,8 +146,8 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
     // 5. Safety.
     const Vec3 requested = out.render.force + externalForceN + out.effectsN + out.hookN;
     out.forceN = mSafety.filter(requested);
-    if (mCoupling.bodies().count > 0) {
-        mCoupling.split(*snapshot.scene, out.render,
+    if (mCoupling.bodies().count > 0 || snapshot.restingCount > 0) {
+        mCoupling.split(snapshot, out.render,
                         out.forceN - (externalForceN + out.effectsN + out.hookN), out.reactionN);
     }
     stamp(4);
@@ -319,6 +319,11 @@ bool place(const Scene& scene, std::uint32_t slot, std::uint32_t body, const Bod
            finite(e.render.axes[1]) && finite(e.render.axes[2]);
 }
 
+/// True when the table's `pose` is the body asleep at the rest pose `rest` (bit for bit).
+bool restsAt(const BodyRest& rest, const BodyPose& pose) noexcept {
+    return pose.sleeping && pose.center == rest.center && pose.rotation == rest.rotation;
+}
+
 /// Solves the k x k system a x = b (k <= 3) by elimination with partial pivoting; an unknown
 /// whose pivot vanishes (a dependent normal) is 0.
 std::array<double, 3> solveSmall(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b,
@@ -397,6 +402,14 @@ bool BodyCoupling::place(const WorldSnapshot& snapshot, const Vec3& p, const Vec
     const std::size_t n = std::min(slots.size(), mTable->size());
     for (std::size_t i = 0; i < n && mPlaced.count < DynamicBodySet::kMaxBodies; ++i) {
         const BodyPose pose = mTable->read(i);
+        // A body the snapshot indexed at rest: rendered from the index (a static object of the
+        // snapshot's scene) while the table shows it asleep at that pose; awake or elsewhere,
+        // its index copy is stale, so it is placed from the table wherever it is (the placed
+        // pose then stands for every item of it: bodyAt).
+        const bool indexed = i < snapshot.rest.size() && snapshot.rest[i].indexed;
+        if (indexed && coupling::restsAt(snapshot.rest[i], pose)) {
+            continue;
+        }
         const double t =
             std::clamp((static_cast<double>(mNowNs) - static_cast<double>(pose.timeNs)) * 1e-9,
                        -coupling::kMaxExtrapolationS, coupling::kMaxExtrapolationS);
@@ -408,15 +421,16 @@ bool BodyCoupling::place(const WorldSnapshot& snapshot, const Vec3& p, const Vec
         const double near = e.render.radius + reachM;
         const double d2 = std::min(glm::dot(e.center - p, e.center - p),
                                    glm::dot(e.center - proxy, e.center - proxy));
-        if (d2 <= near * near) {
+        if (indexed || d2 <= near * near) {
             mPlaced.slots[mPlaced.count++] = slots[i];
         }
     }
     return true;
 }
 
-void BodyCoupling::split(const Scene& scene, const RenderOutput& r, const Vec3& felt,
+void BodyCoupling::split(const WorldSnapshot& snapshot, const RenderOutput& r, const Vec3& felt,
                          Vec3& reactionN) noexcept {
+    const Scene& scene = *snapshot.scene;
     mShareCount = 0;
     const std::size_t k = std::min<std::size_t>(r.contactCount, 3);
     if (k == 0 || !finite(felt)) {
@@ -441,15 +455,24 @@ void BodyCoupling::split(const Scene& scene, const RenderOutput& r, const Vec3& 
     for (std::size_t i = 0; i < k; ++i) {
         const double weight = load > 0.0 ? std::max(lambda[i], 0.0) / load : 1.0 / double(k);
         const Vec3 share = lambda[i] * r.contacts[i].normal + weight * tangent;
-        const DynamicBodySet::Entry* e = mPlaced.find(scene.objectSlotOf(r.contacts[i].slot));
-        if (e == nullptr) {
+        const std::uint32_t slot = scene.objectSlotOf(r.contacts[i].slot);
+        const DynamicBodySet::Entry* e = mPlaced.find(slot);
+        // A body rendered from the index (asleep at rest) takes its share as a placed one does:
+        // the impulse wakes it in the next step, so no reaction is lost across the switch.
+        const std::int64_t resting = e == nullptr ? snapshot.restingBodyAt(slot) : -1;
+        if (e == nullptr && resting < 0) {
             continue;
         }
         const Vec3 n = r.contacts[i].normal;
-        const Material& m = scene.object(e->slot).material;
-        const double rim = std::abs(glm::dot(e->angularVelocity, n)) * mTorsionRadiusM;
-        const double mu = rim <= coupling::kStickSpeedMPerS ? m.staticFriction : m.dynamicFriction;
-        mShares[mShareCount++] = {e->body, share, r.proxy - e->centerOfMass, n,
+        const Material& m = scene.object(slot).material;
+        const double spin = e != nullptr ? std::abs(glm::dot(e->angularVelocity, n)) : 0.0;
+        const double mu = spin * mTorsionRadiusM <= coupling::kStickSpeedMPerS ? m.staticFriction
+                                                                               : m.dynamicFriction;
+        const Vec3 com = e != nullptr
+                             ? e->centerOfMass
+                             : snapshot.rest[static_cast<std::size_t>(resting)].centerOfMass;
+        const auto body = e != nullptr ? e->body : static_cast<std::uint32_t>(resting);
+        mShares[mShareCount++] = {body, share, r.proxy - com, n,
                                   mu * std::max(lambda[i], 0.0) * mTorsionRadiusM};
         reactionN += share;
     }

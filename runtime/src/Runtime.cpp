@@ -170,6 +170,19 @@ std::uint64_t Runtime::nextDeadlineNs(std::size_t i) const {
 }
 
 void Runtime::maintain() {
+    if (mDynamics) {
+        // The bodies asleep now, read from the table (lock-free): the world puts those at rest
+        // for its rest delay into the static index and takes woken ones out (World.h).
+        std::vector<BodyRest> resting;
+        for (std::size_t i = 0; i < mDynamics->ids.size(); ++i) {
+            const BodyPose p = mDynamics->poses.read(i);
+            if (p.sleeping && !mDynamics->records[i].stopped.load(std::memory_order_relaxed)) {
+                resting.push_back(
+                    {mDynamics->ids[i], false, p.center, p.rotation, p.centerOfMass, 0});
+            }
+        }
+        mWorld.setRestingBodies(std::move(resting));
+    }
     mWorld.maintain();
 }
 

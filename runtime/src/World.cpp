@@ -9,6 +9,34 @@
 
 namespace hapto {
 
+namespace {
+
+/// The same body at the same pose, bit for bit.
+bool samePose(const BodyRest& a, const BodyRest& b) noexcept {
+    return a.id == b.id && a.center == b.center && a.rotation == b.rotation;
+}
+
+/// The entry for `id` in a list sorted by id, or null.
+const BodyRest* findRest(const std::vector<BodyRest>& list, ObjectId id) noexcept {
+    const auto it = std::lower_bound(list.begin(), list.end(), id,
+                                     [](const BodyRest& r, ObjectId v) { return r.id < v; });
+    return it != list.end() && it->id == id ? &*it : nullptr;
+}
+
+} // namespace
+
+std::int64_t WorldSnapshot::restingBodyAt(std::uint32_t slot) const noexcept {
+    if (restingCount == 0) {
+        return -1;
+    }
+    const auto it = std::lower_bound(dynamic.begin(), dynamic.end(), slot);
+    if (it == dynamic.end() || *it != slot) {
+        return -1;
+    }
+    const auto i = static_cast<std::size_t>(it - dynamic.begin());
+    return i < rest.size() && rest[i].indexed ? static_cast<std::int64_t>(i) : -1;
+}
+
 World::World(Scene scene, IndexSpec spec)
     : World(std::make_shared<const Scene>(std::move(scene)), spec) {}
 
@@ -16,6 +44,12 @@ World::World(std::shared_ptr<const Scene> scene, IndexSpec spec) : mSpec(spec) {
     if (!scene) {
         throw std::invalid_argument("World: no scene");
     }
+    for (const SceneObject& o : scene->objects()) {
+        if (o.body.dynamic) {
+            mBodyIds.push_back(o.id);
+        }
+    }
+    std::sort(mBodyIds.begin(), mBodyIds.end());
     std::shared_ptr<const SpatialIndex> index = buildIndex(*scene, mSpec);
     ++mBuildsPublished;
     publish(std::move(scene), std::move(index));
@@ -60,9 +94,15 @@ void World::publish(std::shared_ptr<const Scene> scene, std::shared_ptr<const Sp
     next->scene = std::move(scene);
     next->index = std::move(index);
     next->moving = movingSlotsFor(*next->scene);
+    // The bodies keep their entries while they rest as static objects of the scene.
     for (std::uint32_t slot = 0; slot < next->scene->size(); ++slot) {
-        if (next->scene->object(slot).body.dynamic) {
+        const ObjectId id = next->scene->object(slot).id;
+        if (std::binary_search(mBodyIds.begin(), mBodyIds.end(), id)) {
             next->dynamic.push_back(slot);
+            const BodyRest* r = findRest(mRestPublished, id);
+            next->rest.push_back(r != nullptr ? *r : BodyRest{id});
+            next->rest.back().indexed = r != nullptr;
+            next->restingCount += r != nullptr ? 1 : 0;
         }
     }
     mCurrent.store(next.get(), std::memory_order_seq_cst);
@@ -112,6 +152,9 @@ void World::addObject(const SceneObject& object) {
     objects.push_back(object);
     auto scene = std::make_shared<const Scene>(cur.scene->bounds(), std::move(objects));
     mMovers.push_back({object.id, nowNs()});
+    if (object.body.dynamic) {
+        mBodyIds.insert(std::upper_bound(mBodyIds.begin(), mBodyIds.end(), object.id), object.id);
+    }
     // The old index knows nothing of the new slot; slots of the others are unchanged.
     publish(std::move(scene), cur.index);
 }
@@ -145,8 +188,19 @@ void World::startBuild() {
     auto build = std::make_unique<PendingBuild>();
     build->removed = std::exchange(mPendingRemovals, {});
     build->startedNs = nowNs();
-    std::shared_ptr<const Scene> scene =
-        build->removed.empty() ? current().scene : without(*current().scene, build->removed);
+    // The bodies at rest for restDelay (or already at rest in the index) go in at rest.
+    for (const BodyRest& r : mRestWanted) {
+        const BodyRest* published = findRest(mRestPublished, r.id);
+        if ((published != nullptr && samePose(*published, r)) ||
+            (build->startedNs >= r.sinceNs &&
+             build->startedNs - r.sinceNs >=
+                 static_cast<std::uint64_t>(std::max<std::int64_t>(0, mRestDelay.count())))) {
+            build->resting.push_back(r);
+        }
+    }
+    std::shared_ptr<const Scene> scene = withResting(
+        build->removed.empty() ? current().scene : without(*current().scene, build->removed),
+        build->resting);
     if (mClock) { // deterministic mode: built here, published by the caller at once
         std::promise<std::shared_ptr<const SpatialIndex>> built;
         built.set_value(buildIndex(*scene, mSpec));
@@ -164,6 +218,9 @@ void World::finishBuild() {
     std::shared_ptr<const SpatialIndex> index = mBuild->index.get();
     const std::uint64_t started = mBuild->startedNs;
     const std::vector<ObjectId> removed = std::move(mBuild->removed);
+    // A body that woke (or moved) while the build ran is dynamic again: its items in the new
+    // index are stale, and skipped as every dynamic object's are.
+    mRestPublished = stillWanted(mBuild->resting);
     mBuild.reset();
     // Objects that moved after the build started stay on the brute-force path.
     std::erase_if(mMovers, [&](const Mover& m) {
@@ -175,7 +232,86 @@ void World::finishBuild() {
     // moved (same slots) or were appended, so the current scene less `removed` has the same
     // slots for everything the new index holds, and the newest poses.
     const WorldSnapshot& cur = current();
-    publish(removed.empty() ? cur.scene : without(*cur.scene, removed), std::move(index));
+    publish(withResting(removed.empty() ? cur.scene : without(*cur.scene, removed), mRestPublished),
+            std::move(index));
+}
+
+std::shared_ptr<const Scene> World::withResting(std::shared_ptr<const Scene> scene,
+                                                const std::vector<BodyRest>& resting) const {
+    // Shared as it is when every body already has its flag and pose (a scene with no bodies).
+    const bool same = std::all_of(mBodyIds.begin(), mBodyIds.end(), [&](ObjectId id) {
+        const auto slot = scene->slotOf(id);
+        if (!slot) {
+            return true;
+        }
+        const SceneObject& o = scene->object(*slot);
+        const BodyRest* r = findRest(resting, id);
+        return r == nullptr ? o.body.dynamic
+                            : !o.body.dynamic && o.center == r->center && o.rotation == r->rotation;
+    });
+    if (same) {
+        return scene;
+    }
+    std::vector<SceneObject> objects(scene->objects().begin(), scene->objects().end());
+    for (SceneObject& o : objects) {
+        if (!std::binary_search(mBodyIds.begin(), mBodyIds.end(), o.id)) {
+            continue;
+        }
+        const BodyRest* r = findRest(resting, o.id);
+        o.body.dynamic = r == nullptr; // at rest: a static object of this scene
+        if (r != nullptr) {
+            o.center = r->center;
+            o.rotation = r->rotation;
+        }
+    }
+    auto out = std::make_shared<Scene>(scene->bounds(), std::move(objects));
+    out->setPhysics(scene->physics());
+    return out;
+}
+
+std::vector<BodyRest> World::stillWanted(const std::vector<BodyRest>& resting) const {
+    std::vector<BodyRest> keep;
+    for (const BodyRest& r : resting) {
+        const BodyRest* wanted = findRest(mRestWanted, r.id);
+        if (wanted != nullptr && samePose(*wanted, r)) {
+            keep.push_back(r);
+        }
+    }
+    return keep;
+}
+
+void World::setRestingBodies(std::vector<BodyRest> resting) {
+    std::erase_if(resting, [&](const BodyRest& r) {
+        return !std::binary_search(mBodyIds.begin(), mBodyIds.end(), r.id);
+    });
+    std::sort(resting.begin(), resting.end(),
+              [](const BodyRest& a, const BodyRest& b) { return a.id < b.id; });
+    resting.erase(std::unique(resting.begin(), resting.end(),
+                              [](const BodyRest& a, const BodyRest& b) { return a.id == b.id; }),
+                  resting.end());
+    const std::uint64_t now = nowNs();
+    for (BodyRest& r : resting) {
+        const BodyRest* before = findRest(mRestWanted, r.id);
+        r.indexed = false;
+        r.sinceNs = before != nullptr && samePose(*before, r) ? before->sinceNs : now;
+    }
+    mRestWanted = std::move(resting);
+    // Woken (or moved) bodies leave the static world at once, over the same index: no build.
+    std::vector<BodyRest> keep = stillWanted(mRestPublished);
+    if (keep.size() != mRestPublished.size()) {
+        mRestPublished = std::move(keep);
+        const WorldSnapshot& cur = current();
+        publish(withResting(cur.scene, mRestPublished), cur.index);
+    }
+}
+
+bool World::restDue(std::uint64_t now) const {
+    const auto delay = static_cast<std::uint64_t>(std::max<std::int64_t>(0, mRestDelay.count()));
+    return std::any_of(mRestWanted.begin(), mRestWanted.end(), [&](const BodyRest& r) {
+        const BodyRest* published = findRest(mRestPublished, r.id);
+        return (published == nullptr || !samePose(*published, r)) && now >= r.sinceNs &&
+               now - r.sinceNs >= delay;
+    });
 }
 
 void World::maintain() {
@@ -189,7 +325,7 @@ void World::maintain() {
     const std::uint64_t now = nowNs();
     const bool anyRested =
         std::any_of(mMovers.begin(), mMovers.end(), [&](const Mover& m) { return rested(m, now); });
-    if (anyRested || !mPendingRemovals.empty()) {
+    if (anyRested || !mPendingRemovals.empty() || restDue(now)) {
         startBuild();
         if (mClock) {
             finishBuild(); // built inline: publish it now
@@ -206,7 +342,7 @@ void World::settle() {
             finishBuild();
         }
         const std::uint64_t now = nowNs();
-        if (mPendingRemovals.empty() &&
+        if (mPendingRemovals.empty() && !restDue(now) &&
             std::none_of(mMovers.begin(), mMovers.end(),
                          [&](const Mover& m) { return rested(m, now); })) {
             break;

@@ -98,7 +98,8 @@ public:
 
     /// Applies an impulse to body i at the start of the next step, waking it: linear (N s,
     /// world) and angular about its centre of mass (N m s, world); what the hands hand back
-    /// (BodyPoseTable::takeImpulse's sums). Never allocates.
+    /// (BodyPoseTable::takeImpulse's sums). A zero impulse does nothing (it wakes no body).
+    /// Never allocates.
     void applyImpulse(std::size_t i, const Vec3& linearNs, const Vec3& angularNms) noexcept;
     /// The hands' torsional friction on body i for the next step (their soft-finger patches,
     /// runtime/BodyCoupling.h): `budgetNms` = sum over the hands' sent ticks of

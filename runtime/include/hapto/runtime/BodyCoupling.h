@@ -62,14 +62,18 @@ public:
     }
     /// Places the snapshot's dynamic bodies whose bounding sphere comes within `reachM` (m) of
     /// the device point `p` or the proxy, at their table poses extrapolated to the time use()
-    /// gave, and where the same motion had them `dtS` before; forgets the shares. Returns
-    /// false when no body could be placed (no table, or no dynamic object). [servo]
+    /// gave, and where the same motion had them `dtS` before; forgets the shares. A body the
+    /// snapshot holds at rest in its index (WorldSnapshot::rest) is left to the index while
+    /// the table shows it asleep at that pose, and placed wherever it is otherwise (awake, or
+    /// asleep elsewhere: its index copy is stale). Returns false when no body could be placed
+    /// (no table, or no dynamic object). [servo]
     bool place(const WorldSnapshot& snapshot, const Vec3& p, const Vec3& proxy, double reachM,
                double dtS) noexcept;
     /// Splits `felt` (N), the part of the force to send that the contacts of `render` exert,
-    /// among the contact planes, keeps the placed bodies' shares for handBack() and adds them
-    /// to `reactionN`. [servo]
-    void split(const Scene& scene, const RenderOutput& render, const Vec3& felt,
+    /// among the contact planes, keeps the shares of the placed bodies and of the bodies
+    /// `snapshot` renders from its index at rest for handBack() and adds them to
+    /// `reactionN`. [servo]
+    void split(const WorldSnapshot& snapshot, const RenderOutput& render, const Vec3& felt,
                Vec3& reactionN) noexcept;
     /// The force split() saw was sent: hands each share's body its reaction (-share x `dtS`
     /// N s at the contact point, linear and about its centre of mass) and its torsional budget

@@ -25,7 +25,9 @@ namespace hapto {
 /// The dynamic bodies placed for one tick (world frame). [servo] (one per haptic tick)
 struct DynamicBodySet {
     /// Bodies one tick can place near the tool; farther ones beyond it are not rendered that
-    /// tick (HapticTick counts none: the scenes here hold a few bodies).
+    /// tick (HapticTick counts none). Only awake bodies take places: a body asleep in the
+    /// snapshot's index is rendered from the index (WorldSnapshot::rest), so a scene may hold
+    /// any number of sleeping bodies near the tool.
     static constexpr std::size_t kMaxBodies = 16;
 
     /// One placed body.

@@ -237,7 +237,10 @@ public:
     /// True after startStepped(). [control]
     bool stepped() const { return mClock != nullptr; }
     /// World upkeep (re-indexing rested objects, freeing old snapshots): call every few
-    /// milliseconds from the thread that updates the world. Supervision does not depend on
+    /// milliseconds from the thread that updates the world. With dynamics, it also hands the
+    /// world the bodies the table shows asleep (World::setRestingBodies): a body asleep for
+    /// the world's rest delay re-enters the static index, a woken one leaves it; the servo and
+    /// dynamics threads never wait for either. Supervision does not depend on
     /// it. [control]
     void maintain();
     /// Stops every thread: each commands zero force, then the devices are closed. Waits for a

@@ -19,7 +19,28 @@
 
 namespace hapto {
 
+/// A dynamic body at rest, as the control thread hands it to the world
+/// (World::setRestingBodies; Runtime::maintain reads it from the BodyPoseTable), and as a
+/// snapshot records it (WorldSnapshot::rest).
+struct BodyRest {
+    ObjectId id = 0;           ///< The scene object's id.
+    bool indexed = false;      ///< In a snapshot: the body rests in its scene and index.
+    Vec3 center{0.0};          ///< The rest pose's SceneObject::center (m), as published.
+    Quat rotation{1, 0, 0, 0}; ///< The rest pose's rotation, as published (bit for bit).
+    Vec3 centerOfMass{0.0};    ///< The centre of mass at rest (m).
+    std::uint64_t sinceNs = 0; ///< [control] Handed to the world at this pose since (ns).
+};
+
 /// One immutable state of the world. Servo threads hold a raw pointer to it for a tick.
+///
+/// Sleeping bodies. A dynamic body that sleeps (BodyPose::sleeping) re-enters the static world
+/// once the control thread's upkeep has indexed it: in such a snapshot its object is a static
+/// object of `scene` (`body.dynamic` false) at its rest pose, the index holds its items there,
+/// `dynamic` still lists its slot (body i stays entry i) and `rest[i]` says so, with the rest
+/// pose bit for bit as the table published it. A servo renders it from the index like any
+/// static object while the table shows it asleep at that pose, and from the table (placed in
+/// its DynamicBodySet) as soon as the table shows it awake or elsewhere: waking needs no new
+/// snapshot.
 struct WorldSnapshot {
     std::uint64_t version = 0;                 ///< Increases with every publication.
     std::shared_ptr<const Scene> scene;        ///< Every object at its current pose.
@@ -30,11 +51,19 @@ struct WorldSnapshot {
     /// Slots of the scene's dynamic objects (BodyProperties::dynamic) in slot order: entry i
     /// is body i of the BodyPoseTable. Their poses come from that table, never from `scene`.
     std::vector<std::uint32_t> dynamic;
+    /// One per entry of `dynamic`: whether body i rests in this snapshot's scene and index
+    /// (`indexed`), and at which pose.
+    std::vector<BodyRest> rest;
+    /// Bodies with `rest[i].indexed`.
+    std::uint32_t restingCount = 0;
 
     /// The moving slots as a span. [servo]
     std::span<const std::uint32_t> movingSlots() const noexcept { return moving; }
     /// The dynamic slots as a span (body i is entry i). [servo]
     std::span<const std::uint32_t> dynamicSlots() const noexcept { return dynamic; }
+    /// The body whose object is in `slot` and rests in this snapshot's index, or -1. O(log
+    /// bodies). [servo]
+    std::int64_t restingBodyAt(std::uint32_t slot) const noexcept;
 };
 
 /// A servo thread's published claim on a snapshot (a hazard pointer), one cache line each.
@@ -110,6 +139,17 @@ public:
     /// shutdown. [control]
     void settle();
 
+    /// The dynamic bodies asleep now (id, rest pose as the table published it; `indexed` and
+    /// `sinceNs` are ignored). A body listed at the same pose for `restDelay` is put into the
+    /// static index by a later maintain() (a new index built over the scene with the body at
+    /// that pose as a static object, published with it); a body no longer listed, or listed
+    /// at another pose, becomes dynamic again at once in a snapshot that shares the current
+    /// index (its items there are then stale and skipped, as every dynamic object's are).
+    /// Ids of objects that are not dynamic bodies are ignored. [control]
+    void setRestingBodies(std::vector<BodyRest> resting);
+    /// Bodies resting in the current snapshot's index. [control]
+    std::uint32_t restingIndexed() const { return current().restingCount; }
+
     /// How long an object must stay still before it goes back into the index.
     void setRestDelay(std::chrono::nanoseconds delay) { mRestDelay = delay; }
     /// Deterministic mode, for the runtime's step mode, tests and tools: times (moves, the
@@ -132,6 +172,7 @@ private:
     };
     struct PendingBuild {
         std::vector<ObjectId> removed; // ids this build leaves out
+        std::vector<BodyRest> resting; // bodies this build's scene holds at rest, by id
         std::uint64_t startedNs;
         std::future<std::shared_ptr<const SpatialIndex>> index;
     };
@@ -142,6 +183,10 @@ private:
     static std::shared_ptr<const Scene> without(const Scene& scene,
                                                 const std::vector<ObjectId>& ids);
     void finishBuild();
+    std::shared_ptr<const Scene> withResting(std::shared_ptr<const Scene> scene,
+                                             const std::vector<BodyRest>& resting) const;
+    std::vector<BodyRest> stillWanted(const std::vector<BodyRest>& resting) const;
+    bool restDue(std::uint64_t nowNs) const;
     void reclaim();
     std::uint64_t nowNs() const noexcept;
     bool rested(const Mover& mover, std::uint64_t nowNs) const noexcept;
@@ -155,6 +200,9 @@ private:
     std::vector<Mover> mMovers;
     std::unique_ptr<PendingBuild> mBuild;
     std::vector<ObjectId> mPendingRemovals; // removals wait for a build
+    std::vector<ObjectId> mBodyIds;         // the dynamic bodies' ids, sorted
+    std::vector<BodyRest> mRestWanted;      // asleep now, by id (setRestingBodies)
+    std::vector<BodyRest> mRestPublished;   // at rest in the current snapshot, by id
     std::chrono::nanoseconds mRestDelay = std::chrono::milliseconds(100);
     const ManualClock* mClock = nullptr; // deterministic mode; nullptr: CLOCK_MONOTONIC
     std::uint64_t mVersion = 0;
