@@ -36,7 +36,7 @@ std::unique_ptr<TickRun> makeRun(World& world, const Scene& scene, const TickBen
         c.name = "bench";
         inner = makeDevice(c, scene);
     }
-    auto device = std::make_unique<WalkDevice>(s.walkIn, s.seed, std::move(inner));
+    auto device = std::make_unique<WalkDevice>(s.walkIn, s.seed, std::move(inner), s.path);
     run->device = device.get();
     run->owned = std::move(device);
     if (run->owned->open() != DeviceStatus::Ok) {
@@ -59,8 +59,32 @@ std::unique_ptr<TickRun> makeRun(World& world, const Scene& scene, const TickBen
     run->tickNs.assign(s.ticks, 0.0);
     run->forceN.assign(s.ticks, Vec3(0.0));
     run->gapM.assign(s.ticks, 0.0);
+    run->counts.assign(s.ticks, TickCounts{});
     run->startLateNs.reserve(s.ticks); // filled in the sleep modes only
     return run;
+}
+
+/// What `tick` did; `before` is the previous tick's render (null for the first tick).
+TickCounts countsOf(const TickOutput& tick, const RenderOutput* before) {
+    const RenderOutput& r = tick.render;
+    TickCounts c;
+    c.candidates = r.objectsTested;
+    c.solves = tick.solves;
+    c.passes = r.iterations;
+    c.extraLeaves = tick.extraLeaves;
+    c.pullBacks = tick.pullBacks;
+    c.contacts = r.contactCount;
+    for (std::size_t i = 0; i < r.contactCount; ++i) {
+        bool held = false;
+        for (std::size_t j = 0; before != nullptr && j < before->contactCount; ++j) {
+            const Contact& b = before->contacts[j];
+            // The same item's same plane (a box's face; a triangle), to rounding.
+            held = held || (b.slot == r.contacts[i].slot &&
+                            glm::dot(b.normal, r.contacts[i].normal) > 1.0 - 1e-9);
+        }
+        c.facetsEntered += held ? 0 : 1;
+    }
+    return c;
 }
 
 /// Tick `at` of `run`, woken at `wakeNs` for the deadline `deadlineNs`: the servo's step with
@@ -90,6 +114,12 @@ void timedTick(TickRun& run, std::size_t at, std::uint64_t wakeNs, std::uint64_t
     run.extraLeaves += tick.extraLeaves;
     run.pullBacks += tick.pullBacks;
     run.gapM[at] = glm::length(p.devicePointM - tick.render.proxy);
+    const TickCounts c = countsOf(tick, at > 0 ? &run.lastRender : nullptr);
+    run.counts[at] = c;
+    run.passes += c.passes;
+    run.multiContactTicks += c.contacts >= 2 ? 1 : 0;
+    run.facetsEntered += c.facetsEntered;
+    run.lastRender = tick.render;
     holdHandBack(run.device->walk(), p.devicePointM, tick.render.proxy, pushM);
 }
 
@@ -132,8 +162,9 @@ void driveTicks(TickRun& run, std::size_t at, std::size_t count, const TickBench
 
 } // namespace
 
-WalkDevice::WalkDevice(const Aabb& bounds, std::uint64_t seed, std::unique_ptr<Device> inner)
-    : mWalk(bounds, seed), mInner(std::move(inner)) {}
+WalkDevice::WalkDevice(const Aabb& bounds, std::uint64_t seed, std::unique_ptr<Device> inner,
+                       std::vector<Vec3> path)
+    : mWalk(bounds, seed), mPath(std::move(path)), mInner(std::move(inner)) {}
 
 DeviceStatus WalkDevice::open() {
     return mInner ? mInner->open() : DeviceStatus::Ok;
@@ -147,7 +178,13 @@ void WalkDevice::close() {
 
 DeviceStatus WalkDevice::read(DeviceState& state) noexcept {
     const DeviceStatus st = mInner ? mInner->read(state) : DeviceStatus::Ok;
-    state.position = mWalk.next(); // an inner hand was read; the walk drives the tick
+    // An inner hand was read; the walk or the path drives the tick.
+    if (mPath.empty()) {
+        state.position = mWalk.next();
+    } else {
+        state.position = mPath[mPathAt];
+        mPathAt = mPathAt + 1 < mPath.size() ? mPathAt + 1 : 0;
+    }
     state.hasVelocity = false;
     return st;
 }
@@ -247,6 +284,7 @@ Quantiles quantilesOf(std::vector<double> ns) {
     }
     q.mean = sum / static_cast<double>(ns.size());
     std::sort(ns.begin(), ns.end());
+    q.max = ns.back();
     q.p50 = quantileOfSorted(ns, 0.5);
     q.p99 = quantileOfSorted(ns, 0.99);
     q.p999 = quantileOfSorted(ns, 0.999);

@@ -8,6 +8,7 @@
 
 #include "hapto/experiments/HandWalk.h"
 #include "hapto/experiments/TickBench.h"
+#include "hapto/experiments/TickMotion.h"
 #include "hapto/index/Cursor.h"
 #include "hapto/index/SpatialIndex.h"
 #include "hapto/io/InputError.h"
@@ -241,10 +242,18 @@ struct TickArgs {
     double walkEdgeM = 0.0;                  ///< 0: the walk roams the scene's bounds
     std::string json;
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
+    std::vector<std::string> motions;      ///< --motion: names, or "all"
+    experiments::MotionOptions motionSize; ///< --objects (ticks and seed from settings)
+    std::vector<std::string> modes;        ///< --mode: hot, sleep, sleep+warm
+    bool pushMmGiven = false;              ///< --push-mm was given (refused with --motion)
 };
 
 nlohmann::ordered_json toJson(const Quantiles& q) {
-    return {{"ns_p50", q.p50}, {"ns_p99", q.p99}, {"ns_p999", q.p999}, {"ns_mean", q.mean}};
+    return {{"ns_p50", q.p50},
+            {"ns_p99", q.p99},
+            {"ns_p999", q.p999},
+            {"ns_max", q.max},
+            {"ns_mean", q.mean}};
 }
 
 /// The device point's distance from the proxy over a run's ticks (m).
@@ -280,6 +289,11 @@ experiments::TickBenchSettings tickSettings(const TickArgs& args) {
         refuseSameFile(args.json, "--json", args.scene, "--scene");
     }
     s.simDevice = args.device == "sim";
+    for (const std::string& m : args.modes) {
+        s.modes.push_back(m == "hot"     ? TickMode::Hot
+                          : m == "sleep" ? TickMode::Sleep
+                                         : TickMode::Warm); // the option checked the names
+    }
     return s;
 }
 
@@ -379,7 +393,189 @@ nlohmann::ordered_json tickJson(const TickArgs& args, const experiments::TickBen
             {"start_late", toJson(quantilesOf(run.startLateNs))}};
 }
 
+// ---- `hapto bench tick --motion` -------------------------------------------------------------
+// Each motion (experiments/TickMotion.h) over its own generated scene, one after another, every
+// mode asked for (hot alone by default) through the same harness; a row per motion, index and
+// mode with the tick's quantiles and the work counts that explain them.
+
+/// The motions --motion names, in the suite's order ("all": every one).
+std::vector<experiments::TickMotion> parseMotions(const std::vector<std::string>& names) {
+    std::vector<experiments::TickMotion> out;
+    for (const std::string& n : names) {
+        if (n == "all") {
+            out.assign(experiments::kTickMotions.begin(), experiments::kTickMotions.end());
+            continue;
+        }
+        const auto m = experiments::parseTickMotion(n);
+        if (!m) {
+            throw InputError("--motion '" + n + "': unknown motion; use " +
+                             experiments::tickMotionNames() + " or all");
+        }
+        if (std::find(out.begin(), out.end(), *m) == out.end()) {
+            out.push_back(*m);
+        }
+    }
+    return out;
+}
+
+/// What a run's ticks did: means, the largest counts, and the slowest tick's counts.
+struct MotionWork {
+    double solves = 0, candidates = 0, passes = 0, extraLeaves = 0, pullBacks = 0,
+           facetsEntered = 0, contact = 0, multiContact = 0;
+    std::uint32_t maxSolves = 0, maxCandidates = 0;
+    experiments::TickCounts worst; ///< The slowest tick's.
+};
+
+MotionWork workOf(const TickRun& run) {
+    MotionWork w;
+    const double n = static_cast<double>(run.ticks);
+    w.solves = static_cast<double>(run.solves) / n;
+    w.candidates = static_cast<double>(run.candidates) / n;
+    w.passes = static_cast<double>(run.passes) / n;
+    w.extraLeaves = static_cast<double>(run.extraLeaves) / n;
+    w.pullBacks = static_cast<double>(run.pullBacks) / n;
+    w.facetsEntered = static_cast<double>(run.facetsEntered) / n;
+    w.contact = static_cast<double>(run.contactTicks) / n;
+    w.multiContact = static_cast<double>(run.multiContactTicks) / n;
+    for (const experiments::TickCounts& c : run.counts) {
+        w.maxSolves = std::max<std::uint32_t>(w.maxSolves, c.solves);
+        w.maxCandidates = std::max(w.maxCandidates, c.candidates);
+    }
+    const auto slowest = std::max_element(run.tickNs.begin(), run.tickNs.end());
+    w.worst = run.counts[static_cast<std::size_t>(slowest - run.tickNs.begin())];
+    return w;
+}
+
+nlohmann::ordered_json countsJson(const experiments::TickCounts& c) {
+    return {
+        {"candidates", c.candidates},       {"solves", c.solves},        {"passes", c.passes},
+        {"extra_leaves", c.extraLeaves},    {"pull_backs", c.pullBacks}, {"contacts", c.contacts},
+        {"facets_entered", c.facetsEntered}};
+}
+
+/// One motion run's JSON entry.
+nlohmann::ordered_json motionJson(const experiments::MotionCase& c, const TickTarget& target,
+                                  const TickRun& run, const Quantiles& tick, double restP999) {
+    const MotionWork w = workOf(run);
+    nlohmann::ordered_json stages = nlohmann::ordered_json::object();
+    for (std::size_t st = 0; st < kStageCount; ++st) {
+        stages[ServoStepProbe::kStageNames[st]] = toJson(quantilesOf(run.stageNs[st]));
+    }
+    return {{"motion", experiments::tickMotionName(c.motion)},
+            {"scene", c.sceneText},
+            {"path", c.pathText},
+            {"objects", c.scene.size()},
+            {"index", target.spec.toString()},
+            {"mode", modeName(run)},
+            {"ticks", run.ticks},
+            {"tick", toJson(tick)},
+            {"p999_over_rest", restP999 > 0 ? tick.p999 / restP999 : 0.0},
+            {"stages", stages},
+            {"contact_fraction", w.contact},
+            {"multi_contact_fraction", w.multiContact},
+            {"solves_mean", w.solves},
+            {"candidates_mean", w.candidates},
+            {"passes_mean", w.passes},
+            {"extra_leaves_mean", w.extraLeaves},
+            {"pull_backs_mean", w.pullBacks},
+            {"facets_entered_mean", w.facetsEntered},
+            {"solves_max", w.maxSolves},
+            {"candidates_max", w.maxCandidates},
+            {"slowest_tick", countsJson(w.worst)},
+            {"gap_m", gapJson(run.gapM)}};
+}
+
+void printMotionRow(const experiments::MotionCase& c, const TickTarget& target, const TickRun& run,
+                    const Quantiles& q, double restP999) {
+    const MotionWork w = workOf(run);
+    std::printf("%-8s %-15s %-10s %8.0f %8.0f %9.0f %9.0f %6s %5.0f%% %5.0f%% %6.2f %6.2f "
+                "%7.1f %6.2f %5.2f %6.2f | %3u %6u | %2u %5u %3u %2u %2u\n",
+                std::string(experiments::tickMotionName(c.motion)).c_str(),
+                target.spec.toString().c_str(), modeName(run), q.p50, q.p99, q.p999, q.max,
+                restP999 > 0 ? (std::to_string(q.p999 / restP999).substr(0, 5) + "x").c_str() : "-",
+                100.0 * w.contact, 100.0 * w.multiContact, w.solves, w.passes, w.candidates,
+                w.extraLeaves, w.pullBacks, w.facetsEntered, w.maxSolves, w.maxCandidates,
+                static_cast<unsigned>(w.worst.solves), w.worst.candidates,
+                static_cast<unsigned>(w.worst.passes), static_cast<unsigned>(w.worst.extraLeaves),
+                static_cast<unsigned>(w.worst.pullBacks));
+}
+
+void runMotions(const TickArgs& args) {
+    if (!args.scene.empty() || args.walkEdgeM > 0.0 || args.pushMmGiven) {
+        throw InputError(std::string(!args.scene.empty()  ? "--scene"
+                                     : args.walkEdgeM > 0 ? "--walk-edge"
+                                                          : "--push-mm") +
+                         ": not with --motion; each motion generates its own scene and path");
+    }
+    const std::vector<experiments::TickMotion> motions = parseMotions(args.motions);
+    TickArgs base = args;
+    if (base.modes.empty()) {
+        base.modes = {"hot"};
+    }
+    const experiments::TickBenchSettings common = tickSettings(base);
+    experiments::MotionOptions size = args.motionSize;
+    size.ticks = common.ticks;
+    size.seed = common.seed;
+
+    std::printf("motions: %zu ticks of 1 ms each, seed %llu, device %s, about %zu objects or "
+                "triangles; one after another, each over its own scene\n",
+                common.ticks, static_cast<unsigned long long>(common.seed), args.device.c_str(),
+                size.objects);
+    std::printf("timing:  steady clock at each stage boundary (one reading costs ~%.0f ns); "
+                "nearest-rank quantiles over every tick (ns)\n",
+                clockOverheadNs());
+    std::printf("counts:  per tick, means: solves, passes (solver passes of the last solve), "
+                "candidates, extra leaves, pull-backs, facets entered; max: the largest solves "
+                "and candidates of any tick; slowest: that tick's solves, candidates, passes, "
+                "extra leaves, pull-backs\n\n");
+    std::printf("%-8s %-15s %-10s %8s %8s %9s %9s %6s %6s %6s %6s %6s %7s %6s %5s %6s | %10s | "
+                "%s\n",
+                "motion", "index", "mode", "p50", "p99", "p99.9", "max", "/rest", "contact", "2+",
+                "solves", "passes", "cand.", "extra", "pull", "facets", "max s/cand",
+                "slowest s cand pa ex pb");
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    std::vector<std::string> described;
+    double restP999 = 0.0;
+    for (const experiments::TickMotion m : motions) {
+        const experiments::MotionCase c = experiments::makeMotionCase(m, size);
+        experiments::TickBenchSettings s = common;
+        if (args.indices.empty()) {
+            s.indices = {c.index.withMaxMegabytes(args.maxIndexMb)};
+        }
+        s.path = c.path;
+        s.walkIn = c.path.empty() ? c.walkIn : c.scene.bounds();
+        s.pushMm = c.pushMm;
+        const std::vector<TickTarget> targets = experiments::runTickBench(c.scene, s);
+        for (const TickTarget& target : targets) {
+            for (const auto& run : target.runs) {
+                const Quantiles q = quantilesOf(run->tickNs);
+                if (m == experiments::TickMotion::Rest && restP999 == 0.0) {
+                    restP999 = q.p999;
+                }
+                printMotionRow(c, target, *run, q,
+                               m == experiments::TickMotion::Rest ? 0 : restP999);
+                out.push_back(motionJson(c, target, *run, q, restP999));
+                keep(run->kept);
+            }
+        }
+        described.push_back(std::string(experiments::tickMotionName(m)) + ": " + c.sceneText +
+                            "; " + c.pathText);
+    }
+    std::printf("\n");
+    for (const std::string& d : described) {
+        std::printf("%s\n", d.c_str());
+    }
+    if (!args.json.empty()) {
+        writeFileAtomically(args.json, out.dump(2) + "\n");
+        std::printf("\nwrote %s\n", args.json.c_str());
+    }
+}
+
 void runTick(const TickArgs& args) {
+    if (!args.motions.empty()) {
+        runMotions(args);
+        return;
+    }
     experiments::TickBenchSettings s = tickSettings(args);
     const Scene scene = loadSceneOrDefault(args.scene);
     s.walkIn = experiments::walkBox(scene.bounds(), args.walkEdgeM);
@@ -515,9 +711,34 @@ void addBenchCommands(CLI::App& app) {
                      "device, walk_min, walk_max, stages: {read, ...: {ns_p50, ns_p99, ns_p999, "
                      "ns_mean}}, tick: "
                      "{...}, locate_steps_mean, candidates_mean, contact_fraction} to this file");
+    tick->add_option("--motion", targs->motions,
+                     "Instead of one scene's walk, adversarial hand motions, each over its own "
+                     "generated scene, repeatable: rest (the baseline: resting 0.5 mm inside a "
+                     "cube's face), walk (the walk held at 2 mm), trapped (the walk deep in "
+                     "dense cubes, never held back), sweep (straight lines at 1 m/s through the "
+                     "cubes), graze (along cube edges and across vertices), sphere (sliding over "
+                     "a fine-faceted sphere), slabs (through 20 thin slabs at 1 m/s), or all. "
+                     "Reports per motion the tick's p50, p99, p99.9 and max, p99.9 over rest's, "
+                     "and the work that explains them: solves, solver passes, candidates, extra "
+                     "leaves, pull-backs, facets entered, the slowest tick's counts. Hot mode "
+                     "only unless --mode says otherwise; not with --scene, --walk-edge or "
+                     "--push-mm");
+    tick->add_option("--objects", targs->motionSize.objects,
+                     "With --motion: cubes in the cube scenes (the lattice rounds to K^3) and "
+                     "triangles in the sphere, e.g. 1e6")
+        ->capture_default_str()
+        ->transform(wholeNumber(8, 1e7));
+    tick->add_option("--mode", targs->modes,
+                     "Modes to run, repeatable: hot, sleep, sleep+warm (default: all three; "
+                     "with --motion: hot)")
+        ->check(CLI::IsMember({"hot", "sleep", "sleep+warm"}));
     setExamples(tick, {"hapto bench tick --ticks 5000",
+                       "hapto bench tick --motion all --ticks 5000 --json motions.json",
                        "hapto bench tick --scene mesh.json --device sim --json tick.json"});
-    tick->callback([targs] { runTick(*targs); });
+    tick->callback([targs, tick] {
+        targs->pushMmGiven = tick->count("--push-mm") > 0;
+        runTick(*targs);
+    });
 }
 
 } // namespace hapto::cli

@@ -18,6 +18,7 @@
 #include "hapto/devices/Device.h"
 #include "hapto/experiments/HandWalk.h"
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/runtime/RenderOutput.h"
 #include "hapto/runtime/ServoLoop.h"
 #include "hapto/runtime/ServoStep.h"
 #include "hapto/runtime/World.h"
@@ -34,13 +35,16 @@
 namespace hapto::experiments {
 
 /// A device that plays a hand walk: read() hands over the walk's next point (device frame =
-/// world frame) without a velocity, write() keeps the force. Over an `inner` device (a
+/// world frame) without a velocity, write() keeps the force; given a path, it plays the path's
+/// points in turn instead (cyclically), and the walk is not used. Over an `inner` device (a
 /// simulated hand) it reads and writes that one too and reports its status, with the walk's
 /// point in place of its position. Kind "scripted": made by a program, never by a device file.
 class WalkDevice final : public Device {
 public:
-    /// A walk over `bounds` (m) from `seed`; `inner` may be null. [control]
-    WalkDevice(const Aabb& bounds, std::uint64_t seed, std::unique_ptr<Device> inner = nullptr);
+    /// A walk over `bounds` (m) from `seed`, or `path` (m) when it is not empty; `inner` may
+    /// be null. [control]
+    WalkDevice(const Aabb& bounds, std::uint64_t seed, std::unique_ptr<Device> inner = nullptr,
+               std::vector<Vec3> path = {});
     std::string_view name() const override { return "walk"; }
     DeviceKind kind() const override { return DeviceKind::Scripted; }
     DeviceCapabilities capabilities() const override { return {}; }
@@ -57,6 +61,8 @@ public:
 
 private:
     HandWalk mWalk;
+    std::vector<Vec3> mPath;
+    std::size_t mPathAt = 0;
     std::unique_ptr<Device> mInner;
     Vec3 mForceN{0.0};
 };
@@ -89,6 +95,22 @@ struct TickBenchSettings {
     std::int32_t wakeLatencyUs = -1; ///< >= 0: also the sleep modes with this request held.
     /// The modes to run; empty: hot, sleep, sleep+warm (and the held ones with wakeLatencyUs).
     std::vector<TickMode> modes;
+    /// Not empty: the device plays these points (m), one a tick, cyclically, in place of the
+    /// walk (pushMm should then be 0: a path is not held back).
+    std::vector<Vec3> path;
+};
+
+/// What one tick did, the work that explains its time.
+struct TickCounts {
+    std::uint32_t candidates = 0; ///< Candidate slots the renderer examined, every solve.
+    std::uint8_t solves = 0;      ///< Renderer solves (TickOutput::solves).
+    std::uint8_t passes = 0;      ///< Solver passes of the last solve (RenderOutput::iterations).
+    std::uint8_t extraLeaves = 0; ///< Extra leaves listed (TickOutput::extraLeaves).
+    std::uint8_t pullBacks = 0;   ///< Pull-backs (TickOutput::pullBacks).
+    std::uint8_t contacts = 0;    ///< Active constraints at the end (0 to 3).
+    /// Facets entered: the tick's contact planes (item and normal) that the previous tick's
+    /// contacts did not hold: the faces, edges' sides and triangles the proxy moved onto.
+    std::uint8_t facetsEntered = 0;
 };
 
 /// One (index, mode) being driven: its device, its step and its per-tick samples.
@@ -101,17 +123,22 @@ struct TickRun {
     std::unique_ptr<ServoStepShared> shared; ///< Its metrics and mailboxes.
     ServoStepProbe probe;                    ///< The last tick's stage ends and what it computed.
     std::array<std::vector<double>, ServoStepProbe::kStages> stageNs; ///< Per stage, per tick.
-    std::vector<double> tickNs; ///< Per tick: wake-up to the end of the metrics stage (ns).
-    std::vector<Vec3> forceN;   ///< Per tick: the force sent (N, world).
-    std::vector<double> gapM;   ///< Per tick: the device point's distance from the proxy (m).
-    std::uint64_t ticks = 0,    ///< Ticks run.
-        locateSteps = 0,        ///< Cursor steps, both cursors, summed.
-        candidates = 0,         ///< Candidate slots the renderer examined, summed.
-        contactTicks = 0;       ///< Ticks with at least one contact.
-    std::uint64_t solves = 0,   ///< Renderer solves, summed.
-        extraLeaves = 0,        ///< Extra leaves listed, summed.
-        pullBacks = 0;          ///< Pull-backs, summed.
-    std::uint64_t kept = 0;     ///< What the warm-up read, kept.
+    std::vector<double> tickNs;     ///< Per tick: wake-up to the end of the metrics stage (ns).
+    std::vector<Vec3> forceN;       ///< Per tick: the force sent (N, world).
+    std::vector<double> gapM;       ///< Per tick: the device point's distance from the proxy (m).
+    std::uint64_t ticks = 0,        ///< Ticks run.
+        locateSteps = 0,            ///< Cursor steps, both cursors, summed.
+        candidates = 0,             ///< Candidate slots the renderer examined, summed.
+        contactTicks = 0;           ///< Ticks with at least one contact.
+    std::uint64_t solves = 0,       ///< Renderer solves, summed.
+        extraLeaves = 0,            ///< Extra leaves listed, summed.
+        pullBacks = 0;              ///< Pull-backs, summed.
+    std::uint64_t passes = 0,       ///< Solver passes of each tick's last solve, summed.
+        multiContactTicks = 0,      ///< Ticks with two or three contacts (an edge, a corner).
+        facetsEntered = 0;          ///< TickCounts::facetsEntered, summed.
+    std::vector<TickCounts> counts; ///< Per tick: the work it did.
+    RenderOutput lastRender;        ///< The last tick's render (for TickCounts::facetsEntered).
+    std::uint64_t kept = 0;         ///< What the warm-up read, kept.
     /// Warm-ups still running at their deadline: those ticks started late by the overrun,
     /// which the tick's time (from the wake-up) does not show.
     std::uint64_t warmOverruns = 0;
@@ -143,6 +170,7 @@ struct Quantiles {
     double p50 = 0, ///< The median (the samples' unit).
         p99 = 0,    ///< The 99th percentile.
         p999 = 0,   ///< The 99.9th percentile.
+        max = 0,    ///< The largest sample.
         mean = 0;   ///< The mean.
 };
 /// The nearest-rank quantile `q` of `sorted` samples (0 when empty). [any thread]
