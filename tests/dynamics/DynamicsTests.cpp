@@ -359,3 +359,20 @@ TEST_CASE("a body at rest falls asleep and wakes by an impulse or a touch", "[dy
     }
     CHECK(woke);
 }
+
+TEST_CASE("a zero impulse every step wakes nothing: a body left alone still falls asleep",
+          "[dynamics]") {
+    // The runtime's dynamics step hands every body its accumulated impulse each step, most
+    // often zero (DynamicsLoop.cpp, takeImpulses).
+    World w({floorBox(1), dynamicBox(2, Vec3(0, 0.02, 0), Vec3(0.02), 0.2, frictionOf(0.5, 0.4))});
+    for (int k = 0; k < 800; ++k) {
+        w.dynamics->applyImpulse(0, Vec3(0.0), Vec3(0.0));
+        w.dynamics->applyHandTorsion(0, Mat3(0.0));
+        w.dynamics->step();
+    }
+    CHECK(w.body(0).sleeping);
+    w.dynamics->applyImpulse(0, Vec3(0.0), Vec3(0.0));
+    CHECK(w.body(0).sleeping);
+    w.dynamics->applyImpulse(0, Vec3(0.0, 1e-9, 0.0), Vec3(0.0)); // any impulse wakes it
+    CHECK_FALSE(w.body(0).sleeping);
+}
