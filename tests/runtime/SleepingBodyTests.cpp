@@ -9,6 +9,7 @@
 // allocations made inside servo ticks and dynamics steps.
 
 #include "CountingNew.h"
+#include "MeshShapes.h"
 #include "ScriptedDevice.h"
 
 #include "hapto/index/DefaultIndex.h"
@@ -52,10 +53,16 @@ void weightless(Scene& scene) {
     scene.setPhysics(physics);
 }
 
-/// A 4 cm, 50 g dynamic box at the origin drifting at 1 mm/s along x (below the sleep speed,
-/// 2 mm/s), so it falls asleep after 0.5 s about 0.5 mm from where it started.
-Scene driftingBox() {
-    SceneObject box = makeBox(kBoxId, Vec3(0.0), Vec3(kHalfM), Quat(1, 0, 0, 0), stiff());
+/// The 4 cm body: a box, or the same box as a closed 12-triangle mesh.
+SceneObject shapeAt(bool mesh, const Vec3& center, const Quat& rotation = Quat(1, 0, 0, 0)) {
+    return mesh ? makeMesh(kBoxId, center, boxMesh(Vec3(kHalfM)), rotation, stiff())
+                : makeBox(kBoxId, center, Vec3(kHalfM), rotation, stiff());
+}
+
+/// A 4 cm, 50 g dynamic box (or box mesh) at the origin drifting at 1 mm/s along x (below the
+/// sleep speed, 2 mm/s), so it falls asleep after 0.5 s about 0.5 mm from where it started.
+Scene driftingBox(bool mesh = false) {
+    SceneObject box = shapeAt(mesh, Vec3(0.0));
     box.body.dynamic = true;
     box.body.massKg = kMassKg;
     box.body.inertia = Mat3(kMassKg * (2.0 * kHalfM) * (2.0 * kHalfM) / 6.0);
@@ -84,7 +91,8 @@ struct SleepRig {
     std::unique_ptr<Runtime> runtime;
     std::uint64_t t0 = 0;
 
-    explicit SleepRig(bool history) : world(driftingBox(), IndexSpec::parse(kDefaultIndexSpec)) {
+    explicit SleepRig(bool history, bool mesh = false)
+        : world(driftingBox(mesh), IndexSpec::parse(kDefaultIndexSpec)) {
         world.useClock(clock);
         auto d = std::make_unique<ScriptedDevice>("hand", pushAt800());
         if (history) {
@@ -194,7 +202,9 @@ TEST_CASE("a body asleep for the rest delay enters the static index at its rest 
 
 TEST_CASE("a sleeping body is rendered from the index exactly as a static object at its rest "
           "pose") {
-    SleepRig rig(false);
+    const bool mesh = GENERATE(false, true);
+    INFO((mesh ? "box mesh" : "box"));
+    SleepRig rig(false, mesh);
     for (int ms = 1; ms <= 700; ++ms) {
         rig.runTo(ms);
         rig.runtime->maintain();
@@ -204,8 +214,7 @@ TEST_CASE("a sleeping body is rendered from the index exactly as a static object
     const BodyPose pose = rig.body();
     REQUIRE(pose.sleeping);
     // The same box, static at the rest pose, in a world of its own.
-    Scene alone(Aabb{Vec3(-0.125), Vec3(0.125)},
-                {makeBox(kBoxId, pose.center, Vec3(kHalfM), pose.rotation, stiff())});
+    Scene alone(Aabb{Vec3(-0.125), Vec3(0.125)}, {shapeAt(mesh, pose.center, pose.rotation)});
     const World reference(std::move(alone), IndexSpec::parse(kDefaultIndexSpec));
     BodyPoseTable* table = rig.runtime->bodyPoses();
     const std::uint64_t now = rig.clock.nowNs();
@@ -226,6 +235,48 @@ TEST_CASE("a sleeping body is rendered from the index exactly as a static object
         // Its reaction waits for the sleeping body, as a placed body's does.
         CHECK(close(fromIndex.reactionN, fromIndex.forceN));
     }
+}
+
+TEST_CASE("a woken body still in the index is felt where the table has it and not at its rest "
+          "pose") {
+    const bool mesh = GENERATE(false, true);
+    INFO((mesh ? "box mesh" : "box"));
+    SleepRig rig(false, mesh);
+    for (int ms = 1; ms <= 700; ++ms) {
+        rig.runTo(ms);
+        rig.runtime->maintain();
+    }
+    REQUIRE(rig.world.restingIndexed() == 1);
+    const Vec3 rest = rig.body().center;
+    // An application's push (-x, 0.1 m/s) wakes it; no maintain() for 20 ms: the snapshot
+    // still holds it in the index at its rest pose.
+    REQUIRE(rig.runtime->bodyPoses()->addImpulse(0, Vec3(-0.1 * kMassKg, 0.0, 0.0), Vec3(0.0)));
+    for (int ms = 701; ms <= 720; ++ms) {
+        rig.runTo(ms);
+    }
+    const WorldSnapshot& stale = rig.world.current();
+    REQUIRE(stale.restingCount == 1);
+    const BodyPose now = rig.body();
+    REQUIRE_FALSE(now.sleeping);
+    REQUIRE(now.center.x < rest.x - 0.0015); // about 2 mm away by now
+    BodyPoseTable* table = rig.runtime->bodyPoses();
+    const Vec3 out(1, 0, 0);
+    // 1 mm inside where its +x face was: 1 mm outside it now, nothing there.
+    const TickOutput gone =
+        touch(stale, table, rig.clock.nowNs(), rest + (kHalfM - 1e-3) * out, out);
+    CHECK(gone.render.contactCount == 0);
+    CHECK(gone.forceN == Vec3(0.0));
+    // Where its +x face is: felt, placed from the table.
+    const TickOutput there =
+        touch(stale, table, rig.clock.nowNs(), now.center + (kHalfM - 1e-3) * out, out);
+    CHECK(there.bodiesPlaced == 1);
+    REQUIRE(there.render.contactCount >= 1);
+    CHECK(there.render.contacts[0].id == kBoxId);
+    // 500 N/m x 1 mm, less the coupling damping k h on its 0.1 m/s going away (0.05 N).
+    CHECK(there.forceN.x > 0.4);
+    // The next upkeep takes it out of the index.
+    rig.runtime->maintain();
+    CHECK(rig.world.restingIndexed() == 0);
 }
 
 TEST_CASE("a touch wakes a sleeping body within one dynamics step and no hand impulse is lost "
