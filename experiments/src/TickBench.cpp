@@ -52,6 +52,10 @@ std::unique_ptr<TickRun> makeRun(World& world, const Scene& scene, const TickBen
     step.device = run->owned.get();
     step.reader = world.registerReader();
     step.ports = run->shared->portsFor(world);
+    if (!s.bodyPoses.empty()) {
+        run->bodies = std::make_unique<BodyPoseTable>(1);
+        step.ports.bodies = run->bodies.get();
+    }
     step.start(rt::nowNs());
     for (std::vector<double>& stage : run->stageNs) {
         stage.assign(s.ticks, 0.0);
@@ -74,6 +78,7 @@ TickCounts countsOf(const TickOutput& tick, const RenderOutput* before) {
     c.extraLeaves = tick.extraLeaves;
     c.pullBacks = tick.pullBacks;
     c.contacts = r.contactCount;
+    c.bodies = tick.bodiesPlaced;
     for (std::size_t i = 0; i < r.contactCount; ++i) {
         bool held = false;
         for (std::size_t j = 0; before != nullptr && j < before->contactCount; ++j) {
@@ -123,6 +128,20 @@ void timedTick(TickRun& run, std::size_t at, std::uint64_t wakeNs, std::uint64_t
     holdHandBack(run.device->walk(), p.devicePointM, tick.render.proxy, pushM);
 }
 
+/// Publishes tick `k`'s pose of the dynamic body, stamped now, and drops what the hand handed
+/// back to it.
+void publishBody(TickRun& run, std::size_t k, const TickBenchSettings& s) {
+    if (!run.bodies) {
+        return;
+    }
+    BodyPose pose = s.bodyPoses[k % s.bodyPoses.size()];
+    pose.timeNs = rt::nowNs();
+    pose.step = k + 1;
+    run.bodies->publish(0, pose);
+    Vec3 linear, angular;
+    run.bodies->takeImpulse(0, linear, angular);
+}
+
 /// Runs `count` ticks of `run` from sample `at` on, started as its mode says.
 void driveTicks(TickRun& run, std::size_t at, std::size_t count, const TickBenchSettings& s) {
     const auto sleepNs = static_cast<std::uint64_t>(s.sleepUs * 1000.0);
@@ -137,6 +156,7 @@ void driveTicks(TickRun& run, std::size_t at, std::size_t count, const TickBench
         }
     }
     for (std::size_t k = at; k < at + count; ++k) {
+        publishBody(run, k, s);
         std::uint64_t wake = rt::nowNs();
         std::uint64_t deadline = wake;
         if (run.mode != TickMode::Hot) {

@@ -7,6 +7,7 @@
 #include "hapto/experiments/HandWalk.h"
 #include "hapto/experiments/TickBench.h"
 #include "hapto/scenes/Generators.h"
+#include "hapto/scenes/MassProperties.h"
 #include "hapto/scenes/MeshGenerators.h"
 
 #include <algorithm>
@@ -17,13 +18,15 @@ namespace hapto::experiments {
 namespace {
 
 constexpr std::array<std::string_view, kTickMotions.size()> kNames{
-    "rest", "walk", "trapped", "sweep", "graze", "sphere", "slabs"};
+    "rest", "walk", "trapped", "sweep", "graze", "sphere", "slabs", "body"};
 /// One tick (s): the bench's 1 kHz servo.
 constexpr double kTickS = 1e-3;
 /// How far above a surface the scripted hands start, coming in from free space (m).
 constexpr double kApproachM = 0.003;
 /// Free space around the lattice's cubes inside its bounds (m).
 constexpr double kLatticeRoomM = 0.005;
+/// How far inside the dynamic box's top the hand rests (m).
+constexpr double kBodyPressM = 0.001;
 /// The resting hand comes down at this speed (m/s).
 constexpr double kRestDescentMPerS = 0.1;
 
@@ -234,6 +237,30 @@ void slabsCase(MotionCase& c, const MotionOptions& o) {
                  "never held back";
 }
 
+void bodyCase(MotionCase& c, const MotionOptions& o) {
+    c.scene = makeDynamicSlab();
+    const double top = c.scene.object(0).aabb().max.y;
+    const Vec3 rest(0.0, top - kBodyPressM, 0.0);
+    PathBuilder p(rest + Vec3(0.0, kApproachM, 0.0), kRestDescentMPerS * kTickS, o.ticks);
+    p.lineTo(rest);
+    p.arrive();
+    c.approachTicks = p.size();
+    c.path = p.finish();
+    const double w = 2.0 * 3.141592653589793 / kBodySwingPeriodS;
+    c.bodyPoses.resize(o.ticks);
+    for (std::size_t k = 0; k < o.ticks; ++k) {
+        const double t = static_cast<double>(k) * kTickS;
+        BodyPose& pose = c.bodyPoses[k];
+        pose.center = Vec3(kBodySwingM * std::sin(w * t), 0.0, 0.0);
+        pose.centerOfMass = pose.center;
+        pose.velocity = Vec3(kBodySwingM * w * std::cos(w * t), 0.0, 0.0);
+    }
+    c.sceneText = "a dynamic box of 10 x 2 x 10 cm, 100 g, alone";
+    c.pathText = "comes down onto the box's top at 0.1 m/s and rests 1 mm inside it while the "
+                 "box swings 2 cm either way under it once a second (its pose published before "
+                 "each tick)";
+}
+
 } // namespace
 
 std::string_view tickMotionName(TickMotion motion) {
@@ -294,6 +321,16 @@ Scene makeSlabStack() {
     return Scene(Aabb{-room, room}, std::move(slabs));
 }
 
+Scene makeDynamicSlab() {
+    SceneObject box =
+        makeBox(0, Vec3(0.0), Vec3(0.05, 0.01, 0.05), Quat(1, 0, 0, 0), generatedMaterial());
+    box.body.dynamic = true;
+    fillMassProperties(box, 0.1, std::nullopt, std::nullopt);
+    Scene scene(Aabb{Vec3(-0.1), Vec3(0.1)}, {box});
+    scene.setPhysics(ScenePhysics{});
+    return scene;
+}
+
 MotionCase makeMotionCase(TickMotion motion, const MotionOptions& o) {
     MotionCase c;
     c.motion = motion;
@@ -302,8 +339,7 @@ MotionCase makeMotionCase(TickMotion motion, const MotionOptions& o) {
     case TickMotion::Rest:
     case TickMotion::Graze:
         motion == TickMotion::Rest ? restCase(c, o) : grazeCase(c, o);
-        c.sceneText =
-            "a lattice of " + std::to_string(c.scene.size()) + " cubes of 2 mm, 0.5 mm apart";
+        c.sceneText = "a lattice of " + std::to_string(c.scene.size()) + " touching cubes of 2 mm";
         break;
     case TickMotion::Walk:
     case TickMotion::Trapped:
@@ -315,6 +351,9 @@ MotionCase makeMotionCase(TickMotion motion, const MotionOptions& o) {
         break;
     case TickMotion::Sphere:
         sphereCase(c, o);
+        break;
+    case TickMotion::Body:
+        bodyCase(c, o);
         break;
     case TickMotion::Slabs:
         slabsCase(c, o);

@@ -71,6 +71,7 @@ struct Work {
     std::uint64_t ticks = 0, contactTicks = 0, solves = 0, extraLeaves = 0, passes = 0,
                   facetsEntered = 0, candidates = 0;
     std::size_t counts = 0;
+    std::size_t bodyContactTicks = 0; ///< Ticks in contact with a dynamic body placed.
 };
 
 /// One motion run hot over its own scene, as `bench tick --motion` runs it.
@@ -83,10 +84,15 @@ Work runMotion(TickMotion motion, std::size_t ticks) {
     s.path = c.path;
     s.walkIn = c.path.empty() ? c.walkIn : c.scene.bounds();
     s.pushMm = c.pushMm;
+    s.bodyPoses = c.bodyPoses;
     const std::vector<TickTarget> targets = runTickBench(c.scene, s);
     const TickRun& r = *targets.front().runs.front();
-    return {r.ticks,  r.contactTicks,  r.solves,     r.extraLeaves,
-            r.passes, r.facetsEntered, r.candidates, r.counts.size()};
+    Work w{r.ticks,  r.contactTicks,  r.solves,     r.extraLeaves,
+           r.passes, r.facetsEntered, r.candidates, r.counts.size()};
+    for (const TickCounts& k : r.counts) {
+        w.bodyContactTicks += k.bodies > 0 && k.contacts > 0 ? 1 : 0;
+    }
+    return w;
 }
 
 } // namespace
@@ -97,7 +103,7 @@ TEST_CASE("motion names round-trip and unknown ones are refused") {
     }
     CHECK_FALSE(parseTickMotion("spin").has_value());
     CHECK_FALSE(parseTickMotion("").has_value());
-    CHECK(tickMotionNames() == "rest, walk, trapped, sweep, graze, sphere, slabs");
+    CHECK(tickMotionNames() == "rest, walk, trapped, sweep, graze, sphere, slabs, body");
 }
 
 TEST_CASE("every motion's path has a point per tick and is the same for the same seed") {
@@ -224,6 +230,21 @@ TEST_CASE("the slab hand crosses the whole stack down and up at 1 m/s") {
     }
 }
 
+TEST_CASE("the body's poses swing it 2 cm either way once a second under a resting hand") {
+    const MotionCase c = makeMotionCase(TickMotion::Body, small());
+    REQUIRE(c.bodyPoses.size() == c.path.size());
+    REQUIRE(c.scene.object(0).body.dynamic);
+    double lo = 1.0, hi = -1.0;
+    for (const BodyPose& p : c.bodyPoses) {
+        lo = std::min(lo, p.center.x);
+        hi = std::max(hi, p.center.x);
+    }
+    CHECK(lo == Approx(-kBodySwingM).margin(1e-6));
+    CHECK(hi == Approx(kBodySwingM).margin(1e-6));
+    CHECK(c.bodyPoses[1000].center.x == Approx(0.0).margin(1e-12)); // one period
+    CHECK(c.path.back().y == Approx(0.01 - 0.001));
+}
+
 TEST_CASE("the resting hand comes down and rests 0.5 mm inside a top face") {
     const MotionCase c = makeMotionCase(TickMotion::Rest, small());
     const Vec3 rest = c.path.back();
@@ -271,6 +292,10 @@ TEST_CASE("each motion's ticks do the work that explains them") {
         const Work r = runMotion(TickMotion::Slabs, kTicks);
         CHECK(r.contactTicks > kTicks / 2);
         CHECK(r.candidates > 0);
+    }
+    SECTION("body: in contact with the swinging dynamic box once down") {
+        const Work r = runMotion(TickMotion::Body, kTicks);
+        CHECK(r.bodyContactTicks >= kTicks - 40);
     }
     SECTION("walk: the held-back walk is in contact some of the time") {
         const Work r = runMotion(TickMotion::Walk, kTicks);

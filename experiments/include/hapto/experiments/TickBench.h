@@ -18,6 +18,7 @@
 #include "hapto/devices/Device.h"
 #include "hapto/experiments/HandWalk.h"
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/runtime/BodyPoses.h"
 #include "hapto/runtime/RenderOutput.h"
 #include "hapto/runtime/ServoLoop.h"
 #include "hapto/runtime/ServoStep.h"
@@ -98,6 +99,11 @@ struct TickBenchSettings {
     /// Not empty: the device plays these points (m), one a tick, cyclically, in place of the
     /// walk (pushMm should then be 0: a path is not held back).
     std::vector<Vec3> path;
+    /// Not empty: the scene's one dynamic body takes these poses (m, m/s), one a tick
+    /// (cyclically), each published into the step's BodyPoseTable just before the tick and
+    /// stamped with that moment, as a 1 kHz dynamics thread would; the impulses handed back
+    /// are taken and dropped (the dynamics step is not timed here).
+    std::vector<BodyPose> bodyPoses;
 };
 
 /// What one tick did, the work that explains its time.
@@ -108,6 +114,7 @@ struct TickCounts {
     std::uint8_t extraLeaves = 0; ///< Extra leaves listed (TickOutput::extraLeaves).
     std::uint8_t pullBacks = 0;   ///< Pull-backs (TickOutput::pullBacks).
     std::uint8_t contacts = 0;    ///< Active constraints at the end (0 to 3).
+    std::uint8_t bodies = 0;      ///< Dynamic bodies placed near the tool.
     /// Facets entered: the tick's contact planes (item and normal) that the previous tick's
     /// contacts did not hold: the faces, edges' sides and triangles the proxy moved onto.
     std::uint8_t facetsEntered = 0;
@@ -121,6 +128,7 @@ struct TickRun {
     std::unique_ptr<Device> owned;           ///< Owns the device (a WalkDevice).
     std::unique_ptr<ServoStep> step;         ///< The servo step it times.
     std::unique_ptr<ServoStepShared> shared; ///< Its metrics and mailboxes.
+    std::unique_ptr<BodyPoseTable> bodies;   ///< The dynamic body's poses (bodyPoses), or null.
     ServoStepProbe probe;                    ///< The last tick's stage ends and what it computed.
     std::array<std::vector<double>, ServoStepProbe::kStages> stageNs; ///< Per stage, per tick.
     std::vector<double> tickNs;     ///< Per tick: wake-up to the end of the metrics stage (ns).

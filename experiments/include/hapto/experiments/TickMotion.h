@@ -16,6 +16,7 @@
 
 #include "hapto/core/Geometry.h"
 #include "hapto/index/IndexSpec.h"
+#include "hapto/runtime/BodyPoses.h"
 #include "hapto/scenes/Scene.h"
 
 #include <array>
@@ -37,14 +38,15 @@ enum class TickMotion : std::uint8_t {
     Graze,   ///< Along the lines where the lattice's top cubes meet, 0.1 mm down, at 0.5 m/s.
     Sphere,  ///< Slides 1 mm inside a fine-faceted sphere at 0.5 m/s on great-circle arcs.
     Slabs,   ///< Up and down through a stack of thin slabs at 1 m/s.
+    Body,    ///< Rests 1 mm inside a dynamic box's top while the box swings under it.
 };
 
 /// Every motion, in the order the bench runs them.
-inline constexpr std::array<TickMotion, 7> kTickMotions{
+inline constexpr std::array<TickMotion, 8> kTickMotions{
     TickMotion::Rest,  TickMotion::Walk,   TickMotion::Trapped, TickMotion::Sweep,
-    TickMotion::Graze, TickMotion::Sphere, TickMotion::Slabs};
+    TickMotion::Graze, TickMotion::Sphere, TickMotion::Slabs,   TickMotion::Body};
 
-/// "rest", "walk", "trapped", "sweep", "graze", "sphere", "slabs". [any thread]
+/// "rest", "walk", "trapped", "sweep", "graze", "sphere", "slabs", "body". [any thread]
 std::string_view tickMotionName(TickMotion motion);
 /// Parses a motion's name; nullopt for anything else. [any thread]
 std::optional<TickMotion> parseTickMotion(std::string_view name);
@@ -86,6 +88,10 @@ inline constexpr double kSlabEdgeM = 0.1;
 inline constexpr double kFastSpeedMPerS = 1.0;
 /// The grazing and the sliding hand's speed (m/s): the walk's cap, a brisk hand.
 inline constexpr double kSlideSpeedMPerS = 0.5;
+/// The dynamic box's swing along x (m, amplitude) under the resting hand...
+inline constexpr double kBodySwingM = 0.02;
+/// ... and its period (s): 0.13 m/s at the middle of the swing.
+inline constexpr double kBodySwingPeriodS = 1.0;
 
 /// One motion, ready to run: its scene, the index to run it over, and its path.
 struct MotionCase {
@@ -100,6 +106,9 @@ struct MotionCase {
     Aabb walkIn{Vec3(0.0), Vec3(0.0)}; ///< `walk`'s box (m); the trapped path's region too.
     double pushMm = 0.0;               ///< `walk`: held back to 2 mm of the proxy; 0 otherwise.
     std::size_t approachTicks = 0;     ///< Leading path points that come in from free space.
+    /// `body`: the dynamic box's pose at each tick (the bench stamps each with its tick's
+    /// time); empty for the others.
+    std::vector<BodyPose> bodyPoses;
 };
 
 /// Builds a motion's scene and path. Throws InputError naming the size when the scene
@@ -114,5 +123,7 @@ Scene makeMotionLattice(std::size_t objects, int* perSide = nullptr);
 Scene makeMotionCubes(std::size_t objects, std::uint64_t seed);
 /// The stack of kSlabCount slabs `slabs` uses, centred on the origin (y up). [control]
 Scene makeSlabStack();
+/// The dynamic 10 x 2 x 10 cm, 100 g box `body` uses, at the origin (y up). [control]
+Scene makeDynamicSlab();
 
 } // namespace hapto::experiments
