@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <span>
 #include <stdexcept>
 #include <utility>
@@ -64,6 +65,7 @@ std::unique_ptr<TickRun> makeRun(World& world, const Scene& scene, const TickBen
     run->forceN.assign(s.ticks, Vec3(0.0));
     run->gapM.assign(s.ticks, 0.0);
     run->counts.assign(s.ticks, TickCounts{});
+    run->cpuNs.assign(s.cpuTime ? s.ticks : 0, 0.0);
     run->startLateNs.reserve(s.ticks); // filled in the sleep modes only
     return run;
 }
@@ -176,7 +178,11 @@ void driveTicks(TickRun& run, std::size_t at, std::size_t count, const TickBench
                     static_cast<double>(wake > deadline ? wake - deadline : 0));
             }
         }
+        const std::uint64_t cpu0 = s.cpuTime ? threadCpuNs() : 0;
         timedTick(run, k, wake, deadline, s.pushMm * 1e-3);
+        if (s.cpuTime) {
+            run.cpuNs[k] = static_cast<double>(threadCpuNs() - cpu0);
+        }
     }
 }
 
@@ -238,6 +244,13 @@ Aabb walkBox(const Aabb& bounds, double edgeM) {
     const Vec3 half(0.5 * edgeM);
     return {glm::max(bounds.min, bounds.center() - half),
             glm::min(bounds.max, bounds.center() + half)};
+}
+
+std::uint64_t threadCpuNs() noexcept {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<std::uint64_t>(t.tv_sec) * 1'000'000'000u +
+           static_cast<std::uint64_t>(t.tv_nsec);
 }
 
 const char* modeName(const TickRun& run) {

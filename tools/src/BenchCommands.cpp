@@ -247,6 +247,7 @@ struct TickArgs {
     experiments::MotionOptions motionSize; ///< --objects (ticks and seed from settings)
     std::vector<std::string> modes;        ///< --mode: hot, sleep, sleep+warm
     bool pushMmGiven = false;              ///< --push-mm was given (refused with --motion)
+    bool cpuTime = false;                  ///< --cpu-time (with --motion)
 };
 
 nlohmann::ordered_json toJson(const Quantiles& q) {
@@ -425,7 +426,7 @@ struct MotionWork {
     double solves = 0, candidates = 0, passes = 0, extraLeaves = 0, pullBacks = 0,
            facetsEntered = 0, contact = 0, multiContact = 0;
     std::uint32_t maxSolves = 0, maxCandidates = 0;
-    experiments::TickCounts worst; ///< The slowest tick's.
+    experiments::TickCounts worst; ///< The slowest tick's (by CPU time when it was read).
 };
 
 MotionWork workOf(const TickRun& run) {
@@ -443,8 +444,9 @@ MotionWork workOf(const TickRun& run) {
         w.maxSolves = std::max<std::uint32_t>(w.maxSolves, c.solves);
         w.maxCandidates = std::max(w.maxCandidates, c.candidates);
     }
-    const auto slowest = std::max_element(run.tickNs.begin(), run.tickNs.end());
-    w.worst = run.counts[static_cast<std::size_t>(slowest - run.tickNs.begin())];
+    const std::vector<double>& ns = run.cpuNs.empty() ? run.tickNs : run.cpuNs;
+    const auto slowest = std::max_element(ns.begin(), ns.end());
+    w.worst = run.counts[static_cast<std::size_t>(slowest - ns.begin())];
     return w;
 }
 
@@ -455,9 +457,16 @@ nlohmann::ordered_json countsJson(const experiments::TickCounts& c) {
         {"facets_entered", c.facetsEntered}};
 }
 
+/// One motion run's tick times: on the wall (wake-up to the end of the metrics) and on the
+/// thread's CPU clock, and each p99.9 over rest's (0: no rest run to compare with).
+struct MotionTimes {
+    Quantiles wall, cpu;
+    double wallOverRest = 0, cpuOverRest = 0;
+};
+
 /// One motion run's JSON entry.
 nlohmann::ordered_json motionJson(const experiments::MotionCase& c, const TickTarget& target,
-                                  const TickRun& run, const Quantiles& tick, double restP999) {
+                                  const TickRun& run, const MotionTimes& t) {
     const MotionWork w = workOf(run);
     nlohmann::ordered_json stages = nlohmann::ordered_json::object();
     for (std::size_t st = 0; st < kStageCount; ++st) {
@@ -470,8 +479,10 @@ nlohmann::ordered_json motionJson(const experiments::MotionCase& c, const TickTa
             {"index", target.spec.toString()},
             {"mode", modeName(run)},
             {"ticks", run.ticks},
-            {"tick", toJson(tick)},
-            {"p999_over_rest", restP999 > 0 ? tick.p999 / restP999 : 0.0},
+            {"tick", toJson(t.wall)},
+            {"tick_cpu", run.cpuNs.empty() ? nlohmann::ordered_json() : toJson(t.cpu)},
+            {"p999_over_rest", t.wallOverRest},
+            {"cpu_p999_over_rest", t.cpuOverRest},
             {"stages", stages},
             {"contact_fraction", w.contact},
             {"multi_contact_fraction", w.multiContact},
@@ -487,19 +498,57 @@ nlohmann::ordered_json motionJson(const experiments::MotionCase& c, const TickTa
             {"gap_m", gapJson(run.gapM)}};
 }
 
-void printMotionRow(const experiments::MotionCase& c, const TickTarget& target, const TickRun& run,
-                    const Quantiles& q, double restP999) {
+std::string ratioText(double r) {
+    char text[32];
+    std::snprintf(text, sizeof text, r > 0 ? "%.2fx" : "-", r);
+    return text;
+}
+
+std::string motionTimesRow(const experiments::MotionCase& c, const TickTarget& target,
+                           const TickRun& run, const MotionTimes& t) {
+    char row[256];
+    std::snprintf(row, sizeof row,
+                  "%-8s %-15s %-10s | %7.0f %7.0f %8.0f %9.0f | %7.0f %7.0f %8.0f %8.0f | %8s "
+                  "%8s\n",
+                  std::string(experiments::tickMotionName(c.motion)).c_str(),
+                  target.spec.toString().c_str(), modeName(run), t.wall.p50, t.wall.p99,
+                  t.wall.p999, t.wall.max, t.cpu.p50, t.cpu.p99, t.cpu.p999, t.cpu.max,
+                  ratioText(t.wallOverRest).c_str(), ratioText(t.cpuOverRest).c_str());
+    return row;
+}
+
+std::string motionWorkRow(const experiments::MotionCase& c, const TickTarget& target,
+                          const TickRun& run) {
     const MotionWork w = workOf(run);
-    std::printf("%-8s %-15s %-10s %8.0f %8.0f %9.0f %9.0f %6s %5.0f%% %5.0f%% %6.2f %6.2f "
-                "%7.1f %6.2f %5.2f %6.2f | %3u %6u | %2u %5u %3u %2u %2u\n",
-                std::string(experiments::tickMotionName(c.motion)).c_str(),
-                target.spec.toString().c_str(), modeName(run), q.p50, q.p99, q.p999, q.max,
-                restP999 > 0 ? (std::to_string(q.p999 / restP999).substr(0, 5) + "x").c_str() : "-",
-                100.0 * w.contact, 100.0 * w.multiContact, w.solves, w.passes, w.candidates,
-                w.extraLeaves, w.pullBacks, w.facetsEntered, w.maxSolves, w.maxCandidates,
-                static_cast<unsigned>(w.worst.solves), w.worst.candidates,
-                static_cast<unsigned>(w.worst.passes), static_cast<unsigned>(w.worst.extraLeaves),
-                static_cast<unsigned>(w.worst.pullBacks));
+    char row[256];
+    std::snprintf(row, sizeof row,
+                  "%-8s %-15s %-10s | %5.0f%% %5.0f%% %6.2f %6.2f %7.1f %6.2f %5.2f %6.2f | %3u "
+                  "%6u | %2u %5u %3u %2u %2u\n",
+                  std::string(experiments::tickMotionName(c.motion)).c_str(),
+                  target.spec.toString().c_str(), modeName(run), 100.0 * w.contact,
+                  100.0 * w.multiContact, w.solves, w.passes, w.candidates, w.extraLeaves,
+                  w.pullBacks, w.facetsEntered, w.maxSolves, w.maxCandidates,
+                  static_cast<unsigned>(w.worst.solves), w.worst.candidates,
+                  static_cast<unsigned>(w.worst.passes), static_cast<unsigned>(w.worst.extraLeaves),
+                  static_cast<unsigned>(w.worst.pullBacks));
+    return row;
+}
+
+void printMotionHeader(const experiments::TickBenchSettings& common,
+                       const experiments::MotionOptions& size, const std::string& device) {
+    std::printf("motions: %zu ticks of 1 ms each, seed %llu, device %s, about %zu objects or "
+                "triangles; one after another, each over its own scene\n",
+                common.ticks, static_cast<unsigned long long>(common.seed), device.c_str(),
+                size.objects);
+    std::printf("timing:  wall: steady clock from the wake-up to the end of the metrics stage; "
+                "cpu (--cpu-time; 0 without): this thread's CPU clock around the step (without "
+                "the time other processes held the core; a system call per tick, which slows "
+                "the ticks after it); nearest-rank quantiles over every tick (ns); "
+                "/rest: p99.9 over rest's\n");
+    std::printf("counts:  per tick, means: solves, passes (solver passes of the last solve), "
+                "candidates, extra leaves, pull-backs, facets entered; max: the largest solves "
+                "and candidates of any tick; slowest (by cpu): that tick's solves, candidates, "
+                "passes, extra leaves, pull-backs\n");
 }
 
 void runMotions(const TickArgs& args) {
@@ -518,26 +567,13 @@ void runMotions(const TickArgs& args) {
     experiments::MotionOptions size = args.motionSize;
     size.ticks = common.ticks;
     size.seed = common.seed;
+    printMotionHeader(common, size, args.device);
 
-    std::printf("motions: %zu ticks of 1 ms each, seed %llu, device %s, about %zu objects or "
-                "triangles; one after another, each over its own scene\n",
-                common.ticks, static_cast<unsigned long long>(common.seed), args.device.c_str(),
-                size.objects);
-    std::printf("timing:  steady clock at each stage boundary (one reading costs ~%.0f ns); "
-                "nearest-rank quantiles over every tick (ns)\n",
-                clockOverheadNs());
-    std::printf("counts:  per tick, means: solves, passes (solver passes of the last solve), "
-                "candidates, extra leaves, pull-backs, facets entered; max: the largest solves "
-                "and candidates of any tick; slowest: that tick's solves, candidates, passes, "
-                "extra leaves, pull-backs\n\n");
-    std::printf("%-8s %-15s %-10s %8s %8s %9s %9s %6s %6s %6s %6s %6s %7s %6s %5s %6s | %10s | "
-                "%s\n",
-                "motion", "index", "mode", "p50", "p99", "p99.9", "max", "/rest", "contact", "2+",
-                "solves", "passes", "cand.", "extra", "pull", "facets", "max s/cand",
-                "slowest s cand pa ex pb");
+    // Each motion's scene (10^6 objects) and index go before the next is built; only the
+    // rows and the JSON are kept.
+    std::vector<std::string> timeRows, workRows, described;
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
-    std::vector<std::string> described;
-    std::map<std::string, double> restP999; // by index and mode
+    std::map<std::string, std::pair<double, double>> rest; // wall, cpu p99.9 by index and mode
     for (const experiments::TickMotion m : motions) {
         const experiments::MotionCase c = experiments::makeMotionCase(m, size);
         experiments::TickBenchSettings s = common;
@@ -548,23 +584,38 @@ void runMotions(const TickArgs& args) {
         s.walkIn = c.path.empty() ? c.walkIn : c.scene.bounds();
         s.pushMm = c.pushMm;
         s.bodyPoses = c.bodyPoses;
+        s.cpuTime = args.cpuTime;
         const std::vector<TickTarget> targets = experiments::runTickBench(c.scene, s);
         for (const TickTarget& target : targets) {
             for (const auto& run : target.runs) {
-                const Quantiles q = quantilesOf(run->tickNs);
+                MotionTimes t{quantilesOf(run->tickNs), quantilesOf(run->cpuNs)};
                 const std::string key = target.spec.toString() + " " + modeName(*run);
-                const bool rest = m == experiments::TickMotion::Rest;
-                if (rest) {
-                    restP999[key] = q.p999;
+                if (m == experiments::TickMotion::Rest) {
+                    rest[key] = {t.wall.p999, t.cpu.p999};
+                } else if (rest.count(key) != 0) {
+                    t.wallOverRest = t.wall.p999 / rest[key].first;
+                    t.cpuOverRest = args.cpuTime ? t.cpu.p999 / rest[key].second : 0.0;
                 }
-                const double restQ = restP999.count(key) != 0 ? restP999[key] : 0.0;
-                printMotionRow(c, target, *run, q, rest ? 0.0 : restQ);
-                out.push_back(motionJson(c, target, *run, q, restQ));
+                timeRows.push_back(motionTimesRow(c, target, *run, t));
+                workRows.push_back(motionWorkRow(c, target, *run));
+                out.push_back(motionJson(c, target, *run, t));
                 keep(run->kept);
             }
         }
         described.push_back(std::string(experiments::tickMotionName(m)) + ": " + c.sceneText +
                             "; " + c.pathText);
+    }
+    std::printf("\n%-8s %-15s %-10s | %7s %7s %8s %9s | %7s %7s %8s %8s | %8s %8s\n", "motion",
+                "index", "mode", "p50", "p99", "p99.9", "max", "cpu p50", "p99", "p99.9", "max",
+                "/rest", "cpu/rest");
+    for (const std::string& row : timeRows) {
+        std::printf("%s", row.c_str());
+    }
+    std::printf("\n%-8s %-15s %-10s | %6s %6s %6s %6s %7s %6s %5s %6s | %10s | %s\n", "motion",
+                "index", "mode", "contact", "2+", "solves", "passes", "cand.", "extra", "pull",
+                "facets", "max s/cand", "slowest s cand pa ex pb");
+    for (const std::string& row : workRows) {
+        std::printf("%s", row.c_str());
     }
     std::printf("\n");
     for (const std::string& d : described) {
@@ -730,6 +781,12 @@ void addBenchCommands(CLI::App& app) {
         "leaves, pull-backs, facets entered, the slowest tick's counts. Hot mode "
         "only unless --mode says otherwise; not with --scene, --walk-edge or "
         "--push-mm");
+    tick->add_flag("--cpu-time", targs->cpuTime,
+                   "With --motion: also read the thread's CPU clock around each tick and report "
+                   "its quantiles, which leave out the time other processes held the core. A "
+                   "system call per tick: on a VM it makes the ticks after it slower (here the "
+                   "resting tick's p50 0.8 -> 2.5 us), so compare such runs only with each "
+                   "other");
     tick->add_option("--objects", targs->motionSize.objects,
                      "With --motion: cubes in the cube scenes (the lattice rounds to K^3) and "
                      "triangles in the sphere, e.g. 1e6")

@@ -104,6 +104,10 @@ struct TickBenchSettings {
     /// stamped with that moment, as a 1 kHz dynamics thread would; the impulses handed back
     /// are taken and dropped (the dynamics step is not timed here).
     std::vector<BodyPose> bodyPoses;
+    /// Also read this thread's CPU clock around each tick (TickRun::cpuNs): the tick's own
+    /// time without the time other processes held the core. Two clock_gettime calls per tick,
+    /// outside the stages' stamps.
+    bool cpuTime = false;
 };
 
 /// What one tick did, the work that explains its time.
@@ -131,7 +135,10 @@ struct TickRun {
     std::unique_ptr<BodyPoseTable> bodies;   ///< The dynamic body's poses (bodyPoses), or null.
     ServoStepProbe probe;                    ///< The last tick's stage ends and what it computed.
     std::array<std::vector<double>, ServoStepProbe::kStages> stageNs; ///< Per stage, per tick.
-    std::vector<double> tickNs;     ///< Per tick: wake-up to the end of the metrics stage (ns).
+    std::vector<double> tickNs; ///< Per tick: wake-up to the end of the metrics stage (ns).
+    /// Per tick with TickBenchSettings::cpuTime: this thread's CPU time over the step (ns,
+    /// including about half of one clock_gettime call); empty otherwise.
+    std::vector<double> cpuNs;
     std::vector<Vec3> forceN;       ///< Per tick: the force sent (N, world).
     std::vector<double> gapM;       ///< Per tick: the device point's distance from the proxy (m).
     std::uint64_t ticks = 0,        ///< Ticks run.
@@ -161,6 +168,9 @@ struct TickTarget {
     std::unique_ptr<World> world;               ///< The scene's copy, indexed by `spec`.
     std::vector<std::unique_ptr<TickRun>> runs; ///< One per mode it runs.
 };
+
+/// This thread's CPU time (ns, CLOCK_THREAD_CPUTIME_ID). [any thread]
+std::uint64_t threadCpuNs() noexcept;
 
 /// "hot", "sleep", "sleep+warm", "sleep+lat", "sleep+warm+lat". [any thread]
 const char* modeName(const TickRun& run);
