@@ -21,9 +21,25 @@
 //   bound of the real nodes. The build is refused before it starts when that floor passes the
 //   limit, so "octree:1:1e-9" over overlapping boxes is refused in milliseconds, not after
 //   building the levels that fit.
+// - groups: that count is global, so it says nothing where items overlap only here and there
+//   (10^6 random cubes). A cell that touches the inner boxes of more than M items lists them
+//   all, so it splits, and so did its ancestors: a node of the real tree. Per axis, the level-l
+//   cells touching every interval of a group are those in [max of the lows, min of the highs]
+//   (or spanning the gap when that is empty), a product of three ranges, O(1) per level. The
+//   groups come from near neighbours: the inner boxes in units of the bounds, as floats rounded
+//   inward, sorted by the grid cell of their low corner (cells twice the median box, so boxes
+//   that touch sit in adjacent cells), each tested against at most kPairChecks boxes after it
+//   in its own and the four following rows; with M = 1 every pair that overlaps or has a gap
+//   under a sixteenth of a grid cell is a group (cells spanning the gap list both), otherwise
+//   a box and the following boxes that still share a region with it, taken greedily, once
+//   more than M. Of each block of boxes the kKeep groups sharing the most volume are kept, and
+//   per level the floor takes the largest kept group's cells (groups may share cells, so their
+//   counts are not added). Items beyond the first kPairItems, or larger than a grid
+//   cell, are left out: fewer items, a lower floor, still a floor.
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
-// Cost: O(items * levels) with no allocation per item or node; levels <= Octree::kMaxDepth + 1.
+// Cost: O(items * levels) time; memory per item (at most kPairItems of them) one inner box
+// and its sort key (32 bytes, 32 MB at 10^6 items), none per node.
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/SpatialIndex.h"
@@ -37,6 +53,9 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <span>
+#include <tuple>
+#include <vector>
 
 namespace hapto {
 namespace detail {
@@ -120,6 +139,80 @@ Aabb innerBox(const OverlapShape& s, OverlapMode mode) {
     return {in.min + Vec3(shrink), in.max - Vec3(shrink)};
 }
 
+/// An item's inner box in units of the bounds' size (per axis (x - min) / size), rounded
+/// inward to floats; empty (hi < lo) when the item has none.
+struct UnitBox {
+    std::array<float, 3> lo{1.0f, 1.0f, 1.0f};
+    std::array<float, 3> hi{0.0f, 0.0f, 0.0f};
+
+    bool empty() const { return !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]); }
+    float extent() const { return std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}); }
+};
+
+/// The nearest float at or above v.
+float floatUp(double v) {
+    const float f = static_cast<float>(v);
+    return static_cast<double>(f) < v ? std::nextafter(f, std::numeric_limits<float>::infinity())
+                                      : f;
+}
+
+/// The nearest float at or below v.
+float floatDown(double v) {
+    const float f = static_cast<float>(v);
+    return static_cast<double>(f) > v ? std::nextafter(f, -std::numeric_limits<float>::infinity())
+                                      : f;
+}
+
+/// Items the group pass keeps at most (the first ones): 32 bytes each.
+constexpr std::size_t kPairItems = std::size_t(1) << 20;
+/// Boxes after it each box is tested against at most.
+constexpr int kPairChecks = 64;
+
+constexpr std::uint64_t kAxisCells = std::uint64_t(1) << 21;
+/// The key of a box the group pass leaves out (none, or larger than a grid cell).
+constexpr std::uint64_t kNoCell = std::numeric_limits<std::uint64_t>::max();
+
+std::uint64_t packCell(std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+    return (z << 42) | (y << 21) | x;
+}
+
+/// A box's sort record: the grid cell of its low corner (z, y, x, 21 bits each), then the box
+/// (so equal keys sort the same way on any number of threads), and the box.
+struct CellKey {
+    std::uint64_t key = kNoCell;
+    UnitBox box;
+    bool operator<(const CellKey& o) const {
+        return key != o.key ? key < o.key : std::tie(box.lo, box.hi) < std::tie(o.box.lo, o.box.hi);
+    }
+};
+
+/// The inner box `in` in units of the bounds b, rounded inward.
+UnitBox unitBox(const Aabb& in, const Aabb& b) {
+    UnitBox u;
+    for (int a = 0; a < 3; ++a) {
+        const double size = b.max[a] - b.min[a];
+        u.lo[a] = floatUp((in.min[a] - b.min[a]) / size);
+        u.hi[a] = floatDown((in.max[a] - b.min[a]) / size);
+    }
+    return u;
+}
+
+/// A box's record for a grid of `cell` edges (units): kNoCell when the pass leaves it out.
+CellKey cellKey(const UnitBox& u, float cell) {
+    CellKey k;
+    k.box = u;
+    if (u.empty() || !(u.extent() <= cell)) {
+        return k;
+    }
+    std::uint64_t c[3];
+    for (int a = 0; a < 3; ++a) {
+        const double q = std::floor(static_cast<double>(u.lo[a]) / cell);
+        c[a] = static_cast<std::uint64_t>(std::clamp(q, 0.0, double(kAxisCells - 1)));
+    }
+    k.key = packCell(c[0], c[1], c[2]);
+    return k;
+}
+
 /// Per level of an octree: the sums of reach and inner cells, the items with an inner cell,
 /// and the hull of the inner boxes.
 struct LevelCounts {
@@ -145,7 +238,7 @@ struct LevelCounts {
 // Per axis, the item's reach and inner intervals in units of the bounds' size, so a level's
 // cell coordinates are these times 2^l: exact, as the cell steps are size * 2^-l exactly.
 void countItem(const Scene& scene, std::uint32_t item, const IndexSpec& spec, const Aabb& b,
-               int levels, LevelCounts& c) {
+               int levels, LevelCounts& c, CellKey* record, float cell) {
     const OverlapShape s = OverlapShape::of(scene, item);
     const Aabb in = innerBox(s, spec.mode);
     const double tol = kReachTolerance * (absMax(s.aabb) + absMax(b));
@@ -156,6 +249,9 @@ void countItem(const Scene& scene, std::uint32_t item, const IndexSpec& spec, co
         reachHi[a] = (s.aabb.max[a] + tol - b.min[a]) / size;
         inLo[a] = (in.min[a] - b.min[a]) / size;
         inHi[a] = (in.max[a] - b.min[a]) / size;
+    }
+    if (record != nullptr) {
+        *record = cellKey(unitBox(in, b), cell);
     }
     ++c.items;
     bool hasInner = false;
@@ -178,7 +274,10 @@ void countItem(const Scene& scene, std::uint32_t item, const IndexSpec& spec, co
     }
 }
 
-LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b, int levels) {
+// Also writes the records of the first records.size() items' inner boxes (kNoCell for an item
+// not indexed).
+LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b, int levels,
+                        std::span<CellKey> records, float cell) {
     LevelCounts total;
     std::mutex merge;
     parallel::forRanges(0, scene.itemCount(), 4096, [&](std::size_t first, std::size_t end) {
@@ -186,7 +285,8 @@ LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b
         for (std::size_t i = first; i < end; ++i) {
             const std::uint32_t item = scene.item(static_cast<std::uint32_t>(i));
             if (scene.isIndexed(item)) {
-                countItem(scene, item, spec, b, levels, part);
+                countItem(scene, item, spec, b, levels, part,
+                          i < records.size() ? &records[i] : nullptr, cell);
             }
         }
         const std::lock_guard<std::mutex> lock(merge);
@@ -216,11 +316,206 @@ std::uint64_t splitsAtLeast(const LevelCounts& c, const Aabb& b, int l, std::uin
     return c.inner[l] <= low ? 0 : std::min(held, (c.inner[l] - low) / (items - m));
 }
 
+/// Per level, the most cells one group's boxes all touch (the note's groups).
+using LevelCells = std::array<std::uint64_t, kLevels>;
+
+/// The level-l cells (strictly) touching every box of a group: per axis [lo, hi] is the
+/// largest low and the smallest high of the group's boxes.
+std::uint64_t groupCells(const std::array<float, 3>& lo, const std::array<float, 3>& hi, int l) {
+    const double n = static_cast<double>(std::uint64_t(1) << l);
+    std::uint64_t cells = 1;
+    for (int a = 0; a < 3; ++a) {
+        // Cell c touches [lo, hi] when c < hi * n and c + 1 > lo * n.
+        const double first = std::max(std::floor(static_cast<double>(lo[a]) * n), 0.0);
+        const double last = std::min(std::ceil(static_cast<double>(hi[a]) * n) - 1.0, n - 1.0);
+        if (!(last >= first)) {
+            return 0;
+        }
+        cells *= static_cast<std::uint64_t>(last - first) + 1;
+    }
+    return cells;
+}
+
+void takeGroup(const std::array<float, 3>& lo, const std::array<float, 3>& hi, int levels,
+               LevelCells& most) {
+    for (int l = 0; l < levels; ++l) {
+        most[l] = std::max(most[l], groupCells(lo, hi, l));
+    }
+}
+
+/// The group grid's cell edge (units): 1.25 times the median extent of the inner boxes of up to
+/// 4096 items sampled from the first `count`; 0 when none has one.
+float groupGridCell(const Scene& scene, const IndexSpec& spec, const Aabb& b, std::size_t count) {
+    std::vector<float> sample;
+    const std::size_t stride = std::max<std::size_t>(count / 4096, 1);
+    for (std::size_t i = 0; i < count; i += stride) {
+        const std::uint32_t item = scene.item(static_cast<std::uint32_t>(i));
+        if (scene.isIndexed(item)) {
+            const UnitBox u = unitBox(innerBox(OverlapShape::of(scene, item), spec.mode), b);
+            if (!u.empty()) {
+                sample.push_back(u.extent());
+            }
+        }
+    }
+    if (sample.empty()) {
+        return 0.0f;
+    }
+    std::nth_element(sample.begin(), sample.begin() + sample.size() / 2, sample.end());
+    return std::max(1.25f * sample[sample.size() / 2], std::ldexp(1.0f, -20));
+}
+
+/// The rows a box is tested against besides its own, (dy, dz) from its own: with its own row,
+/// every pair of boxes in adjacent cells is seen from one of its two boxes.
+constexpr int kRows[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+
+/// The sorted boxes' group search over [first, end): per row a cursor that only moves forward
+/// (the rows' first keys grow with i's key).
+class GroupSearch {
+public:
+    GroupSearch(std::span<const CellKey> keys, float cell, std::uint32_t m)
+        : mKeys(keys), mCell(cell), mM(m) {}
+
+    /// Finds the best group of box i (the most shared volume) and keeps it when it is among
+    /// the kKeep best of the search so far.
+    void run(std::size_t i) {
+        const std::uint64_t k = mKeys[i].key;
+        const std::uint64_t x = k & (kAxisCells - 1), y = (k >> 21) & (kAxisCells - 1);
+        const std::uint64_t z = k >> 42;
+        mBest = -1.0f;
+        mMembers = 1;
+        mLo = mKeys[i].box.lo;
+        mHi = mKeys[i].box.hi;
+        mChecks = 0;
+        scan(i + 1, packCell(std::min(x + 1, kAxisCells - 1), y, z));
+        for (int r = 0; r < 4 && mMembers <= mM; ++r) {
+            const std::uint64_t ry = y + kRows[r][0], rz = z + kRows[r][1];
+            if ((kRows[r][0] < 0 && y == 0) || ry >= kAxisCells || rz >= kAxisCells) {
+                continue;
+            }
+            const std::uint64_t from = packCell(x == 0 ? 0 : x - 1, ry, rz);
+            std::size_t& j = mCursor[r];
+            if (j == kUnset) { // a range's first box: search once
+                j = static_cast<std::size_t>(
+                    std::lower_bound(mKeys.begin(), mKeys.end(), from,
+                                     [](const CellKey& r, std::uint64_t k) { return r.key < k; }) -
+                    mKeys.begin());
+            }
+            while (j < mKeys.size() && mKeys[j].key < from) {
+                ++j;
+            }
+            scan(j, packCell(std::min(x + 1, kAxisCells - 1), ry, rz));
+        }
+        if (mBest >= 0.0f) {
+            Group* worst = &mKept[0];
+            for (Group& g : mKept) {
+                worst = g.score < worst->score ? &g : worst;
+            }
+            if (mBest > worst->score) {
+                *worst = {mBest, mBestLo, mBestHi};
+            }
+        }
+    }
+
+    /// The kept groups' cells into `most`, per level to `levels`.
+    void take(int levels, LevelCells& most) const {
+        for (const Group& g : mKept) {
+            if (g.score >= 0.0f) {
+                takeGroup(g.lo, g.hi, levels, most);
+            }
+        }
+    }
+
+private:
+    // Boxes [j, ...) up to key `last`: M = 1 keeps the nearest pair (the most shared volume, a
+    // gap under a sixteenth of a cell counting as a thin overlap); M > 1 narrows the shared
+    // box greedily and keeps it once it has more than M members.
+    void scan(std::size_t j, std::uint64_t last) {
+        for (; j < mKeys.size() && mKeys[j].key <= last && mChecks < kPairChecks; ++j) {
+            ++mChecks;
+            const UnitBox& other = mKeys[j].box;
+            std::array<float, 3> lo, hi;
+            float volume = 1.0f;
+            bool shared = true;
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = std::max(mLo[a], other.lo[a]);
+                hi[a] = std::min(mHi[a], other.hi[a]);
+                shared = shared && lo[a] < hi[a];
+                volume *= std::max(hi[a] - lo[a] + mCell / 16.0f, 0.0f);
+            }
+            if (mM == 1 && volume > mBest) {
+                mBest = volume;
+                mBestLo = lo;
+                mBestHi = hi;
+            } else if (mM > 1 && shared) {
+                mLo = lo;
+                mHi = hi;
+                if (++mMembers > mM) {
+                    mBest = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+                    mBestLo = lo;
+                    mBestHi = hi;
+                    return;
+                }
+            }
+        }
+    }
+
+    std::span<const CellKey> mKeys;
+    float mCell;
+    std::uint32_t mM;
+    // The groups kept: evaluating each box's group at every level would cost more than finding
+    // it, and the largest shared volumes give the largest counts where the counts are large.
+    static constexpr std::size_t kKeep = 16;
+    struct Group {
+        float score = -1.0f;
+        std::array<float, 3> lo{}, hi{};
+    };
+    std::array<Group, kKeep> mKept{};
+    static constexpr std::size_t kUnset = std::numeric_limits<std::size_t>::max();
+    std::array<std::size_t, 4> mCursor{kUnset, kUnset, kUnset, kUnset};
+    std::array<float, 3> mLo{}, mHi{}, mBestLo{}, mBestHi{};
+    float mBest = -1.0f;
+    std::uint32_t mMembers = 1;
+    int mChecks = 0;
+};
+
+/// Per level, the most cells any kept group of more than M items' inner boxes touches (the
+/// note's groups); sorts the records.
+LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, int levels) {
+    LevelCells most{};
+    parallel::sort(keys.begin(), keys.end());
+    std::size_t used = keys.size();
+    while (used > 0 && keys[used - 1].key == kNoCell) {
+        --used;
+    }
+    const std::span<const CellKey> sorted(keys.data(), used);
+    std::mutex merge;
+    // Fixed blocks of boxes, each keeping its own groups: the same floor on any number of
+    // threads.
+    constexpr std::size_t kBlock = 4096;
+    parallel::forEach(0, (used + kBlock - 1) / kBlock, 1, [&](std::size_t block) {
+        LevelCells part{};
+        GroupSearch search(sorted, cell, m);
+        for (std::size_t i = block * kBlock; i < std::min(used, (block + 1) * kBlock); ++i) {
+            search.run(i);
+        }
+        search.take(levels, part);
+        const std::lock_guard<std::mutex> lock(merge);
+        for (int l = 0; l < levels; ++l) {
+            most[l] = std::max(most[l], part[l]);
+        }
+    });
+    return most;
+}
+
 IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
     const Aabb b = partitionBounds(scene.bounds());
     const int splitLevels = Octree::splitLevels(b, spec.minLeafSize);
-    const LevelCounts c = countLevels(scene, spec, b, splitLevels + 1);
+    std::vector<CellKey> records(std::min<std::size_t>(scene.itemCount(), kPairItems));
+    const float cell = groupGridCell(scene, spec, b, records.size());
+    const LevelCounts c = countLevels(scene, spec, b, splitLevels + 1, records, cell);
     const std::uint64_t m = static_cast<std::uint64_t>(std::max(spec.maxObjects, 1));
+    const LevelCells groups = groupFloor(records, cell, static_cast<std::uint32_t>(m), splitLevels);
+    std::vector<CellKey>().swap(records);
     // Upper bounds: nodes and entries per level, their totals, the largest level.
     std::uint64_t nodes = 1, totalNodes = 1, slots = 0, widest = 1, entries = 0;
     // Lower bound: nodes the real tree has.
@@ -234,7 +529,8 @@ IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
         nodes = mulSat(splits, 8);
         totalNodes = addSat(totalNodes, nodes);
         if (l < splitLevels) {
-            nodesAtLeast = addSat(nodesAtLeast, mulSat(8, splitsAtLeast(c, b, l, m)));
+            nodesAtLeast =
+                addSat(nodesAtLeast, mulSat(8, std::max(splitsAtLeast(c, b, l, m), groups[l])));
         }
     }
     IndexMemoryEstimate e;

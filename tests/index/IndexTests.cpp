@@ -382,6 +382,59 @@ TEST_CASE("an octree's memory floor refuses a spec at once and never refuses wha
     }
 }
 
+TEST_CASE("the octree floor counts cells shared by overlapping items and stays a floor") {
+    // Items that overlap only here and there: the global count finds nothing, the pairs do.
+    RandomOptions r;
+    r.count = 3000;
+    r.seed = 3;
+    r.cubeSize = 0.01;
+    const Scene sparse = makeRandomScene(r);
+    IndexSpec deep = IndexSpec::octree(1, 1e-9);
+    deep.maxBytes = 64ull << 20;
+    CHECK(estimateIndexMemory(sparse, deep).atLeastBytes > deep.maxBytes);
+    CHECK_THROWS_WITH(buildIndex(sparse, deep), Catch::Contains("nodes over 3000 items"));
+
+    // Apart by more than MIN, M = 1 fits however small MIN: the floor must not refuse it.
+    LatticeOptions apart;
+    apart.perSide = 8;
+    apart.cubeSize = 0.01;
+    apart.gap = 0.004;
+    const Scene lattice = makeLatticeScene(apart);
+    const IndexSpec fine = IndexSpec::octree(1, 1e-9);
+    const auto tree = buildIndex(lattice, fine);
+    CHECK(estimateIndexMemory(lattice, fine).nodesAtLeast <= tree->stats().nodes);
+
+    // Against real builds: scenes that overlap densely, here and there, touch or nearly touch,
+    // at specs down to the smallest MIN that still fits.
+    std::vector<std::pair<std::string, Scene>> scenes = testScenes();
+    scenes.emplace_back("sparse", sparse);
+    r.count = 1000;
+    r.rotate = true;
+    r.cubeSize = 0.015;
+    scenes.emplace_back("dense rotated", makeRandomScene(r));
+    apart.gap = 1e-6;
+    scenes.emplace_back("lattice nearly touching", makeLatticeScene(apart));
+    for (const auto& [name, scene] : scenes) {
+        for (const IndexSpec& spec :
+             {IndexSpec::octree(1, 0.004), IndexSpec::octree(1, 0.0005),
+              IndexSpec::octree(2, 0.001), IndexSpec::octree(3, 0.0005),
+              IndexSpec::octree(1, 0.001, OverlapMode::Aabb), IndexSpec::octree(8, 0.0005)}) {
+            INFO(name << " " << spec.toString());
+            const IndexMemoryEstimate e = estimateIndexMemory(scene, spec);
+            IndexSpec roomy = spec;
+            roomy.maxBytes = 4ull << 30;
+            std::unique_ptr<SpatialIndex> index;
+            try {
+                index = buildIndex(scene, roomy);
+            } catch (const InputError&) { // more than kMaxNodes: nothing to compare
+                continue;
+            }
+            CHECK(e.nodesAtLeast <= index->stats().nodes);
+            CHECK(e.atLeastBytes <= index->stats().buildPeakBytes);
+        }
+    }
+}
+
 TEST_CASE("a mesh's triangles, not the mesh object, are the index's items") {
     const Scene scene = makeMeshScene();
     std::vector<std::uint32_t> indexed;
