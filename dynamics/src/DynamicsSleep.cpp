@@ -8,8 +8,9 @@
 // and it acts as a static object: infinite mass in every contact) and wakes when an impulse
 // reaches it (applyImpulse) or when a moving awake body touches it (separation <= 0 after the
 // step). Sleeping is per body (no islands): a body resting on a sleeping one is supported as
-// by the floor. Invariants: no allocation; this step's contacts become `previous` by a swap
-// of two vectors of equal capacity.
+// by the floor. A sleeping body's resting manifolds are carried from step to step unchanged
+// (carrySleepingPatches), so it wakes warm started. Invariants: no allocation; this step's contacts
+// become `previous` by a swap of two vectors of equal capacity.
 
 #include "DynamicsImpl.h"
 
@@ -36,6 +37,28 @@ double arrivalVelocity(const ContactWork& c, std::span<const BodyState> bodies, 
     return -std::sqrt(std::max(v0 * v0 - 2.0 * gn * c.startSeparation, 0.0));
 }
 
+// A sleeping body keeps the manifolds it rested on (against static items or other sleeping
+// bodies) as they were when it fell asleep: the broad phase skips it, so without this they
+// would be gone when it wakes, and its first step awake would solve its supports cold (no
+// warm start, new friction anchors), a jolt of a few nanometres sideways. Carried within the
+// arrays' capacity, in patch order.
+void carrySleepingPatches(std::span<const BodyState> bodies, Dynamics::Impl& impl) noexcept {
+    for (const FrictionPatch& p : impl.previousPatches) {
+        const bool asleep = bodies[p.a].sleeping && (p.b == kStaticSide || bodies[p.b].sleeping);
+        if (!asleep || impl.patches.size() == impl.patches.capacity() ||
+            impl.contacts.size() + p.count > impl.contacts.capacity()) {
+            continue;
+        }
+        FrictionPatch kept = p;
+        kept.first = static_cast<std::uint32_t>(impl.contacts.size());
+        for (std::uint32_t k = p.first; k < p.first + p.count; ++k) {
+            impl.contacts.push_back(impl.previous[k]);
+            impl.contacts.back().bounceVelocity = 0.0;
+        }
+        impl.patches.push_back(kept);
+    }
+}
+
 } // namespace
 
 void finishContacts(std::span<const BodyState> bodies, Dynamics::Impl& impl,
@@ -48,6 +71,7 @@ void finishContacts(std::span<const BodyState> bodies, Dynamics::Impl& impl,
             c.bounceVelocity = arrivalVelocity(c, bodies, g, dtS);
         }
     }
+    carrySleepingPatches(bodies, impl);
     std::swap(impl.contacts, impl.previous);
     std::swap(impl.patches, impl.previousPatches);
     impl.contacts.clear();
