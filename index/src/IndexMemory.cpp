@@ -35,7 +35,9 @@
 //   more than M. Of each block of boxes the kKeep groups sharing the most volume are kept, and
 //   per level the floor takes the largest kept group's cells (groups may share cells, so their
 //   counts are not added). Items beyond the first kPairItems, or larger than a grid
-//   cell, are left out: fewer items, a lower floor, still a floor.
+//   cell, are left out: fewer items, a lower floor, still a floor. The groups are looked for
+//   only when the ceiling passes the limit (under it the build fits whatever the floor says),
+//   so a build that fits pays nothing for them.
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
 // Cost: O(items * levels) time; memory per item (at most kPairItems of them) one inner box
@@ -238,7 +240,7 @@ struct LevelCounts {
 // Per axis, the item's reach and inner intervals in units of the bounds' size, so a level's
 // cell coordinates are these times 2^l: exact, as the cell steps are size * 2^-l exactly.
 void countItem(const Scene& scene, std::uint32_t item, const IndexSpec& spec, const Aabb& b,
-               int levels, LevelCounts& c, CellKey* record, float cell) {
+               int levels, LevelCounts& c) {
     const OverlapShape s = OverlapShape::of(scene, item);
     const Aabb in = innerBox(s, spec.mode);
     const double tol = kReachTolerance * (absMax(s.aabb) + absMax(b));
@@ -249,9 +251,6 @@ void countItem(const Scene& scene, std::uint32_t item, const IndexSpec& spec, co
         reachHi[a] = (s.aabb.max[a] + tol - b.min[a]) / size;
         inLo[a] = (in.min[a] - b.min[a]) / size;
         inHi[a] = (in.max[a] - b.min[a]) / size;
-    }
-    if (record != nullptr) {
-        *record = cellKey(unitBox(in, b), cell);
     }
     ++c.items;
     bool hasInner = false;
@@ -274,10 +273,7 @@ void countItem(const Scene& scene, std::uint32_t item, const IndexSpec& spec, co
     }
 }
 
-// Also writes the records of the first records.size() items' inner boxes (kNoCell for an item
-// not indexed).
-LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b, int levels,
-                        std::span<CellKey> records, float cell) {
+LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b, int levels) {
     LevelCounts total;
     std::mutex merge;
     parallel::forRanges(0, scene.itemCount(), 4096, [&](std::size_t first, std::size_t end) {
@@ -285,8 +281,7 @@ LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b
         for (std::size_t i = first; i < end; ++i) {
             const std::uint32_t item = scene.item(static_cast<std::uint32_t>(i));
             if (scene.isIndexed(item)) {
-                countItem(scene, item, spec, b, levels, part,
-                          i < records.size() ? &records[i] : nullptr, cell);
+                countItem(scene, item, spec, b, levels, part);
             }
         }
         const std::lock_guard<std::mutex> lock(merge);
@@ -478,6 +473,21 @@ private:
     int mChecks = 0;
 };
 
+/// The group pass's records of the first kPairItems items' inner boxes (kNoCell for an item
+/// not indexed).
+std::vector<CellKey> groupRecords(const Scene& scene, const IndexSpec& spec, const Aabb& b,
+                                  float cell) {
+    std::vector<CellKey> records(std::min<std::size_t>(scene.itemCount(), kPairItems));
+    parallel::forEach(0, records.size(), 4096, [&](std::size_t i) {
+        const std::uint32_t item = scene.item(static_cast<std::uint32_t>(i));
+        if (scene.isIndexed(item)) {
+            const OverlapShape shape = OverlapShape::of(scene, item);
+            records[i] = cellKey(unitBox(innerBox(shape, spec.mode), b), cell);
+        }
+    });
+    return records;
+}
+
 /// Per level, the most cells any kept group of more than M items' inner boxes touches (the
 /// note's groups); sorts the records.
 LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, int levels) {
@@ -510,17 +520,12 @@ LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, i
 IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
     const Aabb b = partitionBounds(scene.bounds());
     const int splitLevels = Octree::splitLevels(b, spec.minLeafSize);
-    std::vector<CellKey> records(std::min<std::size_t>(scene.itemCount(), kPairItems));
-    const float cell = groupGridCell(scene, spec, b, records.size());
-    const LevelCounts c = countLevels(scene, spec, b, splitLevels + 1, records, cell);
+    const LevelCounts c = countLevels(scene, spec, b, splitLevels + 1);
     const std::uint64_t m = static_cast<std::uint64_t>(std::max(spec.maxObjects, 1));
-    const LevelCells groups = groupFloor(records, cell, static_cast<std::uint32_t>(m), splitLevels);
-    std::vector<CellKey>().swap(records);
     // Upper bounds: nodes and entries per level, their totals, the largest level.
     std::uint64_t nodes = 1, totalNodes = 1, slots = 0, widest = 1, entries = 0;
-    // Lower bound: nodes the real tree has.
-    std::uint64_t nodesAtLeast = 1;
-    for (int l = 0; l <= splitLevels && nodes > 0; ++l) {
+    int reached = 0; // levels that may have nodes
+    for (int l = 0; l <= splitLevels && nodes > 0; ++l, ++reached) {
         const std::uint64_t listed = std::min(c.reach[l], mulSat(nodes, c.items));
         const std::uint64_t splits = l < splitLevels ? std::min(nodes, listed / (m + 1)) : 0;
         slots = addSat(slots, l < splitLevels ? std::min(listed, mulSat(m, nodes)) : listed);
@@ -528,14 +533,25 @@ IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
         entries = std::max(entries, listed);
         nodes = mulSat(splits, 8);
         totalNodes = addSat(totalNodes, nodes);
-        if (l < splitLevels) {
-            nodesAtLeast =
-                addSat(nodesAtLeast, mulSat(8, std::max(splitsAtLeast(c, b, l, m), groups[l])));
-        }
     }
     IndexMemoryEstimate e;
     e.atMostBytes =
         detail::octreeBuildBytes({c.items, totalNodes, slots, widest, entries, entries});
+    // The groups only matter when the ceiling passes the limit: under it the build fits
+    // whatever the floor says, and a build that fits pays no group pass.
+    LevelCells groups{};
+    if (e.atMostBytes > spec.maxBytes) {
+        const float cell =
+            groupGridCell(scene, spec, b, std::min<std::size_t>(scene.itemCount(), kPairItems));
+        std::vector<CellKey> records = groupRecords(scene, spec, b, cell);
+        groups = groupFloor(records, cell, static_cast<std::uint32_t>(m), splitLevels);
+    }
+    // Lower bound: nodes the real tree has.
+    std::uint64_t nodesAtLeast = 1;
+    for (int l = 0; l < std::min(reached, splitLevels); ++l) {
+        nodesAtLeast =
+            addSat(nodesAtLeast, mulSat(8, std::max(splitsAtLeast(c, b, l, m), groups[l])));
+    }
     // Alive at the end of the build: per item its id, local id and shape; the nodes and their
     // parents.
     e.atLeastBytes = addSat(mulSat(c.items, 2 * sizeof(std::uint32_t) + sizeof(OverlapShape)),
