@@ -506,14 +506,17 @@ std::string ratioText(double r) {
 
 std::string motionTimesRow(const experiments::MotionCase& c, const TickTarget& target,
                            const TickRun& run, const MotionTimes& t) {
+    char cpu[64] = "      -       -        -        -";
+    if (!run.cpuNs.empty()) {
+        std::snprintf(cpu, sizeof cpu, "%7.0f %7.0f %8.0f %8.0f", t.cpu.p50, t.cpu.p99, t.cpu.p999,
+                      t.cpu.max);
+    }
     char row[256];
-    std::snprintf(row, sizeof row,
-                  "%-8s %-15s %-10s | %7.0f %7.0f %8.0f %9.0f | %7.0f %7.0f %8.0f %8.0f | %8s "
-                  "%8s\n",
+    std::snprintf(row, sizeof row, "%-8s %-15s %-10s | %7.0f %7.0f %8.0f %9.0f | %s | %8s %8s\n",
                   std::string(experiments::tickMotionName(c.motion)).c_str(),
                   target.spec.toString().c_str(), modeName(run), t.wall.p50, t.wall.p99,
-                  t.wall.p999, t.wall.max, t.cpu.p50, t.cpu.p99, t.cpu.p999, t.cpu.max,
-                  ratioText(t.wallOverRest).c_str(), ratioText(t.cpuOverRest).c_str());
+                  t.wall.p999, t.wall.max, cpu, ratioText(t.wallOverRest).c_str(),
+                  ratioText(t.cpuOverRest).c_str());
     return row;
 }
 
@@ -541,7 +544,7 @@ void printMotionHeader(const experiments::TickBenchSettings& common,
                 common.ticks, static_cast<unsigned long long>(common.seed), device.c_str(),
                 size.objects);
     std::printf("timing:  wall: steady clock from the wake-up to the end of the metrics stage; "
-                "cpu (--cpu-time; 0 without): this thread's CPU clock around the step (without "
+                "cpu (--cpu-time; - without): this thread's CPU clock around the step (without "
                 "the time other processes held the core; a system call per tick, which slows "
                 "the ticks after it); nearest-rank quantiles over every tick (ns); "
                 "/rest: p99.9 over rest's\n");
