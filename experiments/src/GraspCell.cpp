@@ -3,6 +3,7 @@
 
 #include "hapto/experiments/GraspCell.h"
 
+#include "hapto/core/Clock.h"
 #include "hapto/devices/SimDevice.h"
 #include "hapto/devices/SimScript.h"
 #include "hapto/experiments/ExperimentSupport.h"
@@ -15,7 +16,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -28,13 +28,6 @@ constexpr ObjectId kFloorId = 1;
 constexpr ObjectId kBoxId = 2;
 constexpr double kHandStartGapM = 0.05; // each hand starts this far outside the box's side (m)
 constexpr double kSlipOnsetM = 0.001;   // slip onset: issue 37's 1 mm bound for a held body
-
-std::uint64_t threadCpuNs() noexcept {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<std::uint64_t>(t.tv_sec) * 1'000'000'000u +
-           static_cast<std::uint64_t>(t.tv_nsec);
-}
 
 /// A simulated hand that notes the stepping thread's CPU time at its read() when `stamp` is
 /// 0 (the first read after the driver cleared it). Forwards everything to a SimDevice.

@@ -2,6 +2,7 @@
 
 #include "hapto/experiments/TickBench.h"
 
+#include "hapto/core/Clock.h"
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/DeviceFactory.h"
 #include "hapto/runtime/Realtime.h"
@@ -9,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 #include <span>
 #include <stdexcept>
 #include <utility>
@@ -244,13 +244,6 @@ Aabb walkBox(const Aabb& bounds, double edgeM) {
     const Vec3 half(0.5 * edgeM);
     return {glm::max(bounds.min, bounds.center() - half),
             glm::min(bounds.max, bounds.center() + half)};
-}
-
-std::uint64_t threadCpuNs() noexcept {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<std::uint64_t>(t.tv_sec) * 1'000'000'000u +
-           static_cast<std::uint64_t>(t.tv_nsec);
 }
 
 const char* modeName(const TickRun& run) {

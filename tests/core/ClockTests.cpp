@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <ctime>
 #include <limits>
 
 using namespace hapto;
@@ -21,6 +22,25 @@ TEST_CASE("clock: monotonicNs never goes back and is the clock steady_clock read
         const std::uint64_t now = monotonicNs();
         cpuPause();
         const std::uint64_t after = toNs(std::chrono::steady_clock::now());
+        REQUIRE(now >= last);
+        REQUIRE(before <= now);
+        REQUIRE(now <= after);
+        last = now;
+    }
+}
+
+TEST_CASE("clock: threadCpuNs never goes back and is this thread's CPU clock") {
+    const auto cpuNow = [] {
+        timespec t{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+        return static_cast<std::uint64_t>(t.tv_sec) * 1'000'000'000ull +
+               static_cast<std::uint64_t>(t.tv_nsec);
+    };
+    std::uint64_t last = threadCpuNs();
+    for (int i = 0; i < 1000; ++i) {
+        const std::uint64_t before = cpuNow();
+        const std::uint64_t now = threadCpuNs();
+        const std::uint64_t after = cpuNow();
         REQUIRE(now >= last);
         REQUIRE(before <= now);
         REQUIRE(now <= after);

@@ -23,6 +23,7 @@
 // Registered from this file's static initialiser (Google Benchmark's registry), so the
 // benchmark main needs no line for it.
 
+#include "hapto/core/Clock.h"
 #include "hapto/dynamics/Dynamics.h"
 #include "hapto/experiments/TickBench.h"
 #include "hapto/index/DefaultIndex.h"
@@ -36,7 +37,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <map>
 #include <memory>
 #include <optional>
@@ -110,14 +110,6 @@ double sinkMm(const Dynamics& dynamics) {
     return -1e3 * lowest;
 }
 
-/// This thread's CPU time (s): what a step costs without the time other processes took the
-/// core away (the wall clock's tail on a shared machine).
-double threadCpuS() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 void stepDynamics(benchmark::State& state, std::size_t n, int bodies) {
     const Prepared& p = prepared(n, bodies);
     DynamicsOptions options;
@@ -130,16 +122,16 @@ void stepDynamics(benchmark::State& state, std::size_t n, int bodies) {
     us.reserve(1 << 22);
     cpuUs.reserve(1 << 22);
     for (auto _ : state) {
-        const double c0 = threadCpuS();
+        const std::uint64_t c0 = threadCpuNs();
         const auto t0 = std::chrono::steady_clock::now();
         dynamics.step();
         const auto t1 = std::chrono::steady_clock::now();
-        const double c1 = threadCpuS();
+        const std::uint64_t c1 = threadCpuNs();
         const double s = std::chrono::duration<double>(t1 - t0).count();
         state.SetIterationTime(s);
         if (us.size() < us.capacity()) {
             us.push_back(1e6 * s);
-            cpuUs.push_back(1e6 * (c1 - c0));
+            cpuUs.push_back(1e-3 * static_cast<double>(c1 - c0));
         }
     }
     const double maxUs = us.empty() ? 0.0 : *std::max_element(us.begin(), us.end());

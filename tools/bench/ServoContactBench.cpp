@@ -22,6 +22,7 @@
 //   hapto_bench --benchmark_filter='^servo-contact-dynamic' --benchmark_min_time=2
 //               --benchmark_repetitions=5   (one line)
 
+#include "hapto/core/Clock.h"
 #include "hapto/experiments/TickBench.h"
 #include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/BodyPoses.h"
@@ -35,7 +36,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -50,13 +50,6 @@ constexpr double kTopY = 0.01;                 // the box's top face (m)
 constexpr double kPressM = 0.001;              // how far the hand is held below it (m)
 constexpr double kSwingM = 0.02;               // the dynamic box's swing (m)
 constexpr double kSwingPeriodS = 4.0;          // and its period (s)
-
-/// This thread's CPU time (us): a tick's cost without the time other processes held the core.
-double threadCpuUs() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return 1e6 * static_cast<double>(t.tv_sec) + 1e-3 * static_cast<double>(t.tv_nsec);
-}
 
 /// A hand that stays where it is put (world = device frame).
 class HeldHand final : public Device {
@@ -131,14 +124,14 @@ struct Side {
     }
     /// One timed tick at `tNs`.
     void tick(std::uint64_t tNs, bool keep) {
-        const double c0 = threadCpuUs();
+        const std::uint64_t c0 = threadCpuNs();
         const auto t0 = std::chrono::steady_clock::now();
         (void)step.run(tNs);
         const auto t1 = std::chrono::steady_clock::now();
-        const double c1 = threadCpuUs();
+        const std::uint64_t c1 = threadCpuNs();
         if (keep && us.size() < us.capacity()) {
             us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
-            cpuUs.push_back(c1 - c0);
+            cpuUs.push_back(1e-3 * static_cast<double>(c1 - c0));
         }
     }
 };

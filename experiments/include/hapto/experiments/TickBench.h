@@ -169,9 +169,6 @@ struct TickTarget {
     std::vector<std::unique_ptr<TickRun>> runs; ///< One per mode it runs.
 };
 
-/// This thread's CPU time (ns, CLOCK_THREAD_CPUTIME_ID). [any thread]
-std::uint64_t threadCpuNs() noexcept;
-
 /// "hot", "sleep", "sleep+warm", "sleep+lat", "sleep+warm+lat". [any thread]
 const char* modeName(const TickRun& run);
 
