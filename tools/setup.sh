@@ -5,7 +5,8 @@
 #                         embedded default scene, printing each device's haptic load
 #                         (installs and builds only what the `hapto` command needs);
 #   tools/setup.sh test   runs the whole test suite through ctest: in the release build, then
-#                         under AddressSanitizer + UBSan (asan) and ThreadSanitizer (tsan),
+#                         under AddressSanitizer + UBSan (asan) and, the tests that start
+#                         threads, under ThreadSanitizer (tsan; HAPTO_TEST_SET in CMakeLists.txt),
 #                         each sanitizer build overlapping the tests before it (see run_tests).
 # Both are idempotent: a second run installs nothing and rebuilds only what changed.
 set -euo pipefail

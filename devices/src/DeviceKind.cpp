@@ -6,7 +6,7 @@
 namespace hapto {
 namespace {
 
-constexpr std::array<std::pair<DeviceKind, std::string_view>, 5> kNames = {{
+constexpr std::array<std::pair<DeviceKind, std::string_view>, 5> kKindNames = {{
     {DeviceKind::Sim, "sim"},
     {DeviceKind::Replay, "replay"},
     {DeviceKind::Falcon, "falcon"},
@@ -17,7 +17,7 @@ constexpr std::array<std::pair<DeviceKind, std::string_view>, 5> kNames = {{
 } // namespace
 
 std::string_view name(DeviceKind kind) noexcept {
-    for (const auto& [k, n] : kNames) {
+    for (const auto& [k, n] : kKindNames) {
         if (k == kind) {
             return n;
         }
@@ -26,7 +26,7 @@ std::string_view name(DeviceKind kind) noexcept {
 }
 
 std::optional<DeviceKind> parseDeviceKind(std::string_view text) noexcept {
-    for (const auto& [k, n] : kNames) {
+    for (const auto& [k, n] : kKindNames) {
         if (n == text && k != DeviceKind::Scripted) {
             return k;
         }

@@ -20,21 +20,21 @@
 namespace hapto {
 namespace {
 
-constexpr double kDefaultMaxForceN = 8.9; // the Falcon's rated peak force
+constexpr double kFalconRatedForceN = 8.9; // the Falcon's rated peak force
 
 } // namespace
 
 struct FalconDevice::Impl {
-    std::string name;                     ///< From the configuration.
-    FalconConfig config;                  ///< Which Falcon, firmware, homing, word limit.
-    double maxForceN = kDefaultMaxForceN; ///< Force clamp (N).
-    falcon::IoSettings io;                ///< Timeouts, command timeout and clock, word limit.
-    std::string error;                    ///< What went wrong last, for people.
-    falcon::FalconTransport usb{error};   ///< The USB link (declared before the I/O thread,
-                                          ///< so it outlives it).
-    falcon::FalconIoThread ioThread;      ///< USB traffic while open.
-    std::atomic<bool> open{false};        ///< read()/write() work only while true.
-    bool firmwareWasLoaded = false;       ///< open() found firmware running.
+    std::string name;                      ///< From the configuration.
+    FalconConfig config;                   ///< Which Falcon, firmware, homing, word limit.
+    double maxForceN = kFalconRatedForceN; ///< Force clamp (N).
+    falcon::IoSettings io;                 ///< Timeouts, command timeout and clock, word limit.
+    std::string error;                     ///< What went wrong last, for people.
+    falcon::FalconTransport usb{error};    ///< The USB link (declared before the I/O thread,
+                                           ///< so it outlives it).
+    falcon::FalconIoThread ioThread;       ///< USB traffic while open.
+    std::atomic<bool> open{false};         ///< read()/write() work only while true.
+    bool firmwareWasLoaded = false;        ///< open() found firmware running.
 
     /// Stops the I/O thread (zero force last) and releases the USB link. [control]
     void release() {
@@ -89,7 +89,7 @@ FalconDevice::FalconDevice(std::string name, const FalconConfig& config, double 
     : mImpl(std::make_unique<Impl>()) {
     mImpl->name = std::move(name);
     mImpl->config = config;
-    mImpl->maxForceN = maxForceN > 0.0 ? maxForceN : kDefaultMaxForceN;
+    mImpl->maxForceN = maxForceN > 0.0 ? maxForceN : kFalconRatedForceN;
     const double timeoutMs = std::isfinite(config.commandTimeoutMs) && config.commandTimeoutMs > 0.0
                                  ? std::min(config.commandTimeoutMs, kMaxCommandTimeoutMs)
                                  : defaultCommandTimeoutMs(1000.0);

@@ -6,7 +6,7 @@
 namespace hapto {
 namespace {
 
-constexpr std::array<std::pair<HandScript, std::string_view>, 6> kNames = {{
+constexpr std::array<std::pair<HandScript, std::string_view>, 6> kScriptNames = {{
     {HandScript::Free, "free"},
     {HandScript::Touch, "touch"},
     {HandScript::Slide, "slide"},
@@ -18,7 +18,7 @@ constexpr std::array<std::pair<HandScript, std::string_view>, 6> kNames = {{
 } // namespace
 
 std::string_view name(HandScript script) noexcept {
-    for (const auto& [s, n] : kNames) {
+    for (const auto& [s, n] : kScriptNames) {
         if (s == script) {
             return n;
         }
@@ -27,7 +27,7 @@ std::string_view name(HandScript script) noexcept {
 }
 
 std::optional<HandScript> parseHandScript(std::string_view text) noexcept {
-    for (const auto& [s, n] : kNames) {
+    for (const auto& [s, n] : kScriptNames) {
         if (n == text) {
             return s;
         }

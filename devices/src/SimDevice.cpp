@@ -10,7 +10,7 @@
 namespace hapto {
 namespace {
 
-constexpr double kDefaultMaxForceN = 10.0;
+constexpr double kSimDefaultMaxForceN = 10.0;
 constexpr std::uint64_t kNoiseStream = 0x5EED0F5E45011AAull; // noise apart from planning
 
 const SimConfig& simOf(const DeviceConfig& config) {
@@ -31,7 +31,7 @@ double quantise(double v, double quantum) {
 
 SimDevice::SimDevice(const DeviceConfig& config, const Scene& scene)
     : mConfig(config), mSim(simOf(config)), mScene(&scene), mDtS(1.0 / config.rateHz),
-      mMaxForceN(config.maxForceN > 0.0 ? config.maxForceN : kDefaultMaxForceN),
+      mMaxForceN(config.maxForceN > 0.0 ? config.maxForceN : kSimDefaultMaxForceN),
       mHand(mSim.handMassKg, mSim.handStiffness, mSim.handDampingRatio),
       mNoise(mSim.seed ^ kNoiseStream) {
     if (mSim.object && !scene.slotOf(*mSim.object)) {

@@ -15,6 +15,11 @@
 
 namespace hapto::contact {
 
+/// An int index (a face, corner or edge number) as a container index.
+constexpr std::size_t at(int i) noexcept {
+    return static_cast<std::size_t>(i);
+}
+
 /// Most corners of one face polygon the clipper reads (a hull face with more keeps its first
 /// kFaceMax corners in angular order; convexHullOf's merged faces stay far below it).
 inline constexpr int kFaceMax = 32;

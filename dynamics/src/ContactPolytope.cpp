@@ -19,10 +19,6 @@ namespace hapto::contact {
 
 namespace {
 
-constexpr std::size_t at(int i) noexcept {
-    return static_cast<std::size_t>(i);
-}
-
 double boxSign(int bits, int k) noexcept {
     return ((bits >> k) & 1) != 0 ? 1.0 : -1.0;
 }

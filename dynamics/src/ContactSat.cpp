@@ -54,10 +54,6 @@ constexpr double kRelTol = 0.05;
 constexpr double kParallel = 1e-6; // |sin| below which two edge directions are parallel
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-constexpr std::size_t at(int i) noexcept {
-    return static_cast<std::size_t>(i);
-}
-
 struct FaceQuery {
     double sep = -kInf;
     int face = -1;

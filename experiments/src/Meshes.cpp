@@ -13,7 +13,7 @@
 namespace hapto::experiments {
 namespace {
 
-constexpr double kStandOffM = 0.02; // start this far outside the mesh, on its +z side
+constexpr double kMeshStandOffM = 0.02; // start this far outside the mesh, on its +z side
 
 /// The sizes: 1 and 3 per decade from 10^2 up to `maxTriangles` (which is always included).
 std::vector<std::size_t> triangleSweep(std::size_t maxTriangles) {
@@ -38,11 +38,11 @@ MeshOptions meshOptions(const MeshesArgs& args, std::size_t triangles) {
     return o;
 }
 
-/// On the z axis, kStandOffM beyond the mesh's bounds. The touch and slide scripts press into
+/// On the z axis, kMeshStandOffM beyond the mesh's bounds. The touch and slide scripts press into
 /// the mesh from there (the sphere's pole, the torus's outer equator) and slide along x; the
 /// free walk moves in the padding around the mesh.
 Vec3 meshStart(const Scene& scene) {
-    return Vec3(0.0, 0.0, scene.object(0).aabb().max.z + kStandOffM);
+    return Vec3(0.0, 0.0, scene.object(0).aabb().max.z + kMeshStandOffM);
 }
 
 } // namespace
@@ -90,7 +90,7 @@ int runMeshes(const MeshesArgs& args) {
                                             {"grid_cells", args.gridCells},
                                             {"octree_max_items", args.octreeMaxItems},
                                             {"octree_min_leaf_m", args.octreeMinLeafM},
-                                            {"stand_off_m", kStandOffM}},
+                                            {"stand_off_m", kMeshStandOffM}},
                                        args.common, args.maxIndexMb, renderers, args.ratesHz, rows,
                                        args.verdict, "triangles_asked", progress);
 

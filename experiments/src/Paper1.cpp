@@ -12,10 +12,10 @@
 namespace hapto::experiments {
 namespace {
 
-constexpr double kCubeM = 0.05;     // the paper's e-Touch boxes
-constexpr double kGapM = 0.01;      // free space between neighbouring cubes
-constexpr double kPadM = 0.04;      // partitioned space beyond the lattice, on every side
-constexpr double kStandOffM = 0.02; // start this far outside the lattice's +z face
+constexpr double kPaper1CubeM = 0.05;      // the paper's e-Touch boxes
+constexpr double kGapM = 0.01;             // free space between neighbouring cubes
+constexpr double kPadM = 0.04;             // partitioned space beyond the lattice, on every side
+constexpr double kLatticeStandOffM = 0.02; // start this far outside the lattice's +z face
 
 /// The sizes: a geometric-ish sweep of K up to `maxPerSide` (which is always included).
 std::vector<int> perSideSweep(int maxPerSide) {
@@ -38,10 +38,10 @@ std::vector<int> perSideSweep(int maxPerSide) {
 Scene latticeScene(int k) {
     LatticeOptions o;
     o.perSide = k;
-    o.cubeSize = kCubeM;
+    o.cubeSize = kPaper1CubeM;
     o.gap = kGapM;
     Scene lattice = makeLatticeScene(o);
-    const double half = 0.5 * (k * kCubeM + (k - 1) * kGapM) + kPadM;
+    const double half = 0.5 * (k * kPaper1CubeM + (k - 1) * kGapM) + kPadM;
     std::vector<SceneObject> objects(lattice.objects().begin(), lattice.objects().end());
     return Scene(Aabb{Vec3(-half), Vec3(half)}, std::move(objects));
 }
@@ -50,10 +50,10 @@ Scene latticeScene(int k) {
 /// centre, the stand-off the touch and slide scripts approach from. The free walk moves in the
 /// 4 cm slab between that face and the partitioned space's boundary.
 Vec3 latticeStart(int k) {
-    const double pitch = kCubeM + kGapM;
+    const double pitch = kPaper1CubeM + kGapM;
     const double c = (k / 2 - 0.5 * (k - 1)) * pitch; // the centre cube's (or next one's) x, y
-    const double face = 0.5 * (k * kCubeM + (k - 1) * kGapM);
-    return Vec3(c, c, face + kStandOffM);
+    const double face = 0.5 * (k * kPaper1CubeM + (k - 1) * kGapM);
+    return Vec3(c, c, face + kLatticeStandOffM);
 }
 
 } // namespace
@@ -84,7 +84,7 @@ int runPaper1(const Paper1Args& args) {
     // Files.
     const auto plots = writeSweepFiles(out, "paper1",
                                        Json{{"max_per_side", args.maxPerSide},
-                                            {"cube_m", kCubeM},
+                                            {"cube_m", kPaper1CubeM},
                                             {"gap_m", kGapM},
                                             {"pad_m", kPadM}},
                                        args.common, args.maxIndexMb, renderers, args.ratesHz, rows,

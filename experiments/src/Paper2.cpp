@@ -13,8 +13,8 @@
 namespace hapto::experiments {
 namespace {
 
-constexpr double kWorkspaceM = 0.25; // the paper's 25 cm work cube
-constexpr double kCubeM = 0.05;      // 5 cm cubes
+constexpr double kWorkspaceM = 0.25;  // the paper's 25 cm work cube
+constexpr double kPaper2CubeM = 0.05; // 5 cm cubes
 
 const char* kTable2Grid = "grid 5x5x5";
 const char* kTable2Octree = "octree M=2";
@@ -61,7 +61,7 @@ std::vector<SweepStep> paper2Steps(const Paper2Args& args, const std::vector<std
                                        o.count = n;
                                        o.seed = seed;
                                        o.workspace = kWorkspaceM;
-                                       o.cubeSize = kCubeM;
+                                       o.cubeSize = kPaper2CubeM;
                                        o.keepClear = keepClear;
                                        return makeRandomScene(o);
                                    },
@@ -161,7 +161,7 @@ int runPaper2(const Paper2Args& args) {
                                        Json{{"counts", counts},
                                             {"seeds", args.seeds},
                                             {"workspace_m", kWorkspaceM},
-                                            {"cube_m", kCubeM},
+                                            {"cube_m", kPaper2CubeM},
                                             {"keep_clear_m", args.keepClearM}},
                                        args.common, args.maxIndexMb, renderers, args.ratesHz, rows,
                                        args.verdict, "count", progress);

@@ -12,6 +12,9 @@
 
 namespace hapto::detail {
 
+/// The coordinate names, by axis, for messages.
+inline constexpr const char* kAxis[3] = {"x", "y", "z"};
+
 /// The model formats hapto reads.
 enum class MeshFormat { Obj, Stl, Ply };
 

@@ -20,8 +20,6 @@
 namespace hapto::detail {
 namespace {
 
-constexpr const char* kAxis[3] = {"x", "y", "z"};
-
 enum class PlyType : std::uint8_t { I8, U8, I16, U16, I32, U32, F32, F64 };
 
 std::optional<PlyType> plyType(std::string_view t) {

@@ -34,8 +34,6 @@ float readF32le(const char* p) {
     return std::bit_cast<float>(readU32le(p));
 }
 
-constexpr const char* kAxis[3] = {"x", "y", "z"};
-
 /// A coordinate already checked by parseNumber, as the 32-bit float the model keeps.
 double asFloat(std::string_view t) {
     return static_cast<float>(*parseNumber(t));

@@ -3,6 +3,8 @@
 
 #include "hapto/view/LiveFeed.h"
 
+#include "ViewJson.h"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -11,9 +13,7 @@
 namespace hapto {
 namespace {
 
-nlohmann::json vec(const Vec3& v) {
-    return nlohmann::json::array({v.x, v.y, v.z});
-}
+using detail::vec;
 
 std::uint64_t steadyNs() {
     return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(

@@ -2,6 +2,8 @@
 
 #include "hapto/view/ViewDocuments.h"
 
+#include "ViewJson.h"
+
 #include "hapto/scenes/TriangleMesh.h"
 #include "hapto/view/LoadWindow.h"
 
@@ -19,13 +21,8 @@
 namespace hapto {
 namespace {
 
-nlohmann::json vec(const Vec3& v) {
-    return nlohmann::json::array({v.x, v.y, v.z});
-}
-
-nlohmann::json quat(const Quat& q) {
-    return nlohmann::json::array({q.w, q.x, q.y, q.z});
-}
+using detail::quat;
+using detail::vec;
 
 // Ids of the objects whose solid holds p, by brute force over their boxes first.
 nlohmann::json containing(const Scene& scene, const Vec3& p) {
