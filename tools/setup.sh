@@ -120,9 +120,24 @@ run_tests() {
   builder_pid=
   echo "== test: $SECONDS s in all"
   if [ ${#failed[@]} -gt 0 ]; then
+    for preset in release asan tsan; do print_failed_tests "$preset"; done
     echo "== FAILED: ${failed[*]}"
     return 1
   fi
+}
+
+# Repeats, at the end of the run where a log's tail shows it, each test PRESET's last ctest
+# failed, with the last lines of its output (ctest printed them whole in its own run above).
+print_failed_tests() {
+  local dir=build/$1/Testing/Temporary
+  [ -s "$dir/LastTestsFailed.log" ] || return 0
+  echo "== $1: failed tests"
+  awk -F: 'NR == FNR { failed[$1] = 1; next }
+    /^[0-9]+\/[0-9]+ Test: / { split($0, a, "/"); show = (a[1] in failed); n = 0 }
+    show && /^[0-9]+\/[0-9]+ Test: / { print "-- " substr($0, index($0, ": ") + 2) }
+    show && /^Output:/ { n = 0; keep = 1; getline; next }
+    show && /^<end of output>/ { for (i = (n > 30 ? n - 30 : 0); i < n; i++) print "   " line[i]; keep = 0 }
+    show && keep { line[n++] = $0 }' "$dir/LastTestsFailed.log" "$dir/LastTest.log"
 }
 
 case "$mode" in
