@@ -48,7 +48,8 @@ TEST_CASE("mailbox: nothing to read before the first publish, then the newest va
     CHECK_FALSE(box.read(out));
 }
 
-TEST_CASE("mailbox: a reader racing a writer never sees a torn value, and never goes back") {
+TEST_CASE("mailbox: a reader racing a writer never sees a torn value, and never goes back",
+          "[threads]") {
     Mailbox<Payload> box;
     std::atomic<bool> done{false};
     constexpr std::uint64_t kCount = 100'000;

@@ -31,7 +31,8 @@ TEST_CASE("spsc ring: order, capacity rounding, wrap-around") {
     }
 }
 
-TEST_CASE("spsc ring: a producer and a consumer thread see every value once, in order") {
+TEST_CASE("spsc ring: a producer and a consumer thread see every value once, in order",
+          "[threads]") {
     SpscRing<std::uint64_t> ring(64);
     constexpr std::uint64_t kCount = 200'000;
     std::thread producer([&] {

@@ -133,7 +133,7 @@ const Vec3 kOrigin(0.0, 0.0, kWorkspaceOriginZ);
 } // namespace
 
 TEST_CASE("set-up with firmware running sends the FTDI requests in order, no upload",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     FalconDevice dev("left", noHoming(), 5.0);
@@ -158,7 +158,7 @@ TEST_CASE("set-up with firmware running sends the FTDI requests in order, no upl
 }
 
 TEST_CASE("firmware is uploaded from the user's file with the handshake and echo check",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     hapto::test::TempDir dir;
     std::string image;
@@ -207,7 +207,7 @@ TEST_CASE("firmware is uploaded from the user's file with the handshake and echo
 }
 
 TEST_CASE("a firmware upload whose echo does not match fails with the byte position",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     hapto::test::TempDir dir;
     hapto::test::writeFile(dir / "falcon.bin", std::string(300, '\x42'));
@@ -223,7 +223,8 @@ TEST_CASE("a firmware upload whose echo does not match fails with the byte posit
     CHECK_THAT(dev.errorMessage(), Catch::Contains("firmware upload failed at byte 124"));
 }
 
-TEST_CASE("without firmware and without a firmware file, open says what to do", "[emulated]") {
+TEST_CASE("without firmware and without a firmware file, open says what to do",
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulatorOptions opt;
     opt.firmwareLoaded = false;
@@ -248,7 +249,7 @@ TEST_CASE("without firmware and without a firmware file, open says what to do", 
 
 TEST_CASE("homing: every packet asks for homing mode, open waits for all three homed flags, and "
           "the Falcon stays homed while it runs and after close",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulatorOptions opt;
     opt.homeAfterPackets = 20;
@@ -295,7 +296,7 @@ TEST_CASE("homing: every packet asks for homing mode, open waits for all three h
     CHECK(emu.badCommandFrames() == 0);
 }
 
-TEST_CASE("homing times out with a message telling the user what to do", "[emulated]") {
+TEST_CASE("homing times out with a message telling the user what to do", "[emulated][threads]") {
     requireEmulation();
     FalconEmulatorOptions opt;
     opt.homeAfterPackets = -1;
@@ -314,7 +315,7 @@ TEST_CASE("homing times out with a message telling the user what to do", "[emula
 }
 
 TEST_CASE("a second of I/O gives known positions and known motor words, zero at close",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     const Pose a = poseNear(Vec3(0.010, -0.015, 0.140));
@@ -392,7 +393,8 @@ TEST_CASE("a second of I/O gives known positions and known motor words, zero at 
     CHECK(dev.write(force) == DeviceStatus::NotOpen);
 }
 
-TEST_CASE("forces are clamped to the max force and non-finite forces become zero", "[emulated]") {
+TEST_CASE("forces are clamped to the max force and non-finite forces become zero",
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     const Pose a = poseNear(Vec3(0.0, 0.0, 0.130));
@@ -418,7 +420,7 @@ TEST_CASE("forces are clamped to the max force and non-finite forces become zero
 
 TEST_CASE("motor words over the configured limit are scaled together: the force keeps its "
           "direction and the largest word equals the limit",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     const Pose a = poseNear(Vec3(0.01, -0.01, 0.13));
@@ -462,7 +464,7 @@ TEST_CASE("motor words over the configured limit are scaled together: the force 
 
 TEST_CASE("a Falcon whose servo stops writing is commanded zero once the newest command is "
           "older than the command timeout (stepped clock)",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     const Pose a = poseNear(Vec3(0.0, 0.0, 0.130));
@@ -561,7 +563,7 @@ TEST_CASE("a Falcon whose servo thread stops is commanded zero (steady clock)",
 }
 
 TEST_CASE("garbage and short packets are counted and skipped, and only garbage is BadData",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     const Pose a = poseNear(Vec3(0.005, 0.010, 0.135));
@@ -597,7 +599,8 @@ TEST_CASE("garbage and short packets are counted and skipped, and only garbage i
     dev.close();
 }
 
-TEST_CASE("unplugged mid-run, the servo sees Disconnected and close does not hang", "[emulated]") {
+TEST_CASE("unplugged mid-run, the servo sees Disconnected and close does not hang",
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     const Pose a = poseNear(Vec3(0.0, 0.01, 0.14));
@@ -637,7 +640,7 @@ TEST_CASE("unplugged mid-run, the servo sees Disconnected and close does not han
 }
 
 TEST_CASE("unplugged and plugged back in, the same device opens again and drives the motors",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     const Pose a = poseNear(Vec3(0.0, 0.01, 0.14));
@@ -684,7 +687,7 @@ TEST_CASE("unplugged and plugged back in, the same device opens again and drives
 }
 
 TEST_CASE("devices are picked by serial or bus/address, and listed for `hapto devices`",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulation();
     FalconEmulator emu;
     std::string why;
@@ -724,7 +727,7 @@ TEST_CASE("devices are picked by serial or bus/address, and listed for `hapto de
     }
 }
 
-TEST_CASE("with no Falcon on the bus, discovery says so", "[emulated]") {
+TEST_CASE("with no Falcon on the bus, discovery says so", "[emulated][threads]") {
     requireEmulation();
     UMockdevTestbed* tb = umockdev_testbed_new(); // an empty bus
     std::string why;

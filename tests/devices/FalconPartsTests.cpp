@@ -48,7 +48,7 @@ IoSettings testSettings() {
 } // namespace
 
 TEST_CASE("falcon transport: opens the Falcon it is asked for, names what it found otherwise",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulationHere();
     FalconEmulator emu;
     std::string error;
@@ -71,7 +71,7 @@ TEST_CASE("falcon transport: opens the Falcon it is asked for, names what it fou
 
 TEST_CASE("falcon firmware: the probe sees no firmware under the bootloader, the upload loads "
           "the image, then the probe answers",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulationHere();
     hapto::test::TempDir dir;
     std::string image;
@@ -97,7 +97,7 @@ TEST_CASE("falcon firmware: the probe sees no firmware under the bootloader, the
 
 TEST_CASE("falcon I/O thread: zero motor words while homing or without a command, the last "
           "packet zero, every packet with the homing bit",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulationHere();
     FalconEmulator emu;
     std::string error;
@@ -134,7 +134,7 @@ TEST_CASE("falcon I/O thread: zero motor words while homing or without a command
 }
 
 TEST_CASE("falcon homing: done once all three flags are homed, a timeout says what to do",
-          "[emulated]") {
+          "[emulated][threads]") {
     requireEmulationHere();
     FalconEmulatorOptions opt;
     SECTION("homes") {

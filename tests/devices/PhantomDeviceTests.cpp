@@ -122,7 +122,8 @@ PhantomDevice& withFrozenClock(PhantomDevice& dev) {
 
 } // namespace
 
-TEST_CASE("a phantom opens by name or the default, and a wrong name is an error naming it") {
+TEST_CASE("a phantom opens by name or the default, and a wrong name is an error naming it",
+          "[threads]") {
     FakeHd fake;
     {
         PhantomDevice dev("left", fakeConfig(""), 0.0);
@@ -164,7 +165,8 @@ TEST_CASE("a phantom opens by name or the default, and a wrong name is an error 
     CHECK(fake.callbacksScheduled() == 0);
 }
 
-TEST_CASE("positions arrive in metres from the HD's millimetres, with velocity and buttons") {
+TEST_CASE("positions arrive in metres from the HD's millimetres, with velocity and buttons",
+          "[threads]") {
     FakeHd fake;
     fake.setMotion(kDefault, 12.5, -40.0, 7.0, 0.0, 0.0, 0.0);
     fake.setButtons(kDefault, 0b10);
@@ -195,7 +197,8 @@ TEST_CASE("positions arrive in metres from the HD's millimetres, with velocity a
 }
 
 TEST_CASE("the stylus orientation arrives from HD_CURRENT_TRANSFORM as a unit quaternion, with "
-          "the gimbal angles") {
+          "the gimbal angles",
+          "[threads]") {
     FakeHd fake;
     fake.setMotion(kDefault, 10.0, 20.0, 30.0, 0.0, 0.0, 0.0);
     PhantomDevice dev("left", fakeConfig(""), 0.0);
@@ -230,7 +233,7 @@ TEST_CASE("the stylus orientation arrives from HD_CURRENT_TRANSFORM as a unit qu
     }
 }
 
-TEST_CASE("forces arrive in newtons, clamped to the limit, and are zero after close") {
+TEST_CASE("forces arrive in newtons, clamped to the limit, and are zero after close", "[threads]") {
     FakeHd fake;
     PhantomDevice dev("left", fakeConfig("Left Touch"), 2.0);
     withFrozenClock(dev);
@@ -263,7 +266,7 @@ TEST_CASE("forces arrive in newtons, clamped to the limit, and are zero after cl
     dev.close(); // twice is safe
 }
 
-TEST_CASE("two phantoms share one HD scheduler and each gets its own force") {
+TEST_CASE("two phantoms share one HD scheduler and each gets its own force", "[threads]") {
     FakeHd fake;
     fake.setMotion(kLeft, -100.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     fake.setMotion(kRight, 100.0, 0.0, 0.0, 0.0, 0.0, 0.0);
@@ -303,7 +306,7 @@ TEST_CASE("two phantoms share one HD scheduler and each gets its own force") {
     CHECK(fake.schedulerRunning() == 0);
 }
 
-TEST_CASE("an HD error in the scheduler becomes a fault with the HD code and text") {
+TEST_CASE("an HD error in the scheduler becomes a fault with the HD code and text", "[threads]") {
     FakeHd fake;
     PhantomDevice dev("left", fakeConfig(""), 0.0);
     withFrozenClock(dev);
@@ -330,7 +333,7 @@ TEST_CASE("an HD error in the scheduler becomes a fault with the HD code and tex
     CHECK(dev.read(s) == DeviceStatus::Ok);
 }
 
-TEST_CASE("an unplugged phantom reads Disconnected") {
+TEST_CASE("an unplugged phantom reads Disconnected", "[threads]") {
     FakeHd fake;
     PhantomDevice dev("left", fakeConfig(""), 0.0);
     REQUIRE(dev.open() == DeviceStatus::Ok);
@@ -341,7 +344,8 @@ TEST_CASE("an unplugged phantom reads Disconnected") {
     CHECK_THAT(dev.errorMessage(), Catch::Contains("cable"));
 }
 
-TEST_CASE("a stalled HD scheduler makes read() report Stalled, and close() still returns") {
+TEST_CASE("a stalled HD scheduler makes read() report Stalled, and close() still returns",
+          "[threads]") {
     FakeHd fake;
     PhantomDevice dev("left", fakeConfig(""), 0.0);
     dev.setStaleTimeout(std::chrono::milliseconds(20));
@@ -386,7 +390,7 @@ TEST_CASE("a missing HD library is a clear error and probePhantoms says why") {
     CHECK_THAT(why, Catch::Contains("not a usable OpenHaptics HD library"));
 }
 
-TEST_CASE("probePhantoms lists the stand-in's default device") {
+TEST_CASE("probePhantoms lists the stand-in's default device", "[threads]") {
     FakeHd fake;
     std::string why;
     const std::vector<PhantomInfo> found = probePhantoms(kFakeLibrary, why);
@@ -407,7 +411,8 @@ TEST_CASE("probePhantoms lists the stand-in's default device") {
 }
 
 TEST_CASE("a phantom whose servo stops writing applies zero force once the newest command is "
-          "older than the command timeout (stepped HD ticks and clock)") {
+          "older than the command timeout (stepped HD ticks and clock)",
+          "[threads]") {
     FakeHd fake;
     PhantomConfig config = fakeConfig("Left Touch");
     config.commandTimeoutMs = 3.0;

@@ -97,7 +97,8 @@ std::size_t contactTicks(const std::vector<TraceSample>& samples) {
 } // namespace
 
 TEST_CASE("replay: a recorded run replayed against the same scene and index writes the same "
-          "forces, tick for tick, with the recorded transform and rate") {
+          "forces, tick for tick, with the recorded transform and rate",
+          "[threads]") {
     test::TempDir dir;
     std::filesystem::create_directories(dir / "run");
     std::filesystem::create_directories(dir / "replay");
@@ -152,7 +153,8 @@ TEST_CASE("replay: a recorded run replayed against the same scene and index writ
 }
 
 TEST_CASE("replay: a device's own transform overrides the recorded one (and then the forces "
-          "differ)") {
+          "differ)",
+          "[threads]") {
     test::TempDir dir;
     std::filesystem::create_directories(dir / "run");
     std::filesystem::create_directories(dir / "replay");

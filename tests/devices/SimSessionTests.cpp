@@ -70,7 +70,8 @@ std::vector<Vec3> pressedForces(const Scene& scene, double pressN, double second
 } // namespace
 
 TEST_CASE("sim touch through the runtime: the steady force is press_n on boxes and meshes of "
-          "800, 1000 and 3000 N/m") {
+          "800, 1000 and 3000 N/m",
+          "[threads]") {
     for (const bool mesh : {false, true}) {
         for (const double k : {800.0, 1000.0, 3000.0}) {
             for (const double pressN : {1.5, 3.0}) {
@@ -91,7 +92,8 @@ TEST_CASE("sim touch through the runtime: the steady force is press_n on boxes a
     }
 }
 
-TEST_CASE("sim touch through the runtime: the same session gives the same forces, tick for tick") {
+TEST_CASE("sim touch through the runtime: the same session gives the same forces, tick for tick",
+          "[threads]") {
     const Scene scene = oneObject(true, 1000.0);
     CHECK(pressedForces(scene, 1.5, 3.0) == pressedForces(scene, 1.5, 3.0));
 }

@@ -327,7 +327,8 @@ TEST_CASE("trace recorder: a full ring drops and counts instead of blocking") {
     CHECK(back[8] == samples[19]);
 }
 
-TEST_CASE("trace recorder: a servo thread and a draining thread lose nothing uncounted") {
+TEST_CASE("trace recorder: a servo thread and a draining thread lose nothing uncounted",
+          "[threads]") {
     test::TempDir dir;
     constexpr std::uint64_t kTicks = 200000;
     std::atomic<bool> done{false};

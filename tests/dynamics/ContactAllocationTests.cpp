@@ -44,7 +44,7 @@ TEST_CASE("Contact: collide() allocates nothing, for every pair kind") {
     CHECK(contacts > 0);
 }
 
-TEST_CASE("Box query: visitLeaves allocates nothing (octree, grid, brute force)") {
+TEST_CASE("Box query: visitLeaves allocates nothing (octree, grid, brute force)", "[threads]") {
     RandomOptions r;
     r.count = 200;
     r.seed = 3;

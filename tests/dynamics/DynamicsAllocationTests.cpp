@@ -10,7 +10,7 @@
 using namespace hapto;
 using namespace hapto::test;
 
-TEST_CASE("the dynamics step allocates nothing", "[dynamics]") {
+TEST_CASE("the dynamics step allocates nothing", "[dynamics][threads]") {
     World w(closedBoxScene()); // sleeping on: bodies fall asleep and wake during the run
     const std::uint64_t before = gAllocations.load();
     for (int k = 0; k < 3000; ++k) {

@@ -72,7 +72,7 @@ TEST_CASE("a box at rest on the floor stays for 5 s", "[dynamics]") {
     CHECK(w.dynamics->stats(0).deepestPenetrationM <= 1e-4 + 1e-5);
 }
 
-TEST_CASE("a stack of three boxes stays for 5 s", "[dynamics]") {
+TEST_CASE("a stack of three boxes stays for 5 s", "[dynamics][threads]") {
     const double hh = 0.02;
     std::vector<SceneObject> o{floorBox(1)};
     for (int k = 0; k < 3; ++k) {
@@ -234,7 +234,7 @@ TEST_CASE("applyImpulse changes momentum exactly", "[dynamics]") {
     CHECK(w.dynamics->stats(0).largestEnergyGainJ < 1e-15);
 }
 
-TEST_CASE("energy never grows in a closed box of bouncing bodies", "[dynamics]") {
+TEST_CASE("energy never grows in a closed box of bouncing bodies", "[dynamics][threads]") {
     World w(closedBoxScene(), Vec3(0, -kG, 0), awake());
     const double start = totalEnergy(*w.dynamics);
     double mass = 0.0;
@@ -257,7 +257,7 @@ TEST_CASE("energy never grows in a closed box of bouncing bodies", "[dynamics]")
     CHECK(deepest < 2e-3);
 }
 
-TEST_CASE("two stepped runs are byte-identical", "[dynamics]") {
+TEST_CASE("two stepped runs are byte-identical", "[dynamics][threads]") {
     World a(closedBoxScene()), b(closedBoxScene());
     a.run(1.0);
     b.run(1.0);
@@ -266,7 +266,7 @@ TEST_CASE("two stepped runs are byte-identical", "[dynamics]") {
                       sizeof(BodyState) * a.dynamics->bodyCount()) == 0);
 }
 
-TEST_CASE("the same steps whatever the index", "[dynamics]") {
+TEST_CASE("the same steps whatever the index", "[dynamics][threads]") {
     // The broad phase sorts each body's candidates by item, so the index's kind and leaf
     // order cannot change a contact or its order: the states agree bit for bit.
     World octree(closedBoxScene()), grid(closedBoxScene(), Vec3(0, -kG, 0), {}, 1000.0, "grid:7"),
@@ -303,7 +303,8 @@ std::vector<SceneObject> cubeFieldScene() {
     return o;
 }
 
-TEST_CASE("a body's cached index query gives the steps a direct query gives", "[dynamics]") {
+TEST_CASE("a body's cached index query gives the steps a direct query gives",
+          "[dynamics][threads]") {
     // The octree's bodies keep a cached query (a few dozen items near them, asked again after
     // moving 5 mm); brute force's one leaf holds all 401 items, more than a cache holds, so
     // its bodies ask the index directly every step. The candidates must be the same items in

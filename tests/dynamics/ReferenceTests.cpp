@@ -245,6 +245,7 @@ TEST_CASE("hapto vs Bullet: a box on a ramp slides as far as Bullet's in 1 s", "
     CHECK(std::abs(h - b) <= 0.02 * kSlideAccel / 2);
 }
 
-TEST_CASE("hapto vs Bullet: a stack of three boxes stays put as Bullet's does", "[reference]") {
+TEST_CASE("hapto vs Bullet: a stack of three boxes stays put as Bullet's does",
+          "[reference][threads]") {
     checkStack(haptoRun(stackScene(), 2000));
 }

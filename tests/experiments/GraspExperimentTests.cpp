@@ -200,7 +200,8 @@ TEST_CASE("grasp cell: a spec it cannot run is refused naming the field") {
 
 // ---- The experiment's outputs (GraspExperiment.h), on the --quick subset.
 
-TEST_CASE("grasp experiment: the quick subset writes its table as CSV, JSON and markdown") {
+TEST_CASE("grasp experiment: the quick subset writes its table as CSV, JSON and markdown",
+          "[threads]") {
     const auto dir = std::filesystem::temp_directory_path() /
                      ("hapto-grasp-experiment-" + std::to_string(::getpid()));
     GraspArgs args;

@@ -190,7 +190,7 @@ TEST_CASE("every text of a figure is an ASCII string constant, every special byt
     CHECK(script.find("\nd") == std::string::npos);
 }
 
-TEST_CASE("gnuplot draws hostile names as text and runs none of them") {
+TEST_CASE("gnuplot draws hostile names as text and runs none of them", "[threads]") {
     test::TempDir root;
     // The output's folder is hostile too (no NUL: a path cannot hold one).
     std::string folder = hostile("dir");

@@ -36,7 +36,8 @@ Scene cubeGrid() {
 
 } // namespace
 
-TEST_CASE("bench tick runs the servo's step: its forces and metrics are a stepped Runtime's") {
+TEST_CASE("bench tick runs the servo's step: its forces and metrics are a stepped Runtime's",
+          "[threads]") {
     const Scene scene = cubeGrid();
     const IndexSpec spec = IndexSpec::parse("octree:2:0.005");
     TickBenchSettings s;
@@ -96,7 +97,7 @@ TEST_CASE("bench tick runs the servo's step: its forces and metrics are a steppe
     runtime.stop();
 }
 
-TEST_CASE("bench tick stamps every stage of the step in order") {
+TEST_CASE("bench tick stamps every stage of the step in order", "[threads]") {
     TickBenchSettings s;
     s.indices = {IndexSpec::parse("octree:2:0.005")};
     s.ticks = 300;
@@ -116,7 +117,8 @@ TEST_CASE("bench tick stamps every stage of the step in order") {
     CHECK(run.shared->metrics.ticks.load() == s.ticks);
 }
 
-TEST_CASE("a warmed simulated hand is primed by the servo's step and starts on the surface") {
+TEST_CASE("a warmed simulated hand is primed by the servo's step and starts on the surface",
+          "[threads]") {
     const Scene scene = cubeGrid();
     WarmedSimDevice hand(simHand("h", 1000.0, "touch", 3, Vec3(0.0, 0.0, 0.025)), scene);
     CHECK(hand.warmUp(0.1) > 0.0);
@@ -134,7 +136,8 @@ TEST_CASE("a warmed simulated hand is primed by the servo's step and starts on t
     hand.close();
 }
 
-TEST_CASE("the experiments' tick probe runs the servo's step and gives its reader back") {
+TEST_CASE("the experiments' tick probe runs the servo's step and gives its reader back",
+          "[threads]") {
     World world(cubeGrid(), IndexSpec::parse("octree:2:0.005"));
     const std::size_t readers = world.readerCount();
     // On a cube's face, so the probe renders a contact.

@@ -256,7 +256,7 @@ TEST_CASE("the resting hand comes down and rests 0.5 mm inside a top face") {
     CHECK(c.path.front().y == Approx(rest.y + 0.003));
 }
 
-TEST_CASE("each motion's ticks do the work that explains them") {
+TEST_CASE("each motion's ticks do the work that explains them", "[threads]") {
     constexpr std::size_t kTicks = 1500;
     SECTION("rest: in contact once down, one face, one solve") {
         const Work r = runMotion(TickMotion::Rest, kTicks);

@@ -58,7 +58,8 @@ std::vector<std::uint32_t> allLeaves(const SpatialIndex& index) {
 
 } // namespace
 
-TEST_CASE("Box query: every item reaching into the box is found, every index and scene") {
+TEST_CASE("Box query: every item reaching into the box is found, every index and scene",
+          "[threads]") {
     Random rng(37);
     for (const auto& [name, scene] : testScenes()) {
         const auto shapes = itemShapes(scene);
@@ -94,7 +95,7 @@ TEST_CASE("Box query: every item reaching into the box is found, every index and
     }
 }
 
-TEST_CASE("Box query: exactly the leaves overlapping the box, each once") {
+TEST_CASE("Box query: exactly the leaves overlapping the box, each once", "[threads]") {
     Random rng(5);
     const Scene scene = makeDegenerateScene();
     for (const IndexSpec& spec : testSpecs()) {
@@ -121,7 +122,8 @@ TEST_CASE("Box query: exactly the leaves overlapping the box, each once") {
     }
 }
 
-TEST_CASE("Box query: a visitor stops the walk, and empty or NaN boxes visit nothing") {
+TEST_CASE("Box query: a visitor stops the walk, and empty or NaN boxes visit nothing",
+          "[threads]") {
     const Scene scene = makeDegenerateScene();
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (const IndexSpec& spec : testSpecs()) {

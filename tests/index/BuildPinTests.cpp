@@ -197,6 +197,6 @@ large clustered | octree:8:0.02:aabb | 153 134 b100c901fdec5664
 
 } // namespace
 
-TEST_CASE("octree and grid builds give the pinned structures on seeded scenes") {
+TEST_CASE("octree and grid builds give the pinned structures on seeded scenes", "[threads]") {
     CHECK(buildLines() == kPinned);
 }

@@ -9,7 +9,7 @@
 using namespace hapto;
 using namespace hapto::test;
 
-TEST_CASE("several threads querying one index at once get what one thread gets") {
+TEST_CASE("several threads querying one index at once get what one thread gets", "[threads]") {
     ClusterOptions c;
     c.count = 3000;
     c.rotate = true;

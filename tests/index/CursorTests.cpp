@@ -44,7 +44,8 @@ std::vector<Vec3> randomWalk(const Aabb& b, std::uint64_t seed, int steps, doubl
 } // namespace
 
 TEST_CASE("a cursor on a long hand-speed walk lands where a fresh locate does, links never "
-          "take more steps than climbing") {
+          "take more steps than climbing",
+          "[threads]") {
     for (const auto& [name, scene] : testScenes()) {
         for (const IndexSpec& spec :
              {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001), IndexSpec::grid(5),
@@ -84,7 +85,8 @@ TEST_CASE("a cursor on a long hand-speed walk lands where a fresh locate does, l
     }
 }
 
-TEST_CASE("cursor: unbound, outside and back, reset to another index, FromRoot steps = depth") {
+TEST_CASE("cursor: unbound, outside and back, reset to another index, FromRoot steps = depth",
+          "[threads]") {
     Cursor unbound;
     CHECK(unbound.locate(Vec3(0.0)).outside);
     CHECK(unbound.locate(Vec3(0.0)).candidates.empty());
@@ -130,7 +132,8 @@ TEST_CASE("cursor: unbound, outside and back, reset to another index, FromRoot s
 }
 
 TEST_CASE("cursor walk: the first unlisted leaf along a segment, every leaf a sampled point is "
-          "in found, the cursor itself unmoved") {
+          "in found, the cursor itself unmoved",
+          "[threads]") {
     for (const auto& [name, scene] : testScenes()) {
         for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::grid(7)}) {
             INFO(name << " " << spec.toString());
@@ -175,7 +178,8 @@ TEST_CASE("cursor walk: the first unlisted leaf along a segment, every leaf a sa
     }
 }
 
-TEST_CASE("cursor walk: outside the bounds, zero length, and an unbound cursor find nothing") {
+TEST_CASE("cursor walk: outside the bounds, zero length, and an unbound cursor find nothing",
+          "[threads]") {
     const Scene scene = makeDegenerateScene();
     const auto tree = Octree::build(scene, IndexSpec::octree(2, 0.005));
     const Cursor cursor(*tree);

@@ -14,7 +14,8 @@
 using namespace hapto;
 using namespace hapto::test;
 
-TEST_CASE("every item holding the query point is a candidate: every index, mode, strategy") {
+TEST_CASE("every item holding the query point is a candidate: every index, mode, strategy",
+          "[threads]") {
     for (const auto& [name, scene] : testScenes()) {
         const std::vector<Vec3> points = queryPoints(scene, 3, 1500);
         const Containment containing(scene);
@@ -76,7 +77,7 @@ TEST_CASE("every item holding the query point is a candidate: every index, mode,
     }
 }
 
-TEST_CASE("a grid cell holds exactly the items overlapping it (brute-force check)") {
+TEST_CASE("a grid cell holds exactly the items overlapping it (brute-force check)", "[threads]") {
     for (const auto& [name, scene] : testScenes()) {
         const auto shapes = itemShapes(scene);
         for (const IndexSpec& spec : {IndexSpec::grid(1), IndexSpec::grid(7),
@@ -111,7 +112,8 @@ TEST_CASE("a grid cell holds exactly the items overlapping it (brute-force check
     }
 }
 
-TEST_CASE("octree leaves hold at most M items unless at minimum size, exactly the overlapping") {
+TEST_CASE("octree leaves hold at most M items unless at minimum size, exactly the overlapping",
+          "[threads]") {
     for (const auto& [name, scene] : testScenes()) {
         const auto shapes = itemShapes(scene);
         for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001),
@@ -157,7 +159,7 @@ TEST_CASE("octree leaves hold at most M items unless at minimum size, exactly th
     }
 }
 
-TEST_CASE("OBB placement never gives more object-cell pairs than AABB placement") {
+TEST_CASE("OBB placement never gives more object-cell pairs than AABB placement", "[threads]") {
     for (const auto& [name, scene] : testScenes()) {
         for (const auto& [obb, aabb] :
              {std::pair{IndexSpec::grid(5), IndexSpec::grid(5, OverlapMode::Aabb)},
@@ -188,7 +190,7 @@ TEST_CASE("OBB placement never gives more object-cell pairs than AABB placement"
           buildIndex(s, IndexSpec::grid(16, OverlapMode::Aabb))->stats().objectCellPairs);
 }
 
-TEST_CASE("stats add up, brute force lists everything, an empty scene works") {
+TEST_CASE("stats add up, brute force lists everything, an empty scene works", "[threads]") {
     const Scene scene = makeDegenerateScene();
     const auto brute = buildIndex(scene, IndexSpec::brute());
     CHECK(brute->stats().leaves == 1);
@@ -220,7 +222,8 @@ TEST_CASE("stats add up, brute force lists everything, an empty scene works") {
     }
 }
 
-TEST_CASE("a point outside the bounds but inside an object that reaches out gets that object") {
+TEST_CASE("a point outside the bounds but inside an object that reaches out gets that object",
+          "[threads]") {
     // Bounds +-0.1 m; object 7 straddles the +x face, 9 lies wholly outside, 8 wholly inside.
     const Scene scene({Vec3(-0.1), Vec3(0.1)},
                       {makeBox(7, {0.1, 0.0, 0.0}, Vec3(0.02)), makeBox(8, Vec3(0.0), Vec3(0.01)),
@@ -261,7 +264,8 @@ TEST_CASE("a point outside the bounds but inside an object that reaches out gets
     }
 }
 
-TEST_CASE("an index that would exceed its memory limit is refused before it is built") {
+TEST_CASE("an index that would exceed its memory limit is refused before it is built",
+          "[threads]") {
     // Three boxes filling the bounds: every one of them in every cell of a fine grid.
     const Scene scene({Vec3(-0.1), Vec3(0.1)},
                       {makeBox(1, Vec3(0.0), Vec3(0.1)), makeBox(2, Vec3(0.0), Vec3(0.099)),
@@ -330,7 +334,8 @@ Scene fiveLargeBoxes() {
 
 } // namespace
 
-TEST_CASE("an octree's memory floor refuses a spec at once and never refuses what fits") {
+TEST_CASE("an octree's memory floor refuses a spec at once and never refuses what fits",
+          "[threads]") {
     const Scene five = fiveLargeBoxes();
     // Issue 39: building this one level by level took 14 s and 1.4 GB before its refusal.
     const IndexSpec huge = IndexSpec::octree(1, 1e-9);
@@ -382,7 +387,8 @@ TEST_CASE("an octree's memory floor refuses a spec at once and never refuses wha
     }
 }
 
-TEST_CASE("the octree floor counts cells shared by overlapping items and stays a floor") {
+TEST_CASE("the octree floor counts cells shared by overlapping items and stays a floor",
+          "[threads]") {
     // Items that overlap only here and there: the global count finds nothing, the pairs do.
     RandomOptions r;
     r.count = 3000;
@@ -438,7 +444,7 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
     }
 }
 
-TEST_CASE("a mesh's triangles, not the mesh object, are the index's items") {
+TEST_CASE("a mesh's triangles, not the mesh object, are the index's items", "[threads]") {
     const Scene scene = makeMeshScene();
     std::vector<std::uint32_t> indexed;
     std::uint32_t meshes = 0;
@@ -545,7 +551,8 @@ placedBy(const std::vector<std::pair<std::uint32_t, OverlapShape>>& shapes, cons
 
 } // namespace
 
-TEST_CASE("axis-aligned boxes by their box, the rest by the full test: the same cells as before") {
+TEST_CASE("axis-aligned boxes by their box, the rest by the full test: the same cells as before",
+          "[threads]") {
     std::vector<std::pair<std::string, Scene>> scenes;
     scenes.emplace_back("mixed alignment", makeMixedAlignmentScene());
     RandomOptions r;

@@ -32,7 +32,8 @@ std::uint32_t expectedNode(const Octree& tree, int level, std::array<std::int64_
 
 } // namespace
 
-TEST_CASE("neighbour links name the equal-size neighbour, else the smallest larger one") {
+TEST_CASE("neighbour links name the equal-size neighbour, else the smallest larger one",
+          "[threads]") {
     for (const auto& [name, scene] : testScenes()) {
         for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001)}) {
             INFO(name << " " << spec.toString());
@@ -66,7 +67,8 @@ TEST_CASE("neighbour links name the equal-size neighbour, else the smallest larg
     }
 }
 
-TEST_CASE("octree layout: breadth first, siblings together, leaves one contiguous run each") {
+TEST_CASE("octree layout: breadth first, siblings together, leaves one contiguous run each",
+          "[threads]") {
     const Scene scene = makeDegenerateScene();
     const auto tree = Octree::build(scene, IndexSpec::octree(2, 0.002));
     const auto nodes = tree->nodes();
@@ -119,7 +121,8 @@ TEST_CASE("octree layout: breadth first, siblings together, leaves one contiguou
     CHECK(tree->stats().bytes == exact);
 }
 
-TEST_CASE("the paper's set-ups: octree leaves stay small on lattice and random scenes") {
+TEST_CASE("the paper's set-ups: octree leaves stay small on lattice and random scenes",
+          "[threads]") {
     LatticeOptions l;
     l.perSide = 20; // 8000 cubes, the paper's largest experiment-1 scene
     const Scene lattice = makeLatticeScene(l);

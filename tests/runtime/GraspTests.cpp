@@ -190,7 +190,8 @@ TEST_CASE("a one-handed press never lifts the cube") {
     }
 }
 
-TEST_CASE("a carried cube never passes through another object: it comes to rest on it") {
+TEST_CASE("a carried cube never passes through another object: it comes to rest on it",
+          "[threads]") {
     // A block under the place the cube is put down: top at y = -0.07.
     Scene base = makeGraspScene();
     std::vector<SceneObject> objects(base.objects().begin(), base.objects().end());
@@ -213,7 +214,8 @@ TEST_CASE("a carried cube never passes through another object: it comes to rest 
 }
 
 TEST_CASE("two hands lift, carry and put down a torus mesh, the index then finds it at its new "
-          "place") {
+          "place",
+          "[threads]") {
     // The grasp scene with its cube (id 0) replaced by a closed torus standing in the x-y plane,
     // as wide as the cube (ring 19 mm + tube 6 mm = 25 mm), resting on the floor: the hands
     // squeeze the outside of its ring where the cube's faces were.

@@ -37,7 +37,7 @@ TEST_CASE("quantiles of a known distribution") {
     CHECK(s.p999 <= s.max);
 }
 
-TEST_CASE("a reader summarising while the writer records sees counts that only grow") {
+TEST_CASE("a reader summarising while the writer records sees counts that only grow", "[threads]") {
     auto h = std::make_unique<LoadHistogram>();
     std::atomic<bool> done{false};
     std::thread writer([&] {

@@ -67,7 +67,8 @@ std::vector<ForceEffect> everyEffect(double k) {
 
 } // namespace
 
-TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (step mode)") {
+TEST_CASE("the servo tick makes no heap allocation, across snapshot updates (step mode)",
+          "[threads]") {
     const Scene scene = makeDefaultScene();
     const std::string spec =
         GENERATE(std::string("octree:2:0.005"), std::string("grid:5"), std::string("brute"));
@@ -208,7 +209,8 @@ std::vector<RuntimeDevice> fiveHandDevices(const Scene& scene) {
 
 } // namespace
 
-TEST_CASE("grouped servos make no heap allocation, across snapshot updates (step mode)") {
+TEST_CASE("grouped servos make no heap allocation, across snapshot updates (step mode)",
+          "[threads]") {
     const Scene scene = makeDefaultScene();
     ManualClock clock;
     World world(scene, IndexSpec::parse(kDefaultIndexSpec));

@@ -201,7 +201,8 @@ TEST_CASE("a body asleep for the rest delay enters the static index at its rest 
 }
 
 TEST_CASE("a sleeping body is rendered from the index exactly as a static object at its rest "
-          "pose") {
+          "pose",
+          "[threads]") {
     const bool mesh = GENERATE(false, true);
     INFO((mesh ? "box mesh" : "box"));
     SleepRig rig(false, mesh);
@@ -238,7 +239,8 @@ TEST_CASE("a sleeping body is rendered from the index exactly as a static object
 }
 
 TEST_CASE("a woken body still in the index is felt where the table has it and not at its rest "
-          "pose") {
+          "pose",
+          "[threads]") {
     const bool mesh = GENERATE(false, true);
     INFO((mesh ? "box mesh" : "box"));
     SleepRig rig(false, mesh);
@@ -353,7 +355,8 @@ TEST_CASE("two stepped runs through sleep, indexing and a wake are byte-identica
     }
 }
 
-TEST_CASE("twenty sleeping plates within one tick's reach are all felt from the index") {
+TEST_CASE("twenty sleeping plates within one tick's reach are all felt from the index",
+          "[threads]") {
     // 20 plates 8 x 0.1 x 8 cm, 2 mm apart, weightless and still: all asleep at 0.5 s,
     // indexed at 0.6 s. Pressing 1 mm into plate k's side puts every plate's bounding sphere
     // (5.7 cm) within the tick's reach, more than DynamicBodySet's 16.

@@ -27,7 +27,8 @@ bool candidatesHold(const SpatialIndex& index, const Vec3& p, std::uint32_t slot
 
 } // namespace
 
-TEST_CASE("a moved object is on the brute-force path at once and back in the index at rest") {
+TEST_CASE("a moved object is on the brute-force path at once and back in the index at rest",
+          "[threads]") {
     World world(twoBoxes(), IndexSpec::parse("octree:1:0.005"));
     world.setRestDelay(std::chrono::nanoseconds(0));
     const std::uint64_t v1 = world.current().version;
@@ -51,7 +52,7 @@ TEST_CASE("a moved object is on the brute-force path at once and back in the ind
     CHECK(world.buildsPublished() == 2);
 }
 
-TEST_CASE("added objects are felt at once, removed ones vanish with their rebuild") {
+TEST_CASE("added objects are felt at once, removed ones vanish with their rebuild", "[threads]") {
     World world(twoBoxes(), IndexSpec::parse("grid:4"));
     world.setRestDelay(std::chrono::nanoseconds(0));
     world.addObject(makeSphere(30, Vec3(0, 0.05, 0), 0.01));
@@ -115,7 +116,8 @@ TEST_CASE("a snapshot a reader holds is not freed until the reader moves on") {
     world.unregisterReader(reader);
 }
 
-TEST_CASE("8 servo-like threads read while the control thread publishes: versions only grow") {
+TEST_CASE("8 servo-like threads read while the control thread publishes: versions only grow",
+          "[threads]") {
     RandomOptions opt;
     opt.count = 300;
     opt.seed = 4;

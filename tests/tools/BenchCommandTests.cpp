@@ -35,7 +35,7 @@ json runJson(const std::string& args) {
 
 } // namespace
 
-TEST_CASE("hapto bench query --json reports every index over the same walk") {
+TEST_CASE("hapto bench query --json reports every index over the same walk", "[threads]") {
     test::TempDir dir;
     const std::string scene = makeScene(dir);
     const json j = runJson("--scene " + scene +
@@ -69,7 +69,8 @@ TEST_CASE("hapto bench query --json reports every index over the same walk") {
     CHECK(j[2]["candidates_mean"].get<double>() < 60.0);
 }
 
-TEST_CASE("hapto bench query: every cursor strategy finds the same leaves along the walk") {
+TEST_CASE("hapto bench query: every cursor strategy finds the same leaves along the walk",
+          "[threads]") {
     test::TempDir dir;
     const std::string scene = makeScene(dir);
     const json j = runJson("--scene " + scene +
@@ -91,7 +92,7 @@ TEST_CASE("hapto bench query: every cursor strategy finds the same leaves along 
     CHECK(j[0]["locate_steps_mean"].get<double>() >= 1.0);
 }
 
-TEST_CASE("hapto bench query: the same seed walks the same path") {
+TEST_CASE("hapto bench query: the same seed walks the same path", "[threads]") {
     test::TempDir dir;
     const std::string scene = makeScene(dir);
     const std::string args = "--scene " + scene + " --steps 2500 --seed 4 --index grid:3";
@@ -102,7 +103,7 @@ TEST_CASE("hapto bench query: the same seed walks the same path") {
     CHECK(c[0]["steps"] == 2500);
 }
 
-TEST_CASE("hapto bench query runs on the default scene and prints a table") {
+TEST_CASE("hapto bench query runs on the default scene and prints a table", "[threads]") {
     const auto r = test::runHapto("bench query --steps 1500 --batch 1");
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
@@ -207,7 +208,8 @@ void checkTickEntry(const json& e, std::size_t ticks) {
 
 } // namespace
 
-TEST_CASE("hapto bench tick --json reports every stage of every mode for every index") {
+TEST_CASE("hapto bench tick --json reports every stage of every mode for every index",
+          "[threads]") {
     test::TempDir dir;
     const std::string scene = makeScene(dir);
     const json j = runTickJson(dir, "--scene " + scene +
@@ -234,7 +236,8 @@ TEST_CASE("hapto bench tick --json reports every stage of every mode for every i
     }
 }
 
-TEST_CASE("hapto bench tick --wake-latency-us adds the sleep modes with the request held") {
+TEST_CASE("hapto bench tick --wake-latency-us adds the sleep modes with the request held",
+          "[threads]") {
     test::TempDir dir;
     const std::string out = (dir / "tick.json").string();
     const auto r = test::runHapto("bench tick --ticks 100 --sleep-us 100 --warm-us 10 "
@@ -263,7 +266,8 @@ TEST_CASE("hapto bench tick --wake-latency-us adds the sleep modes with the requ
     CHECK_THAT(r.output, Catch::Contains("sleep+warm+lat"));
 }
 
-TEST_CASE("hapto bench tick drives a simulated hand's reads and writes, and prints a table") {
+TEST_CASE("hapto bench tick drives a simulated hand's reads and writes, and prints a table",
+          "[threads]") {
     test::TempDir dir;
     const json j = runTickJson(dir, "--device sim --ticks 200 --sleep-us 100 --warm-us 10");
     REQUIRE(j.size() == 3);
@@ -284,7 +288,8 @@ TEST_CASE("hapto bench tick drives a simulated hand's reads and writes, and prin
     }
 }
 
-TEST_CASE("hapto bench tick --walk-edge keeps the walk in a cube about the scene's centre") {
+TEST_CASE("hapto bench tick --walk-edge keeps the walk in a cube about the scene's centre",
+          "[threads]") {
     test::TempDir dir;
     const std::string scene = makeScene(dir);
     const json whole = runTickJson(dir, "--scene " + scene + " --ticks 50 --sleep-us 50");
@@ -302,7 +307,7 @@ TEST_CASE("hapto bench tick --walk-edge keeps the walk in a cube about the scene
     checkTickEntry(inner[0], 50);
 }
 
-TEST_CASE("hapto bench tick --push-mm holds the walking hand back near the proxy") {
+TEST_CASE("hapto bench tick --push-mm holds the walking hand back near the proxy", "[threads]") {
     // 10^3 cubes of 2 mm filling half of a 2.5 cm cube: the hand walks into them all the time.
     test::TempDir dir;
     const std::string scene = (dir / "dense.json").string();

@@ -81,7 +81,7 @@ TEST_CASE("an unknown command is named as unknown, exit 2") {
     CHECK(test::runHapto("--frobnicate").exitCode == 2);
 }
 
-TEST_CASE("options follow one convention, the old spellings still work") {
+TEST_CASE("options follow one convention, the old spellings still work", "[threads]") {
     test::TempDir dir;
     const std::string out = " --out " + dir.path().string();
     // --rates, and --rate as its old spelling, on every experiment; numbers as numbers.

@@ -91,7 +91,8 @@ nlohmann::json runGraspDemo(const TempDir& dir) {
 
 TEST_CASE("hapto demo grasp --kinematic --stepped --object on a closed mesh lifts, carries and "
           "puts it down, "
-          "and the index finds it at its new place") {
+          "and the index finds it at its new place",
+          "[threads]") {
     TempDir dir;
     writeFile(dir / "cube.obj", kCubeObj);
     writeFile(dir / "scene.json", graspScene(R"("file": "cube.obj")"));
@@ -107,7 +108,8 @@ TEST_CASE("hapto demo grasp --kinematic --stepped --object on a closed mesh lift
 
 TEST_CASE("hapto demo grasp --kinematic --stepped --object on a generated torus lying flat on the "
           "floor, 1.5 cm "
-          "from a ridge, lifts, carries and puts it down") {
+          "from a ridge, lifts, carries and puts it down",
+          "[threads]") {
     TempDir dir;
     // A 6 cm torus, axis along y (lying flat), 2016 triangles, written beside its own scene.
     const CommandResult made =
@@ -124,7 +126,8 @@ TEST_CASE("hapto demo grasp --kinematic --stepped --object on a generated torus 
 }
 
 TEST_CASE("hapto demo grasp --kinematic --stepped: the same session gives the same report, path "
-          "and forces") {
+          "and forces",
+          "[threads]") {
     TempDir dir;
     writeFile(dir / "cube.obj", kCubeObj);
     writeFile(dir / "scene.json", graspScene(R"("file": "cube.obj")"));

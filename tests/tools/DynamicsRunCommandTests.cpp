@@ -47,7 +47,8 @@ std::array<std::string, 2> twoRuns(const TempDir& dir, const std::string& args) 
 
 } // namespace
 
-TEST_CASE("hapto run --no-devices --stepped runs the bodies alone, the same every run") {
+TEST_CASE("hapto run --no-devices --stepped runs the bodies alone, the same every run",
+          "[threads]") {
     TempDir dir;
     const auto reports = twoRuns(dir, "--no-devices --stepped --quiet --duration 0.2");
     CHECK(reports[0] == reports[1]);
@@ -61,7 +62,7 @@ TEST_CASE("hapto run --no-devices --stepped runs the bodies alone, the same ever
     CHECK(j["total"]["stable"] == true);
 }
 
-TEST_CASE("hapto run --no-devices is refused when the scene has no dynamic body") {
+TEST_CASE("hapto run --no-devices is refused when the scene has no dynamic body", "[threads]") {
     TempDir dir;
     writeFile(dir / "static.json", kStaticScene);
     const CommandResult r = runHapto("run --scene " + (dir / "static.json").string() +
@@ -81,7 +82,8 @@ TEST_CASE("hapto run --no-devices is refused when the scene has no dynamic body"
     CHECK_THAT(both.output, Catch::Contains("not both"));
 }
 
-TEST_CASE("hapto run --stepped drives simulated hands byte-identically, and refuses hardware") {
+TEST_CASE("hapto run --stepped drives simulated hands byte-identically, and refuses hardware",
+          "[threads]") {
     TempDir dir;
     const auto reports = twoRuns(dir, "--stepped --quiet --duration 0.1");
     CHECK(reports[0] == reports[1]);
@@ -102,7 +104,8 @@ TEST_CASE("hapto run --stepped drives simulated hands byte-identically, and refu
     }
 }
 
-TEST_CASE("hapto run --record writes bodies.trace, and trace export gives its columns") {
+TEST_CASE("hapto run --record writes bodies.trace, and trace export gives its columns",
+          "[threads]") {
     TempDir dir;
     writeFile(dir / "drop.json", kDropScene);
     const CommandResult r = runHapto("run --scene " + (dir / "drop.json").string() +

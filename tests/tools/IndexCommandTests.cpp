@@ -36,7 +36,7 @@ std::vector<std::string> lines(const std::string& text) {
 
 } // namespace
 
-TEST_CASE("hapto query lists candidate ids per point, the same set for every index") {
+TEST_CASE("hapto query lists candidate ids per point, the same set for every index", "[threads]") {
     TempDir dir;
     saveSceneFile(smallScene(), dir / "s.json");
     writeFile(dir / "p.csv", "x,y,z\n0,0,0\n0.01, 0.0, 0.0\n-0.08,0.08,0\n0.5,0,0\n"
@@ -104,7 +104,7 @@ TEST_CASE("hapto query refuses a bad spec or points file with exit code 2 and a 
     CHECK_THAT(r.output, Catch::Contains("none.csv"));
 }
 
-TEST_CASE("hapto index-stats prints the statistics, as text or JSON") {
+TEST_CASE("hapto index-stats prints the statistics, as text or JSON", "[threads]") {
     CommandResult r = runHapto("index-stats --index octree:2:0.005");
     REQUIRE(r.exitCode == 0);
     CHECK_THAT(r.output, Catch::Contains("octree:2:0.005") && Catch::Contains("leaves:") &&

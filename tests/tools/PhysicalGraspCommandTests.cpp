@@ -43,7 +43,8 @@ void checkOnPlinth(const nlohmann::json& place, double boundMm) {
 } // namespace
 
 TEST_CASE("hapto demo grasp --stepped lifts a box, a sphere and a mesh by friction, sets each down "
-          "on the plinth, drops it and it comes to rest there at zero force") {
+          "on the plinth, drops it and it comes to rest there at zero force",
+          "[threads]") {
     for (const char* shape : {"box", "sphere", "mesh"}) {
         DYNAMIC_SECTION(shape) {
             TempDir dir;
@@ -82,7 +83,8 @@ TEST_CASE("hapto demo grasp --stepped lifts a box, a sphere and a mesh by fricti
 }
 
 TEST_CASE("hapto demo grasp --stepped gives the same report every run, and --record writes the "
-          "hands' and the bodies' traces") {
+          "hands' and the bodies' traces",
+          "[threads]") {
     TempDir dir;
     const nlohmann::json first = runPhysical(dir, "--record " + (dir / "a").string());
     const nlohmann::json second = runPhysical(dir, "--record " + (dir / "b").string());
@@ -116,7 +118,8 @@ TEST_CASE("hapto demo grasp --stepped gives the same report every run, and --rec
 }
 
 TEST_CASE("hapto demo grasp --kinematic --stepped still carries the built-in static cube with "
-          "the kinematic controller") {
+          "the kinematic controller",
+          "[threads]") {
     TempDir dir;
     const CommandResult r =
         runHapto("demo grasp --kinematic --stepped --report " + (dir / "report.json").string());
@@ -129,7 +132,8 @@ TEST_CASE("hapto demo grasp --kinematic --stepped still carries the built-in sta
           Approx(report["start_position"][0].get<double>() + 0.10).margin(0.008));
 }
 
-TEST_CASE("hapto demo grasp refuses what cannot work, with exit code 2 and the options named") {
+TEST_CASE("hapto demo grasp refuses what cannot work, with exit code 2 and the options named",
+          "[threads]") {
     TempDir dir;
     // A version-2 scene: its object 0 is static.
     writeFile(dir / "static.json",
@@ -162,7 +166,8 @@ TEST_CASE("hapto demo grasp refuses what cannot work, with exit code 2 and the o
 }
 
 TEST_CASE("hapto demo grasp --stepped with hands squeezing 0.3 N each (mu_s (F1 + F2) = 0.37 m g) "
-          "does not lift the box: not held, and it stays on the floor") {
+          "does not lift the box: not held, and it stays on the floor",
+          "[threads]") {
     TempDir dir;
     const auto hand = [](const char* name, const char* script, double x, int seed) {
         return std::string(R"({"name": ")") + name +

@@ -130,7 +130,8 @@ TEST_CASE("hapto render: pressing d into a box face of stiffness k gives k d alo
     CHECK(pressed > 20);
 }
 
-TEST_CASE("hapto render: the same input gives the same bytes, to a file or standard output") {
+TEST_CASE("hapto render: the same input gives the same bytes, to a file or standard output",
+          "[threads]") {
     TempDir dir;
     writeFile(dir / "cube.json", cubeScene(800.0));
     // A wavy stroke across the top face and over its edge, with friction's default state.

@@ -15,7 +15,7 @@
 using namespace hapto::test;
 using nlohmann::json;
 
-TEST_CASE("hapto run writes a report with every field for both default hands") {
+TEST_CASE("hapto run writes a report with every field for both default hands", "[threads]") {
     TempDir dir;
     const CommandResult r =
         runHapto("run --duration 0.5 --no-realtime --quiet --report " + (dir / "r.json").string());
@@ -40,7 +40,8 @@ TEST_CASE("hapto run writes a report with every field for both default hands") {
                                                   : "warm-up: off, as the servo threads share"));
 }
 
-TEST_CASE("hapto run --warm-us sets the warm-up, 0 turns it off, and the report says so") {
+TEST_CASE("hapto run --warm-us sets the warm-up, 0 turns it off, and the report says so",
+          "[threads]") {
     TempDir dir;
     for (const char* us : {"0", "7.5"}) {
         INFO(us);
@@ -55,7 +56,7 @@ TEST_CASE("hapto run --warm-us sets the warm-up, 0 turns it off, and the report 
     }
 }
 
-TEST_CASE("a session recorded with --record replays as a device and exports as CSV") {
+TEST_CASE("a session recorded with --record replays as a device and exports as CSV", "[threads]") {
     TempDir dir;
     const CommandResult rec =
         runHapto("run --duration 0.3 --no-realtime --quiet --record " + (dir / "runs").string());
@@ -79,7 +80,7 @@ TEST_CASE("a session recorded with --record replays as a device and exports as C
     CHECK(j["devices"][0]["ticks"].get<int>() > 0);
 }
 
-TEST_CASE("a replay runs at its trace's rate unless --rate sets one") {
+TEST_CASE("a replay runs at its trace's rate unless --rate sets one", "[threads]") {
     TempDir dir;
     const CommandResult rec = runHapto("run --rate 2000 --duration 0.2 --no-realtime --quiet "
                                        "--record " +
@@ -101,7 +102,8 @@ TEST_CASE("a replay runs at its trace's rate unless --rate sets one") {
     CHECK(json::parse(readFile(dir / "r.json"))["devices"][0]["rate_hz"] == 500.0);
 }
 
-TEST_CASE("hapto run refuses what cannot work before any device starts, and writes nothing") {
+TEST_CASE("hapto run refuses what cannot work before any device starts, and writes nothing",
+          "[threads]") {
     TempDir dir;
     writeFile(dir / "r.json", "an older report\n");
     // A spin as long as the 500 us period of 2 kHz.
@@ -126,7 +128,7 @@ TEST_CASE("hapto run refuses what cannot work before any device starts, and writ
                         std::filesystem::directory_iterator()) == 2);
 }
 
-TEST_CASE("hapto run drives devices at 20 kHz") {
+TEST_CASE("hapto run drives devices at 20 kHz", "[threads]") {
     TempDir dir;
     const CommandResult r =
         runHapto("run --rate 20000 --duration 0.3 --no-realtime --quiet --report " +
@@ -139,7 +141,8 @@ TEST_CASE("hapto run drives devices at 20 kHz") {
     }
 }
 
-TEST_CASE("hapto run --devices-per-thread drives simulated hands in groups, each reported") {
+TEST_CASE("hapto run --devices-per-thread drives simulated hands in groups, each reported",
+          "[threads]") {
     TempDir dir;
     json devices{{"format", "hapto-devices"}, {"version", 1}, {"devices", json::array()}};
     for (int i = 0; i < 5; ++i) {
@@ -164,7 +167,7 @@ TEST_CASE("hapto run --devices-per-thread drives simulated hands in groups, each
     }
 }
 
-TEST_CASE("hapto run refuses bad input with exit code 2 and says where") {
+TEST_CASE("hapto run refuses bad input with exit code 2 and says where", "[threads]") {
     TempDir dir;
     writeFile(dir / "d.json", R"({"format": "hapto-devices", "version": 1, "devices": [)"
                               R"({"name": "a", "kind": "sim", "transform": {"scale": -1}}]})");
@@ -186,7 +189,8 @@ TEST_CASE("hapto run refuses bad input with exit code 2 and says where") {
     CHECK_THAT(r.output, Catch::Contains("--wake-latency-us"));
 }
 
-TEST_CASE("hapto run --wake-latency-us holds the request while the hands run, or says why not") {
+TEST_CASE("hapto run --wake-latency-us holds the request while the hands run, or says why not",
+          "[threads]") {
     TempDir dir;
     const CommandResult r = runHapto("run --duration 0.3 --no-realtime --quiet --wake-latency-us 0 "
                                      "--report " +

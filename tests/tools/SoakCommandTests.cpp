@@ -23,7 +23,8 @@ using namespace hapto::test;
 using nlohmann::json;
 
 TEST_CASE("hapto soak injects every kind of fault, each device comes back, and the report says "
-          "so") {
+          "so",
+          "[threads]") {
     TempDir dir;
     // 12 s, a fault every 0.5 s: the five kinds each at least once over three hands. The
     // watchdog is generous so a slow (sanitizer) build does not trip it by itself.
@@ -74,7 +75,7 @@ TEST_CASE("hapto soak injects every kind of fault, each device comes back, and t
     CHECK(j["memory"].contains("growth_mib"));
 }
 
-TEST_CASE("hapto soak rejects bad arguments with exit 2") {
+TEST_CASE("hapto soak rejects bad arguments with exit 2", "[threads]") {
     for (const char* args : {"soak --minutes -1", "soak --hands 0", "soak --hands 33",
                              "soak --fault-every 0", "soak --index octree:x"}) {
         INFO(args);
@@ -83,7 +84,7 @@ TEST_CASE("hapto soak rejects bad arguments with exit 2") {
     }
 }
 
-TEST_CASE("an interrupted soak gives no verdict: it does not print PASS and exits 1") {
+TEST_CASE("an interrupted soak gives no verdict: it does not print PASS and exits 1", "[threads]") {
     TempDir dir;
     const std::string exe = std::string(HAPTO_BINARY_DIR) + "/tools/hapto";
     const std::string out = (dir / "out.txt").string();
@@ -122,7 +123,7 @@ TEST_CASE("an interrupted soak gives no verdict: it does not print PASS and exit
     CHECK(j["pass"] == false);
 }
 
-TEST_CASE("a soak too short to reach its first fault is refused before it starts") {
+TEST_CASE("a soak too short to reach its first fault is refused before it starts", "[threads]") {
     TempDir dir;
     const CommandResult r =
         runHapto("soak --minutes 0.05 --fault-every 15 --no-realtime --report " +

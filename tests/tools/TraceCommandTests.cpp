@@ -137,7 +137,8 @@ bool startsWith(const std::string& s, const std::string& prefix) {
 
 } // namespace
 
-TEST_CASE("hapto trace plot draws traces as PNG and SVG, a line per device, contact shaded") {
+TEST_CASE("hapto trace plot draws traces as PNG and SVG, a line per device, contact shaded",
+          "[threads]") {
     test::TempDir dir;
     writeContactTrace(dir / "left.trace", "left", -1.0);
     writeContactTrace(dir / "right.trace", "right", 1.0);
@@ -211,7 +212,7 @@ TEST_CASE("hapto trace plot refuses a bad trace or output with exit code 2, writ
     CHECK_THAT(r.output, Catch::Contains(".png or .svg"));
 }
 
-TEST_CASE("hapto report plot draws a run report per device") {
+TEST_CASE("hapto report plot draws a run report per device", "[threads]") {
     test::TempDir dir;
     const auto run = test::runHapto("run --duration 0.3 --no-realtime --quiet --report " +
                                     (dir / "report.json").string());
@@ -299,7 +300,8 @@ TEST_CASE("hapto report plot refuses a device name with a control character, nam
     }
 }
 
-TEST_CASE("hapto trace plot draws hostile device names and paths as text and runs none") {
+TEST_CASE("hapto trace plot draws hostile device names and paths as text and runs none",
+          "[threads]") {
     test::TempDir root;
     const std::filesystem::path dir = root / kHostileFolder;
     std::filesystem::create_directories(dir);

@@ -46,7 +46,8 @@ struct Session {
 } // namespace
 
 TEST_CASE("a live frame carries each device's ticks, misses, load, point, force and contacts, "
-          "and the poses of moved objects") {
+          "and the poses of moved objects",
+          "[threads]") {
     Session session(kDefaultIndexSpec);
     const Scene& scene = session.scene;
     ManualClock& clock = session.clock;
@@ -106,7 +107,8 @@ TEST_CASE("a live frame carries each device's ticks, misses, load, point, force 
 }
 
 TEST_CASE("a live frame gives the run report's late wake-up note for a device unstable by late "
-          "wake-ups alone, and none while it is stable") {
+          "wake-ups alone, and none while it is stable",
+          "[threads]") {
     Session session(kDefaultIndexSpec);
     ManualClock& clock = session.clock;
     Runtime& runtime = session.runtime;
@@ -142,7 +144,8 @@ TEST_CASE("a live frame gives the run report's late wake-up note for a device un
 }
 
 TEST_CASE("a live frame shows each device's cursor leaf: the box holding its point and the "
-          "objects the leaf lists, as a fresh locate in the same snapshot gives them") {
+          "objects the leaf lists, as a fresh locate in the same snapshot gives them",
+          "[threads]") {
     Session session("octree:4:0.005");
     ManualClock& clock = session.clock;
     World& world = session.world;

@@ -118,7 +118,7 @@ std::string fileText(const std::filesystem::path& path) {
 
 } // namespace
 
-TEST_CASE("the view serves its page, its script, three.js and its documents") {
+TEST_CASE("the view serves its page, its script, three.js and its documents", "[threads]") {
     ViewServer server;
     server.setDocument("/scene.json", R"({"objects":[]})");
     const int port = server.start();
@@ -150,7 +150,7 @@ TEST_CASE("the view serves its page, its script, three.js and its documents") {
     CHECK(missing->status == 404);
 }
 
-TEST_CASE("the view refuses path traversal and serves no file it does not list") {
+TEST_CASE("the view refuses path traversal and serves no file it does not list", "[threads]") {
     ViewServer server;
     const int port = server.start();
     const std::string passwd = fileText("/etc/passwd");
@@ -169,7 +169,7 @@ TEST_CASE("the view refuses path traversal and serves no file it does not list")
     CHECK(statusOf(request("GET", "/view.js", port)) == 200);
 }
 
-TEST_CASE("the view is read-only: only GET and HEAD are answered") {
+TEST_CASE("the view is read-only: only GET and HEAD are answered", "[threads]") {
     ViewServer server;
     server.setDocument("/scene.json", R"({"objects":[1]})");
     const int port = server.start();
@@ -188,7 +188,8 @@ TEST_CASE("the view is read-only: only GET and HEAD are answered") {
     CHECK(statusOf(request("HEAD", "/scene.json", port)) == 200);
 }
 
-TEST_CASE("a stream from another origin, or a loopback view under another host name, is refused") {
+TEST_CASE("a stream from another origin, or a loopback view under another host name, is refused",
+          "[threads]") {
     ViewServer server;
     const int port = server.start();
     server.publish(R"({"t":1})");
@@ -212,7 +213,8 @@ TEST_CASE("a stream from another origin, or a loopback view under another host n
     CHECK(got.find(R"(data: {"t":1})") != std::string::npos);
 }
 
-TEST_CASE("the view serves at most its limit of streams, a closed one frees its place") {
+TEST_CASE("the view serves at most its limit of streams, a closed one frees its place",
+          "[threads]") {
     ViewServerOptions options;
     options.maxStreamClients = 2;
     ViewServer server(options);
@@ -287,7 +289,7 @@ TEST_CASE("loopback addresses, and a missing three.js named with its package") {
                           Catch::Contains("libjs-three"));
 }
 
-TEST_CASE("a port in use is refused with the address named") {
+TEST_CASE("a port in use is refused with the address named", "[threads]") {
     ViewServer first;
     const int port = first.start();
     ViewServerOptions options;
@@ -358,7 +360,8 @@ TEST_CASE("a request head must arrive whole within the request timeout", "[realt
 }
 
 TEST_CASE(
-    "a header flood is refused with 431 and not read further, and long lines keep 414 and 400") {
+    "a header flood is refused with 431 and not read further, and long lines keep 414 and 400",
+    "[threads]") {
     ViewServer server;
     const int port = server.start();
     const std::string start = "GET / HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\n";
@@ -405,7 +408,7 @@ TEST_CASE(
     CHECK(statusOf(request("GET", "/view.js", port)) == 200);
 }
 
-TEST_CASE("paths match exactly, and several ranges in one request are refused") {
+TEST_CASE("paths match exactly, and several ranges in one request are refused", "[threads]") {
     ViewServerOptions options;
     options.liveStream = false;
     ViewServer server(options);
@@ -473,7 +476,7 @@ TEST_CASE("the Host check holds for every binding, addresses compared parsed") {
     }
 }
 
-TEST_CASE("loopback spelled long keeps the rebinding check on every path") {
+TEST_CASE("loopback spelled long keeps the rebinding check on every path", "[threads]") {
     for (const std::string bind : {"0:0:0:0:0:0:0:1", "::ffff:127.0.0.1"}) {
         INFO(bind);
         ViewServerOptions options;
