@@ -60,8 +60,9 @@ build() {
 # gets a core only when no test wants it and any test thread that wakes takes the core back at
 # once; the realtime tests stay alone among tests (RUN_SERIAL). The output is a sequential
 # run's: a sanitizer build's output is held and printed whole just before its preset's tests.
-# Every preset is built and tested even after a failure; each ctest prints its own failures, and
-# the run fails if any build or test failed. Arguments after `test` go to every ctest
+# Every preset is built and tested even after a failure; each ctest prints its own failures. A
+# preset's failed tests run once more, alone; the run fails if any build failed or any test
+# failed twice, and its last lines name every test that failed, with the end of its output. Arguments after `test` go to every ctest
 # (e.g. `tools/setup.sh test -R bad_input`).
 builder_pid= builder_dir=
 
@@ -114,30 +115,52 @@ run_tests() {
       continue
     fi
     echo "== $preset: ctest"
-    ctest --preset "$preset" -j "$jobs" "$@" || failed+=("$preset (tests)")
+    ctest --preset "$preset" -j "$jobs" "$@" || rerun_failed "$preset" "$@" ||
+      failed+=("$preset (tests)")
   done
   wait "$builder_pid" || true
   builder_pid=
   echo "== test: $SECONDS s in all"
+  for preset in release asan tsan; do
+    print_tests "$preset: failed, then passed on a rerun" "$builder_dir/$preset.first-failed" \
+      "$builder_dir/$preset.first-log"
+  done
   if [ ${#failed[@]} -gt 0 ]; then
-    for preset in release asan tsan; do print_failed_tests "$preset"; done
+    for preset in release asan tsan; do
+      print_tests "$preset: failed" "build/$preset/Testing/Temporary/LastTestsFailed.log" \
+        "build/$preset/Testing/Temporary/LastTest.log"
+    done
     echo "== FAILED: ${failed[*]}"
     return 1
   fi
 }
 
-# Repeats, at the end of the run where a log's tail shows it, each test PRESET's last ctest
-# failed, with the last lines of its output (ctest printed them whole in its own run above).
-print_failed_tests() {
-  local dir=build/$1/Testing/Temporary
-  [ -s "$dir/LastTestsFailed.log" ] || return 0
-  echo "== $1: failed tests"
+# After PRESET's ctest failed: runs its failed tests once more, alone (-j 1, so a test that
+# failed from the machine's load, e.g. a wall-clock session's servo thread held off past its
+# watchdog, gets the machine). Returns whether they all passed. The first run's list and log
+# are kept for the summary, which names every test that needed the rerun.
+rerun_failed() {
+  local preset=$1 dir=build/$1/Testing/Temporary
+  shift
+  cp "$dir/LastTestsFailed.log" "$builder_dir/$preset.first-failed" 2>/dev/null || return 1
+  cp "$dir/LastTest.log" "$builder_dir/$preset.first-log"
+  echo "== $preset: ctest, the failed tests again"
+  ctest --preset "$preset" -j 1 --rerun-failed "$@"
+}
+
+# Repeats, at the end of the run where a log's tail shows it, each test in ctest's list of
+# failed tests FAILED (under the heading TITLE), with the last lines of its output from ctest's
+# log LOG (ctest printed it whole in its own run above).
+print_tests() {
+  local title=$1 failed=$2 log=$3
+  [ -s "$failed" ] || return 0
+  echo "== $title:"
   awk -F: 'NR == FNR { failed[$1] = 1; next }
     /^[0-9]+\/[0-9]+ Test: / { split($0, a, "/"); show = (a[1] in failed); n = 0 }
     show && /^[0-9]+\/[0-9]+ Test: / { print "-- " substr($0, index($0, ": ") + 2) }
     show && /^Output:/ { n = 0; keep = 1; getline; next }
     show && /^<end of output>/ { for (i = (n > 30 ? n - 30 : 0); i < n; i++) print "   " line[i]; keep = 0 }
-    show && keep { line[n++] = $0 }' "$dir/LastTestsFailed.log" "$dir/LastTest.log"
+    show && keep { line[n++] = $0 }' "$failed" "$log"
 }
 
 case "$mode" in
