@@ -17,8 +17,9 @@ using namespace hapto::test;
 namespace {
 
 // A unit cube in quads, and the same cube with one quad left out (open).
-const char* kCubeObj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
-                       "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+const char* kUnitCubeObj =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
 const char* kOpenCubeObj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\n"
                            "v 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\n";
 
@@ -32,7 +33,7 @@ TEST_CASE("scene import wraps a model in a scene that refers to it relative to i
     TempDir dir;
     std::filesystem::create_directories(dir / "models");
     std::filesystem::create_directories(dir / "scenes");
-    writeFile(dir / "models/cube.obj", kCubeObj);
+    writeFile(dir / "models/cube.obj", kUnitCubeObj);
     const auto r = runHapto("scene import " + q(dir / "models/cube.obj") +
                             " --scale 0.05 --center 0.1,0,-0.1 --rotation 0,0,0,1 "
                             "--stiffness 1200 --friction 0.5,0.25 -o " +
@@ -65,7 +66,7 @@ TEST_CASE("scene import wraps a model in a scene that refers to it relative to i
 TEST_CASE("scene info reports the triangles: total, per mesh, degenerate and duplicate dropped, "
           "closed or not") {
     TempDir dir;
-    writeFile(dir / "cube.obj", kCubeObj);
+    writeFile(dir / "cube.obj", kUnitCubeObj);
     writeFile(dir / "open.obj", kOpenCubeObj);
     writeFile(dir / "s.json", R"({"format": "hapto-scene", "version": 2, "objects": [
         {"id": 4, "shape": "mesh", "center": [0, 0, 0], "file": "cube.obj"},
@@ -90,7 +91,7 @@ TEST_CASE("scene info reports the triangles: total, per mesh, degenerate and dup
 
 TEST_CASE("scene import refuses bad models and options with exit code 2 and writes nothing") {
     TempDir dir;
-    writeFile(dir / "cube.obj", kCubeObj);
+    writeFile(dir / "cube.obj", kUnitCubeObj);
     writeFile(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
     writeFile(dir / "old.json", "an older file\n");
     writeFile(dir / "model.json", "{}\n");
@@ -124,7 +125,7 @@ TEST_CASE("scene import refuses bad models and options with exit code 2 and writ
     const auto r = runHapto("scene import " + q(dir / "cube.obj") + " -o " + q(dir / "cube.obj"));
     CHECK(r.exitCode == 2);
     CHECK_THAT(r.output, Catch::Contains("the model file"));
-    CHECK(readFile(dir / "cube.obj") == kCubeObj);
+    CHECK(readFile(dir / "cube.obj") == kUnitCubeObj);
 }
 
 TEST_CASE("scene convert turns JSON into binary and back, and every --scene reads the binary") {
@@ -167,7 +168,7 @@ TEST_CASE("scene convert refuses its input as output, a damaged input and a mode
     CHECK(readFile(dir / "old.json") == "an older file\n");
 
     // A model named relative to the scene cannot be referenced from another folder.
-    writeFile(dir / "cube.obj", kCubeObj);
+    writeFile(dir / "cube.obj", kUnitCubeObj);
     REQUIRE(runHapto("scene import " + q(dir / "cube.obj") + " -o " + q(dir / "m.json")).exitCode ==
             0);
     std::filesystem::create_directories(dir / "elsewhere");
