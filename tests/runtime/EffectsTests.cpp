@@ -24,7 +24,7 @@ using test::ScriptedDevice;
 
 namespace {
 
-constexpr std::uint64_t kMs = 1'000'000;
+using test::kMs;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool near(const Vec3& a, const Vec3& b, double eps = 1e-12) {
@@ -40,14 +40,14 @@ struct RigDevice {
 
 /// One scripted device at 1 kHz in step mode over the cube scene; `setup` brings its effects,
 /// transform and renderer damping, `hook` is registered before the start.
-struct Rig {
+struct EffectsRig {
     ManualClock clock;
     World world;
     ScriptedDevice* device = nullptr;
     std::unique_ptr<Runtime> runtime;
     std::uint64_t t0 = 0;
 
-    Rig(ScriptedDevice::Path path, RigDevice setup = {}, TickHook hook = {})
+    EffectsRig(ScriptedDevice::Path path, RigDevice setup = {}, TickHook hook = {})
         : world(cubeScene(), IndexSpec::parse(kDefaultIndexSpec)) {
         DeviceConfig& config = setup.config;
         world.useClock(clock);
@@ -209,7 +209,7 @@ TEST_CASE("runtime: a device's configured effects act from the first tick, each 
     const Vec3 p(0.08, 0.06, -0.04);
     const Vec3 anchor(0.07, 0.08, -0.04);
     SECTION("a spring to a point") {
-        Rig rig(still(p), withEffects({ForceEffect::springToPoint(anchor, 20.0)}));
+        EffectsRig rig(still(p), withEffects({ForceEffect::springToPoint(anchor, 20.0)}));
         rig.runTo(1);
         REQUIRE(rig.ticks() == 1);
         CHECK(near(rig.force(), -20.0 * (p - anchor)));
@@ -218,7 +218,7 @@ TEST_CASE("runtime: a device's configured effects act from the first tick, each 
         // The device frame is the world moved by +0.01 m in x: the effect sees world points.
         RigDevice c = withEffects({ForceEffect::springToPlane(anchor, Vec3(1, 0, 0), 20.0)});
         c.config.transform.translation = Vec3(0.01, 0, 0);
-        Rig rig(still(p - Vec3(0.01, 0, 0)), c);
+        EffectsRig rig(still(p - Vec3(0.01, 0, 0)), c);
         rig.runTo(1);
         CHECK(near(rig.force(), Vec3(-20.0 * (p.x - anchor.x), 0, 0)));
     }
@@ -226,9 +226,9 @@ TEST_CASE("runtime: a device's configured effects act from the first tick, each 
         // Moving at 0.1 m/s in +x from x = 0.06: inside the 1 cm ball around x = 0.08 only
         // between x = 0.07 and 0.09 (ticks 100 to 300).
         const Vec3 v(0.1, 0, 0);
-        Rig rig(moving(Vec3(0.06, 0.06, 0.0), v),
-                withEffects(
-                    {ForceEffect::damper(5.0, EffectRegion::sphere(Vec3(0.08, 0.06, 0), 0.01))}));
+        EffectsRig rig(moving(Vec3(0.06, 0.06, 0.0), v),
+                       withEffects({ForceEffect::damper(
+                           5.0, EffectRegion::sphere(Vec3(0.08, 0.06, 0), 0.01))}));
         rig.runTo(50);
         CHECK(rig.force() == Vec3(0.0));
         rig.runTo(200);
@@ -241,7 +241,7 @@ TEST_CASE("runtime: a device's configured effects act from the first tick, each 
     SECTION("a constant force, off and on") {
         ForceEffect off = ForceEffect::constant(Vec3(0, 0, 0.5));
         off.enabled = false;
-        Rig rig(still(p), withEffects({ForceEffect::constant(Vec3(0.25, 0, 0)), off}));
+        EffectsRig rig(still(p), withEffects({ForceEffect::constant(Vec3(0.25, 0, 0)), off}));
         rig.runTo(3);
         CHECK(rig.force() == Vec3(0.25, 0, 0));
         rig.runtime->setEffectEnabled(0, 1, true);
@@ -256,7 +256,7 @@ TEST_CASE("runtime: a device's configured effects act from the first tick, each 
 
 TEST_CASE("runtime: effects set from the control thread are picked up at the next tick") {
     const Vec3 p(0.08, 0.06, -0.04);
-    Rig rig(still(p));
+    EffectsRig rig(still(p));
     rig.runTo(10);
     CHECK(rig.force() == Vec3(0.0));
     CHECK(rig.runtime->effects(0).size() == 0);
@@ -295,7 +295,7 @@ TEST_CASE("runtime: effects set from the control thread are picked up at the nex
 
 TEST_CASE("runtime: effects are set from a list, and lastTick gives the force sent, zero after "
           "the stop") {
-    Rig rig(still(Vec3(0.08, 0.06, -0.04)));
+    EffectsRig rig(still(Vec3(0.08, 0.06, -0.04)));
     rig.runtime->setEffects(0, {ForceEffect::damper(2.0), ForceEffect::constant(Vec3(0, 0, 0.4))});
     CHECK(rig.runtime->effects(0).size() == 2);
     rig.runTo(3);
@@ -332,8 +332,8 @@ TEST_CASE("runtime: a device's renderer damping comes from its configuration") {
     damped.config.maxForceN = 50.0;
     RigDevice plain;
     plain.config.maxForceN = 50.0;
-    Rig a(path, damped);
-    Rig b(path, plain);
+    EffectsRig a(path, damped);
+    EffectsRig b(path, plain);
     a.runTo(80); // 8 mm down: 3 mm into the cube, 1.5 N from the spring alone
     b.runTo(80);
     // The 80th reading is 7.9 mm down, 2.9 mm into the top face at y = 0.025.
@@ -375,7 +375,7 @@ TEST_CASE("runtime: the hook is called every tick with the sample, proxy, contac
     probe.returns = Vec3(0.0, 0.0, 0.4);
     RigDevice c;
     c.config.transform.translation = Vec3(0.002, 0, 0); // device frame != world frame
-    Rig rig(test::pressIntoCube(0.0), c, TickHook{&probeHook, &probe});
+    EffectsRig rig(test::pressIntoCube(0.0), c, TickHook{&probeHook, &probe});
     rig.runTo(100);
     CHECK(probe.calls == 100);
     CHECK(probe.dtS == Approx(1e-3));
@@ -405,7 +405,7 @@ TEST_CASE("runtime: a hook may be a lambda that captures nothing, declared noexc
                             return p.returns;
                         },
                         &probe};
-    Rig rig(still(Vec3(0.08, 0.06, 0)), {}, hook);
+    EffectsRig rig(still(Vec3(0.08, 0.06, 0)), {}, hook);
     rig.runTo(10);
     CHECK(probe.calls == 10);
     CHECK(near(rig.force(), probe.returns));
@@ -414,7 +414,7 @@ TEST_CASE("runtime: a hook may be a lambda that captures nothing, declared noexc
 
 TEST_CASE("runtime: a hook registers only before the start") {
     HookProbe probe;
-    Rig rig(still(Vec3(0.08, 0, 0)));
+    EffectsRig rig(still(Vec3(0.08, 0, 0)));
     CHECK_THROWS_AS(rig.runtime->setTickHook(0, TickHook{&probeHook, &probe}), std::logic_error);
     rig.runTo(5);
     CHECK(probe.calls == 0);
@@ -424,7 +424,7 @@ TEST_CASE("runtime: effects and the hook pass through the safety filter") {
     HookProbe probe;
     SECTION("a non-finite hook force is replaced by zero and counted; contact still renders") {
         probe.returns = Vec3(kNaN, 0.0, 0.0);
-        Rig rig(test::pressIntoCube(0.0), {}, TickHook{&probeHook, &probe});
+        EffectsRig rig(test::pressIntoCube(0.0), {}, TickHook{&probeHook, &probe});
         rig.runTo(100);
         CHECK(finite(rig.force()));
         CHECK(near(rig.force(), probe.renderForce, 1e-12));
@@ -435,7 +435,7 @@ TEST_CASE("runtime: effects and the hook pass through the safety filter") {
     }
     SECTION("an infinite hook force in free space sends zero") {
         probe.returns = Vec3(0.0, std::numeric_limits<double>::infinity(), 0.0);
-        Rig rig(still(Vec3(0.08, 0.06, 0)), {}, TickHook{&probeHook, &probe});
+        EffectsRig rig(still(Vec3(0.08, 0.06, 0)), {}, TickHook{&probeHook, &probe});
         rig.runTo(10);
         CHECK(rig.force() == Vec3(0.0));
         for (const ScriptedDevice::Written& w : rig.device->forces()) {
@@ -445,7 +445,7 @@ TEST_CASE("runtime: effects and the hook pass through the safety filter") {
     }
     SECTION("a huge hook force is rate-limited, then clamped to the device's maximum") {
         probe.returns = Vec3(1e9, 0.0, 0.0);
-        Rig rig(still(Vec3(0.08, 0.06, 0)), {}, TickHook{&probeHook, &probe});
+        EffectsRig rig(still(Vec3(0.08, 0.06, 0)), {}, TickHook{&probeHook, &probe});
         rig.runTo(1);
         CHECK(glm::length(rig.force()) == Approx(1.0)); // 1 N per tick from zero
         rig.runTo(20);
@@ -454,8 +454,8 @@ TEST_CASE("runtime: effects and the hook pass through the safety filter") {
     }
     SECTION("a stiff spring far from its anchor is clamped to the device's maximum") {
         // 10^4 N/m at 10 cm asks for 1000 N.
-        Rig rig(still(Vec3(0.08, 0.06, 0)),
-                withEffects({ForceEffect::springToPoint(Vec3(0.08, -0.04, 0), 1e4)}));
+        EffectsRig rig(still(Vec3(0.08, 0.06, 0)),
+                       withEffects({ForceEffect::springToPoint(Vec3(0.08, -0.04, 0), 1e4)}));
         double largest = 0;
         for (std::uint64_t ms = 1; ms <= 20; ++ms) {
             rig.runTo(ms);
@@ -467,9 +467,10 @@ TEST_CASE("runtime: effects and the hook pass through the safety filter") {
     }
     SECTION("effects and the hook add up with contact before the filter") {
         probe.returns = Vec3(0.0, 0.0, -0.2);
-        Rig rig(test::pressIntoCube(0.0),
-                withEffects({ForceEffect::constant(Vec3(0.3, 0, 0)), ForceEffect::damper(2.0)}),
-                TickHook{&probeHook, &probe});
+        EffectsRig rig(
+            test::pressIntoCube(0.0),
+            withEffects({ForceEffect::constant(Vec3(0.3, 0, 0)), ForceEffect::damper(2.0)}),
+            TickHook{&probeHook, &probe});
         rig.runTo(100); // held still: the damper adds nothing
         CHECK(near(rig.force(), probe.renderForce + Vec3(0.3, 0, -0.2), 1e-12));
     }

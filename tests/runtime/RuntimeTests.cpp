@@ -27,14 +27,14 @@ using test::ScriptedDevice;
 
 namespace {
 
-struct Rig {
+struct ThreadRig {
     World world;
     std::vector<ScriptedDevice*> devices;
     std::vector<FaultInjectingDevice*> injectors; // wraps each device
     std::unique_ptr<Runtime> runtime;
 
-    Rig(Scene scene, int count, double rateHz, std::function<void(int, ScriptedDevice&)> setup = {},
-        RuntimeOptions options = {})
+    ThreadRig(Scene scene, int count, double rateHz,
+              std::function<void(int, ScriptedDevice&)> setup = {}, RuntimeOptions options = {})
         : world(std::move(scene), IndexSpec::parse(kDefaultIndexSpec)) {
         std::vector<RuntimeDevice> rds;
         for (int i = 0; i < count; ++i) {
@@ -73,7 +73,7 @@ TEST_CASE("servo threads: D devices tick, feel the cube, and the report agrees w
     RuntimeOptions opt;
     opt.stallTimeoutNs = 250'000'000;
     opt.reopenAfterNs = 0;
-    Rig rig(cubeScene(), 4, 2000.0, {}, opt);
+    ThreadRig rig(cubeScene(), 4, 2000.0, {}, opt);
     rig.runtime->start();
     // Until each presses 2 mm into the cube and feels it (about 1 N), or faults.
     REQUIRE(rig.pump([&] {
@@ -144,7 +144,7 @@ TEST_CASE("servo threads: each injected fault zeroes that device and leaves the 
     INFO("inject " << static_cast<int>(c.inject));
     RuntimeOptions never;
     never.reopenAfterNs = 0; // the fault keeps the device down
-    Rig rig(
+    ThreadRig rig(
         cubeScene(), 3, 1000.0,
         [&](int i, ScriptedDevice& d) {
             if (i == 1) {
@@ -179,39 +179,16 @@ TEST_CASE("servo threads: each injected fault zeroes that device and leaves the 
     }
 }
 
-namespace {
-
-// Presses into the cube, lifts off at read 400, presses again from read 500 on.
-ScriptedDevice::Path pressLiftPress(double x) {
-    const ScriptedDevice::Path press = test::pressIntoCube(x);
-    return [press](std::uint64_t t) {
-        if (t < 400) {
-            return press(t);
-        }
-        if (t < 500) {
-            return press(0); // 1 cm above the top face
-        }
-        return press(t - 500);
-    };
-}
-
-bool hasEvent(const DeviceReport& d, const std::string& text) {
-    return std::any_of(d.events.begin(), d.events.end(),
-                       [&](const std::string& e) { return e.find(text) != std::string::npos; });
-}
-
-} // namespace
-
 TEST_CASE("servo threads: a device that disconnects and comes back is zeroed at once, reopened "
           "and driven again while the others go on",
           "[realtime]") {
     RuntimeOptions opt;
     opt.reopenAfterNs = 100'000'000; // try every 100 ms
-    Rig rig(
+    ThreadRig rig(
         cubeScene(), 2, 1000.0,
         [](int i, ScriptedDevice& d) {
             if (i == 1) {
-                d.setPath(pressLiftPress(0.0));
+                d.setPath(test::pressLiftPress(0.0));
             }
         },
         opt);
@@ -247,9 +224,9 @@ TEST_CASE("servo threads: a device that disconnects and comes back is zeroed at 
     CHECK(back.faults == 1);
     CHECK(back.reopens == 1);
     CHECK(back.downS >= 0.2); // away for 300 ms; noticed within a few ms
-    CHECK(hasEvent(back, "read-failed: disconnected"));
-    CHECK(hasEvent(back, "reopen failed, disconnected")); // tried while it was away
-    CHECK(hasEvent(back, "reopened"));
+    CHECK(test::hasEvent(back, "read-failed: disconnected"));
+    CHECK(test::hasEvent(back, "reopen failed, disconnected")); // tried while it was away
+    CHECK(test::hasEvent(back, "reopened"));
     CHECK_FALSE(back.stable);
     CHECK(r.devices[0].faults == 0);
     CHECK(r.devices[0].fault.empty());
@@ -265,7 +242,7 @@ TEST_CASE("servo threads: a device that disconnects and comes back is zeroed at 
 }
 
 TEST_CASE("servo threads pick up a new snapshot at their next tick", "[realtime]") {
-    Rig rig(cubeScene(), 2, 1000.0);
+    ThreadRig rig(cubeScene(), 2, 1000.0);
     rig.runtime->start();
     REQUIRE(rig.pump([&] {
         return rig.runtime->metrics(0).ticks.load() > 0 && rig.runtime->metrics(1).ticks.load() > 0;
@@ -281,7 +258,7 @@ TEST_CASE("servo threads pick up a new snapshot at their next tick", "[realtime]
 TEST_CASE("servo threads: a publisher flooding snapshot updates never stops or faults a servo "
           "thread",
           "[realtime]") {
-    Rig rig(cubeScene(), 3, 2000.0);
+    ThreadRig rig(cubeScene(), 3, 2000.0);
     rig.world.setRestDelay(std::chrono::milliseconds(2)); // re-index often, too
     rig.runtime->start();
     for (int published = 0; published < 2000; ++published) {

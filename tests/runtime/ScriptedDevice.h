@@ -7,6 +7,7 @@
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/runtime/ManualClock.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -193,6 +194,9 @@ private:
     bool mOpen = false, mClosed = false;
 };
 
+/// A millisecond on the runtime's clocks (ns).
+inline constexpr std::uint64_t kMs = 1'000'000;
+
 /// The configuration the runtime tests give scripted device i: named "d<i>", at `rateHz`,
 /// forces clamped at 5 N.
 inline DeviceConfig scriptedConfig(int i, double rateHz) {
@@ -214,6 +218,27 @@ inline ScriptedDevice::Path pressIntoCube(double x = 0.0) {
         }
         return Vec3(x, top - 0.002, 0.0);
     };
+}
+
+/// pressIntoCube(x), lifted off at read 400 (1 cm above the top face) and pressing again from
+/// read 500 on.
+inline ScriptedDevice::Path pressLiftPress(double x) {
+    const ScriptedDevice::Path press = pressIntoCube(x);
+    return [press](std::uint64_t t) {
+        if (t < 400) {
+            return press(t);
+        }
+        if (t < 500) {
+            return press(0);
+        }
+        return press(t - 500);
+    };
+}
+
+/// Whether any of a report's events (a DeviceReport's) contains `text`.
+template <class Report> bool hasEvent(const Report& d, const std::string& text) {
+    return std::any_of(d.events.begin(), d.events.end(),
+                       [&](const std::string& e) { return e.find(text) != std::string::npos; });
 }
 
 } // namespace hapto::test

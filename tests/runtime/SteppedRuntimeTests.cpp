@@ -27,7 +27,7 @@ using test::ScriptedDevice;
 
 namespace {
 
-constexpr std::uint64_t kMs = 1'000'000;
+using test::kMs;
 
 using Rig = test::SteppedRig;
 
@@ -256,24 +256,6 @@ TEST_CASE("step mode: each injected fault zeroes that device in the tick it happ
     CHECK_FALSE(r.stable);
 }
 
-namespace {
-
-// Presses into the cube, lifts off at read 400, presses again from read 500 on.
-ScriptedDevice::Path pressLiftPress(double x) {
-    const ScriptedDevice::Path press = test::pressIntoCube(x);
-    return [press](std::uint64_t t) {
-        if (t < 400) {
-            return press(t);
-        }
-        if (t < 500) {
-            return press(0); // 1 cm above the top face
-        }
-        return press(t - 500);
-    };
-}
-
-} // namespace
-
 TEST_CASE("step mode: a device that is unplugged and comes back is zeroed at once, tried every "
           "reopenAfterNs, reopened and driven again from zero force") {
     RuntimeOptions opt;
@@ -282,7 +264,7 @@ TEST_CASE("step mode: a device that is unplugged and comes back is zeroed at onc
         2, 1000.0,
         [&](int i, ScriptedDevice& d) {
             if (i == 1) {
-                d.setPath(pressLiftPress(0.0));
+                d.setPath(test::pressLiftPress(0.0));
             }
         },
         opt);

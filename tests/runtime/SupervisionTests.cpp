@@ -3,6 +3,7 @@
 // bound, for what must eventually happen, and assert no counts of ticks or sleeps. The test
 // thread never calls maintain(): it stands for a control thread that is blocked.
 
+#include "CubeScene.h"
 #include "ScriptedDevice.h"
 
 #include "hapto/devices/FaultInjectingDevice.h"
@@ -16,16 +17,10 @@
 #include <thread>
 
 using namespace hapto;
+using test::cubeScene;
 using test::ScriptedDevice;
 
 namespace {
-
-Scene cubeScene() {
-    Material m;
-    m.stiffness = 500.0;
-    return Scene(Aabb{Vec3(-0.125), Vec3(0.125)},
-                 {makeBox(7, Vec3(0), Vec3(0.025), Quat(1, 0, 0, 0), m)});
-}
 
 /// A scripted device whose open() can be held shut (a Falcon homing for 30 s), and which
 /// notes how many reads any device of the test had made when it was opened.
@@ -68,14 +63,14 @@ private:
     std::atomic<bool> mWaiting{false};
 };
 
-struct Rig {
+struct SupervisedRig {
     World world{cubeScene(), IndexSpec::parse(kDefaultIndexSpec)};
     std::atomic<std::uint64_t> allReads{0};
     std::vector<GatedDevice*> devices;
     std::vector<FaultInjectingDevice*> injectors;
     std::unique_ptr<Runtime> runtime;
 
-    Rig(int count, RuntimeOptions options) {
+    SupervisedRig(int count, RuntimeOptions options) {
         std::vector<RuntimeDevice> rds;
         for (int i = 0; i < count; ++i) {
             auto d = std::make_unique<GatedDevice>("d" + std::to_string(i), allReads);
@@ -103,15 +98,10 @@ struct Rig {
     const DeviceReport device(std::size_t i) const { return runtime->report().devices.at(i); }
 };
 
-bool hasEvent(const DeviceReport& d, const std::string& what) {
-    return std::any_of(d.events.begin(), d.events.end(),
-                       [&](const std::string& e) { return e.find(what) != std::string::npos; });
-}
-
 } // namespace
 
 TEST_CASE("every device is opened before any servo thread starts", "[realtime]") {
-    Rig rig(3, {});
+    SupervisedRig rig(3, {});
     rig.runtime->start();
     REQUIRE(rig.waitFor([&] { return rig.devices[2]->reads() > 10; }));
     for (GatedDevice* d : rig.devices) {
@@ -125,7 +115,7 @@ TEST_CASE("a watchdog fault is recovered like any other fault, and the session g
     RuntimeOptions opt;
     opt.stallTimeoutNs = 50'000'000;
     opt.reopenAfterNs = 50'000'000;
-    Rig rig(2, opt);
+    SupervisedRig rig(2, opt);
     rig.runtime->start();
     REQUIRE(rig.waitFor([&] { return rig.devices[0]->reads() > 100; }));
     // The device hangs inside read() for 300 ms: as a stalled host or USB stack would.
@@ -139,8 +129,8 @@ TEST_CASE("a watchdog fault is recovered like any other fault, and the session g
     INFO(d.fault);
     CHECK(alwaysRunning);
     CHECK(d.faults >= 1);
-    CHECK(hasEvent(d, "watchdog"));
-    CHECK(hasEvent(d, "reopened"));
+    CHECK(test::hasEvent(d, "watchdog"));
+    CHECK(test::hasEvent(d, "reopened"));
     CHECK(rig.injectors[0]->firstForceAfterFault() == 0.0); // the stalled tick sent nothing
     // Driven again: it ticks and presses into the cube once more.
     const std::uint64_t before = rig.devices[0]->reads();
@@ -158,7 +148,7 @@ TEST_CASE("supervision never waits for a slow open: while one device's reopen ha
     RuntimeOptions opt;
     opt.stallTimeoutNs = 50'000'000;
     opt.reopenAfterNs = 20'000'000;
-    Rig rig(2, opt);
+    SupervisedRig rig(2, opt);
     rig.runtime->start();
     REQUIRE(rig.waitFor([&] { return rig.devices[1]->reads() > 100; }));
 
@@ -171,7 +161,7 @@ TEST_CASE("supervision never waits for a slow open: while one device's reopen ha
     rig.injectors[1]->inject(InjectedFault::Stall, 300'000'000);
     REQUIRE(rig.waitFor([&] { return rig.device(1).reopens >= 1; }));
     CHECK(rig.devices[0]->openWaiting()); // all of it while device 0's open still hangs
-    CHECK(hasEvent(rig.device(1), "watchdog"));
+    CHECK(test::hasEvent(rig.device(1), "watchdog"));
     CHECK(rig.injectors[1]->firstForceAfterFault() == 0.0);
     CHECK(rig.runtime->anyRunning());
 
@@ -185,7 +175,7 @@ TEST_CASE("stop() during a hanging reopen waits for it and leaves every device a
           "[realtime]") {
     RuntimeOptions opt;
     opt.reopenAfterNs = 10'000'000;
-    Rig rig(2, opt);
+    SupervisedRig rig(2, opt);
     rig.runtime->start();
     REQUIRE(rig.waitFor([&] { return rig.devices[0]->reads() > 100; }));
     rig.devices[0]->holdOpens(true);
@@ -209,7 +199,7 @@ TEST_CASE("stop() during a hanging reopen waits for it and leaves every device a
 TEST_CASE("emergencyStop from another thread zeroes and closes every device without the "
           "control thread",
           "[realtime]") {
-    Rig rig(2, {});
+    SupervisedRig rig(2, {});
     rig.runtime->start();
     REQUIRE(rig.waitFor([&] {
         return glm::length(rig.devices[0]->lastForce()) > 0.1 &&
