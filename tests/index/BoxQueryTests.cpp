@@ -4,6 +4,7 @@
 // once and no other, a visitor can stop the walk, and an empty or NaN box visits nothing.
 
 #include "IndexTestScenes.h"
+#include "OneThreadBuilds.h"
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/Overlap.h"
@@ -58,8 +59,8 @@ std::vector<std::uint32_t> allLeaves(const SpatialIndex& index) {
 
 } // namespace
 
-TEST_CASE("Box query: every item reaching into the box is found, every index and scene",
-          "[threads]") {
+TEST_CASE("Box query: every item reaching into the box is found, every index and scene") {
+    hapto::test::buildOnOneThread();
     Random rng(37);
     for (const auto& [name, scene] : testScenes()) {
         const auto shapes = itemShapes(scene);
@@ -95,7 +96,8 @@ TEST_CASE("Box query: every item reaching into the box is found, every index and
     }
 }
 
-TEST_CASE("Box query: exactly the leaves overlapping the box, each once", "[threads]") {
+TEST_CASE("Box query: exactly the leaves overlapping the box, each once") {
+    hapto::test::buildOnOneThread();
     Random rng(5);
     const Scene scene = makeDegenerateScene();
     for (const IndexSpec& spec : testSpecs()) {
@@ -122,8 +124,8 @@ TEST_CASE("Box query: exactly the leaves overlapping the box, each once", "[thre
     }
 }
 
-TEST_CASE("Box query: a visitor stops the walk, and empty or NaN boxes visit nothing",
-          "[threads]") {
+TEST_CASE("Box query: a visitor stops the walk, and empty or NaN boxes visit nothing") {
+    hapto::test::buildOnOneThread();
     const Scene scene = makeDegenerateScene();
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (const IndexSpec& spec : testSpecs()) {

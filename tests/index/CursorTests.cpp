@@ -1,4 +1,5 @@
 #include "IndexTestScenes.h"
+#include "OneThreadBuilds.h"
 
 #include "hapto/index/Cursor.h"
 #include "hapto/index/Octree.h"
@@ -44,8 +45,8 @@ std::vector<Vec3> randomWalk(const Aabb& b, std::uint64_t seed, int steps, doubl
 } // namespace
 
 TEST_CASE("a cursor on a long hand-speed walk lands where a fresh locate does, links never "
-          "take more steps than climbing",
-          "[threads]") {
+          "take more steps than climbing") {
+    hapto::test::buildOnOneThread();
     for (const auto& [name, scene] : testScenes()) {
         for (const IndexSpec& spec :
              {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001), IndexSpec::grid(5),

@@ -1,4 +1,5 @@
 #include "IndexTestScenes.h"
+#include "OneThreadBuilds.h"
 
 #include "hapto/index/BruteForce.h"
 #include "hapto/index/Cursor.h"
@@ -14,8 +15,8 @@
 using namespace hapto;
 using namespace hapto::test;
 
-TEST_CASE("every item holding the query point is a candidate: every index, mode, strategy",
-          "[threads]") {
+TEST_CASE("every item holding the query point is a candidate: every index, mode, strategy") {
+    hapto::test::buildOnOneThread();
     for (const auto& [name, scene] : testScenes()) {
         const std::vector<Vec3> points = queryPoints(scene, 3, 1500);
         const Containment containing(scene);
@@ -112,8 +113,8 @@ TEST_CASE("a grid cell holds exactly the items overlapping it (brute-force check
     }
 }
 
-TEST_CASE("octree leaves hold at most M items unless at minimum size, exactly the overlapping",
-          "[threads]") {
+TEST_CASE("octree leaves hold at most M items unless at minimum size, exactly the overlapping") {
+    hapto::test::buildOnOneThread();
     for (const auto& [name, scene] : testScenes()) {
         const auto shapes = itemShapes(scene);
         for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001),
@@ -190,7 +191,8 @@ TEST_CASE("OBB placement never gives more object-cell pairs than AABB placement"
           buildIndex(s, IndexSpec::grid(16, OverlapMode::Aabb))->stats().objectCellPairs);
 }
 
-TEST_CASE("stats add up, brute force lists everything, an empty scene works", "[threads]") {
+TEST_CASE("stats add up, brute force lists everything, an empty scene works") {
+    hapto::test::buildOnOneThread();
     const Scene scene = makeDegenerateScene();
     const auto brute = buildIndex(scene, IndexSpec::brute());
     CHECK(brute->stats().leaves == 1);
@@ -264,8 +266,8 @@ TEST_CASE("a point outside the bounds but inside an object that reaches out gets
     }
 }
 
-TEST_CASE("an index that would exceed its memory limit is refused before it is built",
-          "[threads]") {
+TEST_CASE("an index that would exceed its memory limit is refused before it is built") {
+    hapto::test::buildOnOneThread();
     // Three boxes filling the bounds: every one of them in every cell of a fine grid.
     const Scene scene({Vec3(-0.1), Vec3(0.1)},
                       {makeBox(1, Vec3(0.0), Vec3(0.1)), makeBox(2, Vec3(0.0), Vec3(0.099)),
@@ -387,8 +389,8 @@ TEST_CASE("an octree's memory floor refuses a spec at once and never refuses wha
     }
 }
 
-TEST_CASE("the octree floor counts cells shared by overlapping items and stays a floor",
-          "[threads]") {
+TEST_CASE("the octree floor counts cells shared by overlapping items and stays a floor") {
+    hapto::test::buildOnOneThread();
     // Items that overlap only here and there: the global count finds nothing, the pairs do.
     RandomOptions r;
     r.count = 3000;
@@ -551,8 +553,8 @@ placedBy(const std::vector<std::pair<std::uint32_t, OverlapShape>>& shapes, cons
 
 } // namespace
 
-TEST_CASE("axis-aligned boxes by their box, the rest by the full test: the same cells as before",
-          "[threads]") {
+TEST_CASE("axis-aligned boxes by their box, the rest by the full test: the same cells as before") {
+    hapto::test::buildOnOneThread();
     std::vector<std::pair<std::string, Scene>> scenes;
     scenes.emplace_back("mixed alignment", makeMixedAlignmentScene());
     RandomOptions r;

@@ -1,4 +1,5 @@
 #include "IndexTestScenes.h"
+#include "OneThreadBuilds.h"
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/UniformGrid.h"
@@ -32,8 +33,8 @@ std::uint32_t expectedNode(const Octree& tree, int level, std::array<std::int64_
 
 } // namespace
 
-TEST_CASE("neighbour links name the equal-size neighbour, else the smallest larger one",
-          "[threads]") {
+TEST_CASE("neighbour links name the equal-size neighbour, else the smallest larger one") {
+    hapto::test::buildOnOneThread();
     for (const auto& [name, scene] : testScenes()) {
         for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001)}) {
             INFO(name << " " << spec.toString());

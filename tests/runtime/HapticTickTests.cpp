@@ -1,5 +1,6 @@
 // HapticTick, the one haptic tick: locate, candidates, render, effects, safety.
 
+#include "OneThreadBuilds.h"
 #include "TestMeshes.h"
 #include "hapto/experiments/HandWalk.h"
 #include "hapto/index/DefaultIndex.h"
@@ -221,8 +222,8 @@ double nearestFacetPlane(const TriangleMesh& mesh, double r) {
 } // namespace
 
 TEST_CASE("a hand sliding over a fine mesh whose leaves are smaller than one tick's motion stays "
-          "on the surface: the leaves the proxy slides over are rendered too",
-          "[threads]") {
+          "on the surface: the leaves the proxy slides over are rendered too") {
+    hapto::test::buildOnOneThread();
     // An icosphere of 327 680 triangles (edges about 0.45 mm) in an octree of 0.5 mm leaves,
     // and a device 1 mm inside it sliding 0.5 mm per tick over its top: every few ticks the
     // proxy slides into a leaf that neither the device's nor its own old leaf lists.
@@ -316,8 +317,8 @@ DeepPress pressDeepAndFast(double stepM, const char* spec) {
 } // namespace
 
 TEST_CASE("a hand pressing deep and fast over a fine mesh is held on every tick under every index: "
-          "the leaves of the proxy's whole path are rendered",
-          "[threads]") {
+          "the leaves of the proxy's whole path are rendered") {
+    hapto::test::buildOnOneThread();
     // Up to 2 mm per tick: the solver's passes slide the proxy sideways over several small
     // leaves before it settles, so walking only the straight ways from its start missed some,
     // and a proxy that slid over an unlisted leaf fell through the surface. Every index must
@@ -332,8 +333,8 @@ TEST_CASE("a hand pressing deep and fast over a fine mesh is held on every tick 
 }
 
 TEST_CASE("a hand faster than its leaves can be listed has its goal pulled back: the proxy moves "
-          "less, never through the surface, and the hand is held",
-          "[threads]") {
+          "less, never through the surface, and the hand is held") {
+    hapto::test::buildOnOneThread();
     // Up to 6 mm per tick over 0.2 mm leaves: more leaves than a tick can list
     // (HapticTick::kExtraLeaves). The goal is pulled back toward the proxy instead: the proxy
     // moves less on those ticks but never sinks into the mesh, and the contacts and force are
@@ -347,8 +348,8 @@ TEST_CASE("a hand faster than its leaves can be listed has its goal pulled back:
 }
 
 TEST_CASE("timing a tick's stages changes none of its results, and the stamps are in stage order "
-          "within the tick, re-solves included",
-          "[threads]") {
+          "within the tick, re-solves included") {
+    hapto::test::buildOnOneThread();
     // The fine-mesh slide of the test above, with its re-solves over leaves the proxy slides
     // into (`hapto bench tick` times the servo's own tick this way), ticked by a timed and an
     // untimed HapticTick side by side.
@@ -385,8 +386,8 @@ TEST_CASE("timing a tick's stages changes none of its results, and the stamps ar
 }
 
 TEST_CASE("a proxy trapped far behind a hand that pushed through keeps its contacts and the "
-          "device point's force when its goal is pulled back, and stays out of every cube",
-          "[threads]") {
+          "device point's force when its goal is pulled back, and stays out of every cube") {
+    hapto::test::buildOnOneThread();
     // 10^3 cubes of 2 mm filling half of a 2.5 cm cube, and the benchmarks' hand walk (up to
     // 0.5 mm per tick) through them, ignoring the force: the proxy is caught in the pockets
     // between cubes, up to centimetres behind, and its way toward the hand can cross more 1 mm
