@@ -143,6 +143,8 @@ public:
     /// |force| of the first write that came more than 20 ms after the one before it (a thread
     /// that could not run); negative if no such gap happened.
     double forceAfterGap() const { return mForceAfterGap.load(); }
+    /// Forgets any gap seen so far: forceAfterGap() is about the gaps from here on.
+    void forgetGaps() { mForceAfterGap.store(-1.0); }
     /// Largest force magnitude written while reads >= tick (for "zero after K misses" checks).
     bool closed() const { return mClosed; }
 

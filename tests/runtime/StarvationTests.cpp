@@ -79,9 +79,17 @@ TEST_CASE("a servo thread starved by a CPU hog gets zero force when it runs agai
         }
         return done();
     };
-    REQUIRE(pump([&] { return hands[0]->reads() >= 300 && hands[1]->reads() >= 300; }));
-    CHECK(glm::length(hands[0]->lastForce()) > 0.0); // pressing: the device holds a force
-    REQUIRE(hands[0]->forceAfterGap() < 0.0);        // no 20 ms gap so far
+    // Both pressing, holding a force, and running (not faulted): a stall of the machine before
+    // the hog may have tripped the watchdog already; the test then waits for the reopen and
+    // counts only what comes after this point.
+    REQUIRE(pump([&] {
+        const RunReport now = runtime.report();
+        return hands[0]->reads() >= 300 && hands[1]->reads() >= 300 &&
+               glm::length(hands[0]->lastForce()) > 0.0 && now.devices[0].fault.empty() &&
+               now.devices[1].fault.empty();
+    }));
+    const RunReport before = runtime.report();
+    hands[0]->forgetGaps();
 
     // The hog: FIFO 50 > the servo threads' 20, spinning 300 ms on device 0's core.
     enum class Hog { Starting, Spinning, Done };
@@ -114,7 +122,8 @@ TEST_CASE("a servo thread starved by a CPU hog gets zero force when it runs agai
     REQUIRE(hogError.empty());
     const std::uint64_t otherAfter = runtime.metrics(1).ticks.load();
 
-    const bool reopened = pump([&] { return runtime.report().devices[0].reopens == 1; });
+    const bool reopened =
+        pump([&] { return runtime.report().devices[0].reopens == before.devices[0].reopens + 1; });
     if (!reopened) {
         const RunReport now = runtime.report();
         for (const DeviceReport& d : now.devices) {
@@ -136,17 +145,18 @@ TEST_CASE("a servo thread starved by a CPU hog gets zero force when it runs agai
     // Starved for ~300 ms: the watchdog faulted it, and the first force it sent when it could
     // run again was zero.
     CHECK(hands[0]->forceAfterGap() == 0.0);
-    CHECK(starved.faults == 1);
-    REQUIRE_FALSE(starved.events.empty());
-    CHECK(starved.events[0].find("watchdog: no tick for 50 ms") != std::string::npos);
-    CHECK(starved.reopens == 1);
+    CHECK(starved.faults == before.devices[0].faults + 1);
+    REQUIRE(starved.events.size() > before.devices[0].events.size());
+    CHECK(starved.events[before.devices[0].events.size()].find("watchdog: no tick for 50 ms") !=
+          std::string::npos);
+    CHECK(starved.reopens == before.devices[0].reopens + 1);
     CHECK(starved.fault.empty()); // running again at the end
     // The other device ticked all through the hog and never faulted. (How promptly it ticked
     // is the machine's to say, not this test's: a 2-core VM has held a core's SCHED_FIFO
     // thread off for over 20 ms while a build ran beside it, the watchdog's 50 ms never.)
     CHECK(otherAfter > otherBefore);
-    CHECK(r.devices[1].faults == 0);
-    CHECK(r.devices[1].events.empty());
+    CHECK(r.devices[1].faults == before.devices[1].faults);
+    CHECK(r.devices[1].events.size() == before.devices[1].events.size());
     for (auto* h : hands) {
         CHECK(glm::length(h->lastForce()) == 0.0);
     }
