@@ -62,8 +62,8 @@ build() {
 # run's: a sanitizer build's output is held and printed whole just before its preset's tests.
 # Every preset is built and tested even after a failure; each ctest prints its own failures. A
 # preset's failed tests run once more, alone; the run fails if any build failed or any test
-# failed twice, and its last lines name every test that failed, with the end of its output. Arguments after `test` go to every ctest
-# (e.g. `tools/setup.sh test -R bad_input`).
+# failed twice, and its last lines name every test that failed, with the end of its output.
+# Arguments after `test` go to every ctest (e.g. `tools/setup.sh test -R bad_input`).
 builder_pid= builder_dir=
 
 # [builder] Builds each preset given, under SCHED_IDLE; DIR/PRESET.log holds its output and
@@ -159,7 +159,10 @@ print_tests() {
     /^[0-9]+\/[0-9]+ Test: / { split($0, a, "/"); show = (a[1] in failed); n = 0 }
     show && /^[0-9]+\/[0-9]+ Test: / { print "-- " substr($0, index($0, ": ") + 2) }
     show && /^Output:/ { n = 0; keep = 1; getline; next }
-    show && /^<end of output>/ { for (i = (n > 30 ? n - 30 : 0); i < n; i++) print "   " line[i]; keep = 0 }
+    show && /^<end of output>/ {
+      for (i = (n > 30 ? n - 30 : 0); i < n; i++) print "   " line[i]
+      keep = 0
+    }
     show && keep { line[n++] = $0 }' "$failed" "$log"
 }
 
