@@ -20,6 +20,8 @@ using test::ScriptedDevice;
 
 namespace {
 
+using test::kMs;
+
 // Piecewise-linear path through (tick, point) keyframes, held after the last.
 ScriptedDevice::Path keyframes(std::vector<std::pair<std::uint64_t, Vec3>> keys) {
     return [keys](std::uint64_t t) {
@@ -62,7 +64,6 @@ Hands graspPaths(Vec3 lift, Vec3 carry, Vec3 lower, double open) {
 }
 
 struct GraspRig {
-    static constexpr std::uint64_t kMs = 1'000'000;
     ManualClock clock;
     World world;
     std::unique_ptr<Runtime> runtime;

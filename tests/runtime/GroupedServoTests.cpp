@@ -25,7 +25,7 @@ using test::ScriptedDevice;
 
 namespace {
 
-constexpr std::uint64_t kMs = 1'000'000;
+using test::kMs;
 
 /// A stepped runtime of `count` scripted 1 kHz devices over the cube scene, `perThread` to a
 /// servo thread: device i presses into the cube at x = 0.004 i - 0.01.
