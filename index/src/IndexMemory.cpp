@@ -38,10 +38,21 @@
 //   cell, are left out: fewer items, a lower floor, still a floor. The groups are looked for
 //   only when the ceiling passes the limit (under it the build fits whatever the floor says),
 //   so a build that fits pays nothing for them.
+// - distinct cells: items that do not overlap but sit closer than a level's cells (a lattice
+//   with 0.5 mm gaps) split every cell spanning a gap, few per pair, so the largest group says
+//   little. When the floor with it still fits the limit, every box's best group marks its
+//   cells (at most kMarkCells a level) on one bitmap per level below kMarkLevels, and the
+//   level's set bits, distinct split cells, add up: at 10^6 such cubes the floor is 3.7 x 10^7
+//   nodes where the largest group gave 265. With M > 1 a box with no group sharing volume
+//   notes a near group instead: the following boxes whose gaps to the group stay under a grid
+//   cell, taken greedily, once more than M (a cell spanning the gaps lists them all: a
+//   lattice's corners).
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
 // Cost: O(items * levels) time; memory per item (at most kPairItems of them) one inner box
-// and its sort key (32 bytes, 32 MB at 10^6 items), none per node.
+// and its sort key (32 bytes), then its best group's shared box (28 bytes): 54 MB at 10^6
+// items with the bitmaps (8^l bits at level l, 16 MB at level 9, one level at a time); none
+// per node.
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/SpatialIndex.h"
@@ -52,6 +63,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -314,21 +326,37 @@ std::uint64_t splitsAtLeast(const LevelCounts& c, const Aabb& b, int l, std::uin
 /// Per level, the most cells one group's boxes all touch (the note's groups).
 using LevelCells = std::array<std::uint64_t, kLevels>;
 
-/// The level-l cells (strictly) touching every box of a group: per axis [lo, hi] is the
-/// largest low and the smallest high of the group's boxes.
-std::uint64_t groupCells(const std::array<float, 3>& lo, const std::array<float, 3>& hi, int l) {
+/// The box a group's boxes share, in units of the bounds: per axis the largest low and the
+/// smallest high (lo > hi across a gap); no group when lo is NaN (then it touches no cell).
+struct SharedBox {
+    std::array<float, 3> lo{std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f};
+    std::array<float, 3> hi{};
+};
+
+/// The level-l cells (strictly) touching every box of a group, per axis [first[a], last[a]]:
+/// lo and hi are the largest low and the smallest high of the group's boxes. False when none.
+bool groupRange(const std::array<float, 3>& lo, const std::array<float, 3>& hi, int l,
+                std::array<std::uint64_t, 3>& first, std::array<std::uint64_t, 3>& last) {
     const double n = static_cast<double>(std::uint64_t(1) << l);
-    std::uint64_t cells = 1;
     for (int a = 0; a < 3; ++a) {
         // Cell c touches [lo, hi] when c < hi * n and c + 1 > lo * n.
-        const double first = std::max(std::floor(static_cast<double>(lo[a]) * n), 0.0);
-        const double last = std::min(std::ceil(static_cast<double>(hi[a]) * n) - 1.0, n - 1.0);
-        if (!(last >= first)) {
-            return 0;
+        const double f = std::max(std::floor(static_cast<double>(lo[a]) * n), 0.0);
+        const double e = std::min(std::ceil(static_cast<double>(hi[a]) * n) - 1.0, n - 1.0);
+        if (!(e >= f)) {
+            return false; // also for a NaN low (no group)
         }
-        cells *= static_cast<std::uint64_t>(last - first) + 1;
+        first[a] = static_cast<std::uint64_t>(f);
+        last[a] = static_cast<std::uint64_t>(e);
     }
-    return cells;
+    return true;
+}
+
+std::uint64_t groupCells(const std::array<float, 3>& lo, const std::array<float, 3>& hi, int l) {
+    std::array<std::uint64_t, 3> first, last;
+    if (!groupRange(lo, hi, l, first, last)) {
+        return 0;
+    }
+    return (last[0] - first[0] + 1) * (last[1] - first[1] + 1) * (last[2] - first[2] + 1);
 }
 
 void takeGroup(const std::array<float, 3>& lo, const std::array<float, 3>& hi, int levels,
@@ -367,19 +395,22 @@ constexpr int kRows[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
 /// (the rows' first keys grow with i's key).
 class GroupSearch {
 public:
-    GroupSearch(std::span<const CellKey> keys, float cell, std::uint32_t m)
-        : mKeys(keys), mCell(cell), mM(m) {}
+    GroupSearch(std::span<const CellKey> keys, float cell, std::uint32_t m,
+                std::span<SharedBox> found)
+        : mKeys(keys), mCell(cell), mM(m), mFound(found) {}
 
-    /// Finds the best group of box i (the most shared volume) and keeps it when it is among
-    /// the kKeep best of the search so far.
+    /// Finds the best group of box i (the most shared volume), notes its shared box in
+    /// found[i] (left empty when it has none) and keeps it when it is among the kKeep best of
+    /// the search so far.
     void run(std::size_t i) {
         const std::uint64_t k = mKeys[i].key;
         const std::uint64_t x = k & (kAxisCells - 1), y = (k >> 21) & (kAxisCells - 1);
         const std::uint64_t z = k >> 42;
         mBest = -1.0f;
         mMembers = 1;
-        mLo = mKeys[i].box.lo;
-        mHi = mKeys[i].box.hi;
+        mNearMembers = 1;
+        mLo = mNearLo = mKeys[i].box.lo;
+        mHi = mNearHi = mKeys[i].box.hi;
         mChecks = 0;
         scan(i + 1, packCell(std::min(x + 1, kAxisCells - 1), y, z));
         for (int r = 0; r < 4 && mMembers <= mM; ++r) {
@@ -400,7 +431,11 @@ public:
             }
             scan(j, packCell(std::min(x + 1, kAxisCells - 1), ry, rz));
         }
+        if (mBest < 0.0f && mNearMembers > mM) {
+            mFound[i] = {mNearLo, mNearHi}; // noted, not kept: no shared volume
+        }
         if (mBest >= 0.0f) {
+            mFound[i] = {mBestLo, mBestHi};
             Group* worst = &mKept[0];
             for (Group& g : mKept) {
                 worst = g.score < worst->score ? &g : worst;
@@ -423,7 +458,9 @@ public:
 private:
     // Boxes [j, ...) up to key `last`: M = 1 keeps the nearest pair (the most shared volume, a
     // gap under a sixteenth of a cell counting as a thin overlap); M > 1 narrows the shared
-    // box greedily and keeps it once it has more than M members.
+    // box greedily and keeps it once it has more than M members, and beside it a near group:
+    // boxes whose gaps to the group stay under a grid cell (cells spanning the gaps list them
+    // all, a lattice's corners).
     void scan(std::size_t j, std::uint64_t last) {
         for (; j < mKeys.size() && mKeys[j].key <= last && mChecks < kPairChecks; ++j) {
             ++mChecks;
@@ -451,12 +488,30 @@ private:
                     return;
                 }
             }
+            if (mM > 1 && mNearMembers <= mM) {
+                takeNear(other);
+            }
         }
+    }
+
+    void takeNear(const UnitBox& other) {
+        std::array<float, 3> lo, hi;
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::max(mNearLo[a], other.lo[a]);
+            hi[a] = std::min(mNearHi[a], other.hi[a]);
+            if (!(hi[a] - lo[a] > -mCell)) {
+                return;
+            }
+        }
+        mNearLo = lo;
+        mNearHi = hi;
+        ++mNearMembers;
     }
 
     std::span<const CellKey> mKeys;
     float mCell;
     std::uint32_t mM;
+    std::span<SharedBox> mFound;
     // The groups kept: evaluating each box's group at every level would cost more than finding
     // it, and the largest shared volumes give the largest counts where the counts are large.
     static constexpr std::size_t kKeep = 16;
@@ -467,9 +522,9 @@ private:
     std::array<Group, kKeep> mKept{};
     static constexpr std::size_t kUnset = std::numeric_limits<std::size_t>::max();
     std::array<std::size_t, 4> mCursor{kUnset, kUnset, kUnset, kUnset};
-    std::array<float, 3> mLo{}, mHi{}, mBestLo{}, mBestHi{};
+    std::array<float, 3> mLo{}, mHi{}, mBestLo{}, mBestHi{}, mNearLo{}, mNearHi{};
     float mBest = -1.0f;
-    std::uint32_t mMembers = 1;
+    std::uint32_t mMembers = 1, mNearMembers = 1;
     int mChecks = 0;
 };
 
@@ -489,8 +544,10 @@ std::vector<CellKey> groupRecords(const Scene& scene, const IndexSpec& spec, con
 }
 
 /// Per level, the most cells any kept group of more than M items' inner boxes touches (the
-/// note's groups); sorts the records.
-LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, int levels) {
+/// note's groups); sorts the records and notes each box's best group in `found` (the shared
+/// box, empty when none; one per record).
+LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, int levels,
+                      std::vector<SharedBox>& found) {
     LevelCells most{};
     parallel::sort(keys.begin(), keys.end());
     std::size_t used = keys.size();
@@ -498,13 +555,14 @@ LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, i
         --used;
     }
     const std::span<const CellKey> sorted(keys.data(), used);
+    found.assign(used, SharedBox{});
     std::mutex merge;
     // Fixed blocks of boxes, each keeping its own groups: the same floor on any number of
     // threads.
     constexpr std::size_t kBlock = 4096;
     parallel::forEach(0, (used + kBlock - 1) / kBlock, 1, [&](std::size_t block) {
         LevelCells part{};
-        GroupSearch search(sorted, cell, m);
+        GroupSearch search(sorted, cell, m, found);
         for (std::size_t i = block * kBlock; i < std::min(used, (block + 1) * kBlock); ++i) {
             search.run(i);
         }
@@ -515,6 +573,94 @@ LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, i
         }
     });
     return most;
+}
+
+/// Levels whose groups' distinct cells are counted on a bitmap of 8^l bits (16 MB at 9).
+constexpr int kMarkLevels = 10;
+/// Cells of one group's shared box marked per level at most (any subset keeps a floor).
+constexpr std::uint64_t kMarkCells = 64;
+
+/// Sets the bits of up to kMarkCells level-l cells in [first, last] (per axis).
+void markCells(std::span<std::uint64_t> bits, int l, const std::array<std::uint64_t, 3>& first,
+               const std::array<std::uint64_t, 3>& last) {
+    std::uint64_t marked = 0;
+    for (std::uint64_t z = first[2]; z <= last[2]; ++z) {
+        for (std::uint64_t y = first[1]; y <= last[1]; ++y) {
+            for (std::uint64_t x = first[0]; x <= last[0]; ++x) {
+                if (++marked > kMarkCells) {
+                    return;
+                }
+                const std::uint64_t cell = (z << (2 * l)) | (y << l) | x;
+                const std::uint64_t bit = std::uint64_t(1) << (cell & 63);
+                std::atomic_ref<std::uint64_t> word(bits[cell >> 6]);
+                if ((word.load(std::memory_order_relaxed) & bit) == 0) {
+                    word.fetch_or(bit, std::memory_order_relaxed);
+                }
+            }
+        }
+    }
+}
+
+/// Per level below min(levels, kMarkLevels), the distinct cells that every box of some group
+/// in `found` touches. Each is a split cell of the real tree and distinct cells are distinct
+/// nodes, so unlike the largest group's count these add up. Order-free: the same on any
+/// number of threads.
+LevelCells distinctGroupCells(std::span<const SharedBox> found, int levels) {
+    LevelCells cells{};
+    for (int l = 0; l < std::min(levels, kMarkLevels); ++l) {
+        std::vector<std::uint64_t> bits(((std::uint64_t(1) << (3 * l)) + 63) / 64);
+        parallel::forEach(0, found.size(), 4096, [&](std::size_t i) {
+            std::array<std::uint64_t, 3> first, last;
+            if (groupRange(found[i].lo, found[i].hi, l, first, last)) {
+                markCells(bits, l, first, last);
+            }
+        });
+        for (const std::uint64_t w : bits) {
+            cells[l] += static_cast<std::uint64_t>(std::popcount(w));
+        }
+    }
+    return cells;
+}
+
+/// The floor's nodes: the root and 8 per level-l split, l < levels, taking per level the
+/// larger of the global count and `groups`.
+std::uint64_t nodesFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int levels,
+                         const LevelCells& groups) {
+    std::uint64_t nodes = 1;
+    for (int l = 0; l < levels; ++l) {
+        nodes = addSat(nodes, mulSat(8, std::max(splitsAtLeast(c, b, l, m), groups[l])));
+    }
+    return nodes;
+}
+
+/// Alive at the end of the build: per item its id, local id and shape; the nodes and their
+/// parents.
+std::uint64_t floorBytes(std::uint64_t items, std::uint64_t nodes) {
+    return addSat(
+        mulSat(items, 2 * sizeof(std::uint32_t) + sizeof(OverlapShape)),
+        addSat(mulSat(nodes, sizeof(OctreeNode)), mulSat(nodes / 8, sizeof(std::uint32_t))));
+}
+
+/// The groups' split cells per level below `levels` (the note's groups): the largest kept
+/// group's, and when the floor with them still fits the limit, the groups' distinct cells.
+LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
+                       const LevelCounts& c, int levels) {
+    const std::uint64_t m = static_cast<std::uint64_t>(std::max(spec.maxObjects, 1));
+    const float cell =
+        groupGridCell(scene, spec, b, std::min<std::size_t>(scene.itemCount(), kPairItems));
+    std::vector<SharedBox> found;
+    LevelCells groups;
+    {
+        std::vector<CellKey> records = groupRecords(scene, spec, b, cell);
+        groups = groupFloor(records, cell, static_cast<std::uint32_t>(m), levels, found);
+    }
+    if (floorBytes(c.items, nodesFloor(c, b, m, levels, groups)) <= spec.maxBytes) {
+        const LevelCells distinct = distinctGroupCells(found, levels);
+        for (int l = 0; l < levels; ++l) {
+            groups[l] = std::max(groups[l], distinct[l]);
+        }
+    }
+    return groups;
 }
 
 IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
@@ -537,27 +683,13 @@ IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
     IndexMemoryEstimate e;
     e.atMostBytes =
         detail::octreeBuildBytes({c.items, totalNodes, slots, widest, entries, entries});
-    // The groups only matter when the ceiling passes the limit: under it the build fits
-    // whatever the floor says, and a build that fits pays no group pass.
-    LevelCells groups{};
-    if (e.atMostBytes > spec.maxBytes) {
-        const float cell =
-            groupGridCell(scene, spec, b, std::min<std::size_t>(scene.itemCount(), kPairItems));
-        std::vector<CellKey> records = groupRecords(scene, spec, b, cell);
-        groups = groupFloor(records, cell, static_cast<std::uint32_t>(m), splitLevels);
-    }
-    // Lower bound: nodes the real tree has.
-    std::uint64_t nodesAtLeast = 1;
-    for (int l = 0; l < std::min(reached, splitLevels); ++l) {
-        nodesAtLeast =
-            addSat(nodesAtLeast, mulSat(8, std::max(splitsAtLeast(c, b, l, m), groups[l])));
-    }
-    // Alive at the end of the build: per item its id, local id and shape; the nodes and their
-    // parents.
-    e.atLeastBytes = addSat(mulSat(c.items, 2 * sizeof(std::uint32_t) + sizeof(OverlapShape)),
-                            addSat(mulSat(nodesAtLeast, sizeof(OctreeNode)),
-                                   mulSat(nodesAtLeast / 8, sizeof(std::uint32_t))));
-    e.nodesAtLeast = nodesAtLeast;
+    // Lower bound: nodes the real tree has. The groups only matter when the ceiling passes
+    // the limit: under it the build fits whatever the floor says, and pays no group pass.
+    const int splitting = std::min(reached, splitLevels);
+    const LevelCells groups =
+        e.atMostBytes > spec.maxBytes ? groupSplits(scene, spec, b, c, splitting) : LevelCells{};
+    e.nodesAtLeast = nodesFloor(c, b, m, splitting, groups);
+    e.atLeastBytes = floorBytes(c.items, e.nodesAtLeast);
     return e;
 }
 

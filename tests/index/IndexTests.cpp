@@ -413,6 +413,25 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
     fine.maxBytes = 1;
     CHECK(estimateIndexMemory(lattice, fine).nodesAtLeast <= tree->stats().nodes);
 
+    // Items that do not overlap but sit closer than a level's cells: every cell spanning a gap
+    // lists two cubes, few per pair, so the largest group says little; the pairs' distinct
+    // cells add up, and the spec is refused by the floor before anything is built.
+    LatticeOptions gaps;
+    gaps.perSide = 24;
+    gaps.cubeSize = 0.01;
+    gaps.gap = 0.001;
+    const Scene near = makeLatticeScene(gaps);
+    CHECK_THROWS_WITH(buildIndex(near, deep), Catch::Contains("nodes over 13824 items"));
+    // With M = 2 a split cell spans two gaps (a lattice's corner, four cubes): the near groups
+    // find them where no three cubes share any volume.
+    IndexSpec corners = IndexSpec::octree(2, 1e-9);
+    corners.maxBytes = 1;
+    corners.maxBytes = estimateIndexMemory(near, corners).atLeastBytes;
+    const std::uint64_t cornersFloor = estimateIndexMemory(near, corners).nodesAtLeast;
+    corners.maxBytes = 4ull << 30;
+    CHECK(cornersFloor > 10000);
+    CHECK(cornersFloor <= buildIndex(near, corners)->stats().nodes);
+
     // Against real builds: scenes that overlap densely, here and there, touch or nearly touch,
     // at specs down to the smallest MIN that still fits.
     std::vector<std::pair<std::string, Scene>> scenes = testScenes();
@@ -423,6 +442,8 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
     scenes.emplace_back("dense rotated", makeRandomScene(r));
     apart.gap = 1e-6;
     scenes.emplace_back("lattice nearly touching", makeLatticeScene(apart));
+    apart.gap = 0.001;
+    scenes.emplace_back("lattice 1 mm apart", makeLatticeScene(apart));
     for (const auto& [name, scene] : scenes) {
         for (const IndexSpec& spec :
              {IndexSpec::octree(1, 0.004), IndexSpec::octree(1, 0.0005),
@@ -432,6 +453,11 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
             IndexSpec tight = spec; // a ceiling above the limit: the groups are looked for
             tight.maxBytes = 1;
             const IndexMemoryEstimate e = estimateIndexMemory(scene, tight);
+            // At the largest group's floor the limit is not passed yet: the groups' distinct
+            // cells are counted too.
+            tight.maxBytes = e.atLeastBytes;
+            const IndexMemoryEstimate distinct = estimateIndexMemory(scene, tight);
+            CHECK(distinct.nodesAtLeast >= e.nodesAtLeast);
             IndexSpec roomy = spec;
             roomy.maxBytes = 4ull << 30;
             std::unique_ptr<SpatialIndex> index;
@@ -440,8 +466,8 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
             } catch (const InputError&) { // more than kMaxNodes: nothing to compare
                 continue;
             }
-            CHECK(e.nodesAtLeast <= index->stats().nodes);
-            CHECK(e.atLeastBytes <= index->stats().buildPeakBytes);
+            CHECK(distinct.nodesAtLeast <= index->stats().nodes);
+            CHECK(distinct.atLeastBytes <= index->stats().buildPeakBytes);
         }
     }
 }
