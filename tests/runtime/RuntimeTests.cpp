@@ -144,6 +144,9 @@ TEST_CASE("servo threads: each injected fault zeroes that device and leaves the 
     INFO("inject " << static_cast<int>(c.inject));
     RuntimeOptions never;
     never.reopenAfterNs = 0; // the fault keeps the device down
+    // A watchdog well under the injected 300 ms stall but above the stalls a loaded machine
+    // (or a sanitizer) gives a thread now and then: those would fault a device first.
+    never.stallTimeoutNs = 150'000'000;
     ThreadRig rig(
         cubeScene(), 3, 1000.0,
         [&](int i, ScriptedDevice& d) {
