@@ -33,11 +33,13 @@
 #include "hapto/io/InputError.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 namespace hapto {
 namespace {
@@ -300,6 +302,10 @@ private:
     void classifyLevel();
     SplitCells splitCells(std::uint64_t node) const;
     void classifyObjects(const SplitCells& cells, std::size_t lo, std::size_t hi);
+    template <class Bounds>
+    void classifyWith(const std::vector<Bounds>& bounds, const SplitCells& cells, std::size_t lo,
+                      std::size_t hi);
+    bool overlapsCell(std::uint32_t local, const OverlapCell& cell) const;
     void allocateLevel();
     void refuseAbove(std::uint64_t nodes, std::uint64_t slots, std::uint64_t next) const;
     void placeNode(std::size_t k, std::uint64_t& leafTotal, std::uint64_t& nextTotal);
@@ -309,10 +315,18 @@ private:
 
     Octree& mTree;
     const IndexSpec& mSpec;
-    const std::uint32_t mCount;          // items
-    const std::uint32_t mMaxObjects;     // M
-    std::vector<std::uint32_t> mSlotOf;  // per local id (Morton order): the item id
-    std::vector<OverlapShape> mShapes;   // per local id: the item's shape
+    const std::uint32_t mCount;         // items
+    const std::uint32_t mMaxObjects;    // M
+    std::vector<std::uint32_t> mSlotOf; // per local id (Morton order): the item id
+    // Per local id, one of: the item's AABB and scale when that is every item's whole test (Aabb
+    // mode, or only axis-aligned boxes: 56 bytes an item), else its shape (192 bytes).
+    struct BoxBounds {
+        Aabb aabb;
+        double scale = 0.0;
+    };
+    bool mAabbOnly = false;
+    std::vector<BoxBounds> mBoxes;
+    std::vector<OverlapShape> mShapes;
     std::vector<std::uint32_t> mEntries; // the lists of the current level's nodes, back to back
     std::vector<std::uint64_t> mStart;   // per node of the level, + 1: where its list starts
     std::vector<std::uint8_t> mMasks;    // per entry: the octants it overlaps (nodes that split)
@@ -360,8 +374,18 @@ void OctreeBuilder::run() {
 void OctreeBuilder::sortByMorton(const Scene& scene, std::span<const std::uint32_t> items) {
     const Aabb box = mTree.bounds();
     std::vector<std::uint64_t> keys(mCount);
+    const bool aabbMode = mSpec.mode == OverlapMode::Aabb;
+    std::atomic<bool> anyExact{false};
     parallel::forEach(0, mCount, 4096, [&](std::size_t i) {
-        const Vec3 c = itemCenter(scene, items[i]);
+        // An exact test is needed past the AABB for triangles, spheres and rotated boxes (a
+        // quarter-turned box, axis-aligned by its shape, is counted here too: it only costs the
+        // compact path).
+        const std::uint32_t item = items[i];
+        if (!aabbMode && (isTriangleItem(item) || scene.body(item).shape == Shape::Sphere ||
+                          !scene.body(item).axisAligned)) {
+            anyExact.store(true, std::memory_order_relaxed);
+        }
+        const Vec3 c = itemCenter(scene, item);
         std::uint64_t code = 0;
         for (int a = 0; a < 3; ++a) {
             const double t = (c[a] - box.min[a]) / (box.max[a] - box.min[a]);
@@ -374,19 +398,32 @@ void OctreeBuilder::sortByMorton(const Scene& scene, std::span<const std::uint32
     });
     parallel::sort(keys.begin(), keys.end());
     mSlotOf.resize(mCount);
-    mShapes.resize(mCount);
+    mAabbOnly = !anyExact.load();
+    (mAabbOnly ? mBoxes.resize(mCount) : mShapes.resize(mCount));
     parallel::forEach(0, mCount, 4096, [&](std::size_t local) {
         mSlotOf[local] = items[static_cast<std::uint32_t>(keys[local])];
-        mShapes[local] = OverlapShape::of(scene, mSlotOf[local]);
+        const OverlapShape s = OverlapShape::of(scene, mSlotOf[local]);
+        if (mAabbOnly) {
+            mBoxes[local] = {s.aabb, s.scale};
+        } else {
+            mShapes[local] = s;
+        }
     });
+}
+
+bool OctreeBuilder::overlapsCell(std::uint32_t local, const OverlapCell& cell) const {
+    return mAabbOnly ? overlapsAabb(mBoxes[local].aabb, mBoxes[local].scale, cell)
+                     : overlaps(mShapes[local], cell, mSpec.mode);
 }
 
 // The root's list: every object overlapping the bounds; the root node itself.
 void OctreeBuilder::listRoot() {
     const Aabb box = mTree.bounds();
     std::vector<std::uint8_t> keep(mCount);
-    parallel::forEach(0, mCount, 4096,
-                      [&](std::size_t i) { keep[i] = overlaps(mShapes[i], box, mSpec.mode); });
+    const OverlapCell cell = OverlapCell::of(box);
+    parallel::forEach(0, mCount, 4096, [&](std::size_t i) {
+        keep[i] = overlapsCell(static_cast<std::uint32_t>(i), cell);
+    });
     mEntries.reserve(mCount);
     for (std::uint32_t i = 0; i < mCount; ++i) {
         if (keep[i]) {
@@ -452,9 +489,19 @@ OctreeBuilder::SplitCells OctreeBuilder::splitCells(std::uint64_t node) const {
 // The octant masks of entries [lo, hi) of one node: the octants each AABB reaches (with the
 // parent's tolerance, which is no smaller than any child's), then the full test on those only.
 void OctreeBuilder::classifyObjects(const SplitCells& cells, std::size_t lo, std::size_t hi) {
+    if (mAabbOnly) {
+        classifyWith(mBoxes, cells, lo, hi);
+    } else {
+        classifyWith(mShapes, cells, lo, hi);
+    }
+}
+
+template <class Bounds>
+void OctreeBuilder::classifyWith(const std::vector<Bounds>& bounds, const SplitCells& cells,
+                                 std::size_t lo, std::size_t hi) {
     for (std::size_t i = lo; i < hi; ++i) {
-        const OverlapShape& s = mShapes[mEntries[i]];
-        const double tol = overlapTolerance(s, cells.whole);
+        const Bounds& s = bounds[mEntries[i]];
+        const double tol = overlapToleranceFor(s.scale, cells.whole.scale);
         std::uint32_t reach = 0xFF;
         for (int a = 0; a < 3; ++a) {
             const std::uint32_t upper = a == 0 ? 0xAA : a == 1 ? 0xCC : 0xF0;
@@ -467,7 +514,11 @@ void OctreeBuilder::classifyObjects(const SplitCells& cells, std::size_t lo, std
         std::uint8_t m = 0;
         for (std::uint32_t o = 0; o < 8; ++o) {
             if ((reach >> o) & 1) {
-                m |= std::uint8_t(overlaps(s, cells.child[o], mSpec.mode)) << o;
+                if constexpr (std::is_same_v<Bounds, BoxBounds>) {
+                    m |= std::uint8_t(overlapsAabb(s.aabb, s.scale, cells.child[o])) << o;
+                } else {
+                    m |= std::uint8_t(overlaps(s, cells.child[o], mSpec.mode)) << o;
+                }
             }
         }
         mMasks[i] = m;

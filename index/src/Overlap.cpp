@@ -71,15 +71,20 @@ bool overlaps(const OverlapShape& shape, const Aabb& cell, OverlapMode mode) noe
     return overlaps(shape, OverlapCell::of(cell), mode);
 }
 
-bool overlaps(const OverlapShape& shape, const OverlapCell& prepared, OverlapMode mode) noexcept {
-    const double tol = overlapToleranceFor(shape.scale, prepared.scale);
-    const Aabb& a = shape.aabb;
+bool overlapsAabb(const Aabb& a, double scale, const OverlapCell& prepared) noexcept {
+    const double tol = overlapToleranceFor(scale, prepared.scale);
     const Aabb& cell = prepared.box;
-    if (!(a.min.x <= cell.max.x + tol && a.max.x + tol >= cell.min.x &&
-          a.min.y <= cell.max.y + tol && a.max.y + tol >= cell.min.y &&
-          a.min.z <= cell.max.z + tol && a.max.z + tol >= cell.min.z)) {
+    return a.min.x <= cell.max.x + tol && a.max.x + tol >= cell.min.x &&
+           a.min.y <= cell.max.y + tol && a.max.y + tol >= cell.min.y &&
+           a.min.z <= cell.max.z + tol && a.max.z + tol >= cell.min.z;
+}
+
+bool overlaps(const OverlapShape& shape, const OverlapCell& prepared, OverlapMode mode) noexcept {
+    if (!overlapsAabb(shape.aabb, shape.scale, prepared)) {
         return false;
     }
+    const Aabb& a = shape.aabb;
+    const Aabb& cell = prepared.box;
     if (mode == OverlapMode::Aabb || shape.axisAligned) {
         return true;
     }
@@ -98,7 +103,8 @@ bool overlaps(const OverlapShape& shape, const OverlapCell& prepared, OverlapMod
     case OverlapShape::Kind::Sphere:
         return overlapsSphereAabb(shape.obb.center, shape.radius, cell);
     case OverlapShape::Kind::Triangle:
-        return overlapsTriangleAabb(shape.triangle, cell, tol);
+        return overlapsTriangleAabb(shape.triangle, cell,
+                                    overlapToleranceFor(shape.scale, prepared.scale));
     case OverlapShape::Kind::Box:
         break;
     }

@@ -80,6 +80,10 @@ struct OverlapCell {
 bool overlaps(const OverlapShape& shape, const Aabb& cell, OverlapMode mode) noexcept;
 /// The same, for a prepared cell. [any thread]
 bool overlaps(const OverlapShape& shape, const OverlapCell& cell, OverlapMode mode) noexcept;
+/// The first test of overlaps(): an AABB with its shape's scale (OverlapShape::scale) against
+/// a prepared cell, with their tolerance; the whole test of an axis-aligned box, or of any
+/// item in Aabb mode. [any thread]
+bool overlapsAabb(const Aabb& aabb, double scale, const OverlapCell& cell) noexcept;
 /// The tolerance (m) overlaps() allows between these bounds and a cell. [any thread]
 double overlapTolerance(const OverlapShape& shape, const OverlapCell& cell) noexcept;
 
