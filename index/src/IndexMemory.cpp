@@ -40,19 +40,18 @@
 //   so a build that fits pays nothing for them.
 // - distinct cells: items that do not overlap but sit closer than a level's cells (a lattice
 //   with 0.5 mm gaps) split every cell spanning a gap, few per pair, so the largest group says
-//   little. When the floor with it still fits the limit, every box's best group marks its
-//   cells (at most kMarkCells a level) on one bitmap per level below kMarkLevels, and the
-//   level's set bits, distinct split cells, add up: at 10^6 such cubes the floor is 3.7 x 10^7
-//   nodes where the largest group gave 265. With M > 1 a box with no group sharing volume
-//   notes a near group instead: the following boxes whose gaps to the group stay under a grid
-//   cell, taken greedily, once more than M (a cell spanning the gaps lists them all: a
-//   lattice's corners).
+//   little. When the floor with it still fits the limit, the search runs again and every
+//   box's best group marks its cells (at most kMarkCells a level) on one bitmap per level
+//   below kMarkLevels, and the level's set bits, distinct split cells, add up: at 10^6 such
+//   cubes the floor is 3.7 x 10^7 nodes where the largest group gave 265. With M > 1 a box
+//   with no group sharing volume marks a near group instead: the following boxes whose gaps
+//   to the group stay under a grid cell, taken greedily, once more than M (a cell spanning
+//   the gaps lists them all: a lattice's corners).
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
 // Cost: O(items * levels) time; memory per item (at most kPairItems of them) one inner box
-// and its sort key (32 bytes), then its best group's shared box (28 bytes): 54 MB at 10^6
-// items with the bitmaps (8^l bits at level l, 16 MB at level 9, one level at a time); none
-// per node.
+// and its sort key (32 bytes, 32 MB at 10^6 items), none per node; the second search's
+// bitmaps, 8^l bits at level l, 19 MB for levels 0 to 9.
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/SpatialIndex.h"
@@ -326,13 +325,6 @@ std::uint64_t splitsAtLeast(const LevelCounts& c, const Aabb& b, int l, std::uin
 /// Per level, the most cells one group's boxes all touch (the note's groups).
 using LevelCells = std::array<std::uint64_t, kLevels>;
 
-/// The box a group's boxes share, in units of the bounds: per axis the largest low and the
-/// smallest high (lo > hi across a gap); no group when lo is NaN (then it touches no cell).
-struct SharedBox {
-    std::array<float, 3> lo{std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f};
-    std::array<float, 3> hi{};
-};
-
 /// The level-l cells (strictly) touching every box of a group, per axis [first[a], last[a]]:
 /// lo and hi are the largest low and the smallest high of the group's boxes. False when none.
 bool groupRange(const std::array<float, 3>& lo, const std::array<float, 3>& hi, int l,
@@ -387,6 +379,70 @@ float groupGridCell(const Scene& scene, const IndexSpec& spec, const Aabb& b, st
     return std::max(1.25f * sample[sample.size() / 2], std::ldexp(1.0f, -20));
 }
 
+/// Levels whose groups' distinct cells are counted on a bitmap of 8^l bits (16 MB at 9).
+constexpr int kMarkLevels = 10;
+/// Cells of one group's shared box marked per level at most (any subset keeps a floor).
+constexpr std::uint64_t kMarkCells = 64;
+
+/// Sets the bits of up to kMarkCells level-l cells in [first, last] (per axis).
+void markCells(std::span<std::uint64_t> bits, int l, const std::array<std::uint64_t, 3>& first,
+               const std::array<std::uint64_t, 3>& last) {
+    std::uint64_t marked = 0;
+    for (std::uint64_t z = first[2]; z <= last[2]; ++z) {
+        for (std::uint64_t y = first[1]; y <= last[1]; ++y) {
+            for (std::uint64_t x = first[0]; x <= last[0]; ++x) {
+                if (++marked > kMarkCells) {
+                    return;
+                }
+                const std::uint64_t cell = (z << (2 * l)) | (y << l) | x;
+                const std::uint64_t bit = std::uint64_t(1) << (cell & 63);
+                std::atomic_ref<std::uint64_t> word(bits[cell >> 6]);
+                if ((word.load(std::memory_order_relaxed) & bit) == 0) {
+                    word.fetch_or(bit, std::memory_order_relaxed);
+                }
+            }
+        }
+    }
+}
+
+/// Per level below min(levels, kMarkLevels), a bitmap of the cells that every box of some
+/// marked group touches. Each is a split cell of the real tree and distinct cells are distinct
+/// nodes, so unlike the largest group's count these add up. Marked with relaxed atomic ORs:
+/// the same bits on any number of threads.
+class CellMarks {
+public:
+    explicit CellMarks(int levels) : mLevels(std::min(levels, kMarkLevels)) {
+        for (int l = 0; l < mLevels; ++l) {
+            mBits[l].resize(((std::uint64_t(1) << (3 * l)) + 63) / 64);
+        }
+    }
+
+    /// Marks the cells of every level that all boxes sharing [lo, hi] touch (groupRange).
+    void mark(const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
+        std::array<std::uint64_t, 3> first, last;
+        for (int l = 0; l < mLevels; ++l) {
+            if (groupRange(lo, hi, l, first, last)) {
+                markCells(mBits[l], l, first, last);
+            }
+        }
+    }
+
+    /// Per level, the cells marked.
+    LevelCells counts() const {
+        LevelCells cells{};
+        for (int l = 0; l < mLevels; ++l) {
+            for (const std::uint64_t w : mBits[l]) {
+                cells[l] += static_cast<std::uint64_t>(std::popcount(w));
+            }
+        }
+        return cells;
+    }
+
+private:
+    int mLevels;
+    std::array<std::vector<std::uint64_t>, kMarkLevels> mBits;
+};
+
 /// The rows a box is tested against besides its own, (dy, dz) from its own: with its own row,
 /// every pair of boxes in adjacent cells is seen from one of its two boxes.
 constexpr int kRows[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
@@ -395,13 +451,13 @@ constexpr int kRows[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
 /// (the rows' first keys grow with i's key).
 class GroupSearch {
 public:
-    GroupSearch(std::span<const CellKey> keys, float cell, std::uint32_t m,
-                std::span<SharedBox> found)
-        : mKeys(keys), mCell(cell), mM(m), mFound(found) {}
+    /// With `marks` the search also marks every group it finds (the second pass).
+    GroupSearch(std::span<const CellKey> keys, float cell, std::uint32_t m, CellMarks* marks)
+        : mKeys(keys), mCell(cell), mM(m), mMarks(marks) {}
 
-    /// Finds the best group of box i (the most shared volume), notes its shared box in
-    /// found[i] (left empty when it has none) and keeps it when it is among the kKeep best of
-    /// the search so far.
+    /// Finds the best group of box i (the most shared volume), keeps it when it is among the
+    /// kKeep best of the search so far, and marks it (with M > 1, when no group shares volume,
+    /// the near group).
     void run(std::size_t i) {
         const std::uint64_t k = mKeys[i].key;
         const std::uint64_t x = k & (kAxisCells - 1), y = (k >> 21) & (kAxisCells - 1);
@@ -431,11 +487,13 @@ public:
             }
             scan(j, packCell(std::min(x + 1, kAxisCells - 1), ry, rz));
         }
-        if (mBest < 0.0f && mNearMembers > mM) {
-            mFound[i] = {mNearLo, mNearHi}; // noted, not kept: no shared volume
+        if (mMarks != nullptr && mBest < 0.0f && mNearMembers > mM) {
+            mMarks->mark(mNearLo, mNearHi); // marked, not kept: no shared volume
         }
         if (mBest >= 0.0f) {
-            mFound[i] = {mBestLo, mBestHi};
+            if (mMarks != nullptr) {
+                mMarks->mark(mBestLo, mBestHi);
+            }
             Group* worst = &mKept[0];
             for (Group& g : mKept) {
                 worst = g.score < worst->score ? &g : worst;
@@ -488,7 +546,7 @@ private:
                     return;
                 }
             }
-            if (mM > 1 && mNearMembers <= mM) {
+            if (mMarks != nullptr && mM > 1 && mNearMembers <= mM) {
                 takeNear(other);
             }
         }
@@ -511,7 +569,7 @@ private:
     std::span<const CellKey> mKeys;
     float mCell;
     std::uint32_t mM;
-    std::span<SharedBox> mFound;
+    CellMarks* mMarks;
     // The groups kept: evaluating each box's group at every level would cost more than finding
     // it, and the largest shared volumes give the largest counts where the counts are large.
     static constexpr std::size_t kKeep = 16;
@@ -543,26 +601,30 @@ std::vector<CellKey> groupRecords(const Scene& scene, const IndexSpec& spec, con
     return records;
 }
 
-/// Per level, the most cells any kept group of more than M items' inner boxes touches (the
-/// note's groups); sorts the records and notes each box's best group in `found` (the shared
-/// box, empty when none; one per record).
-LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, int levels,
-                      std::vector<SharedBox>& found) {
-    LevelCells most{};
+/// Sorts the group pass's records; the records of boxes it leaves out (kNoCell) come last and
+/// are not in the span returned.
+std::span<const CellKey> sortRecords(std::vector<CellKey>& keys) {
     parallel::sort(keys.begin(), keys.end());
     std::size_t used = keys.size();
     while (used > 0 && keys[used - 1].key == kNoCell) {
         --used;
     }
-    const std::span<const CellKey> sorted(keys.data(), used);
-    found.assign(used, SharedBox{});
+    return {keys.data(), used};
+}
+
+/// Per level, the most cells any kept group of more than M items' inner boxes touches (the
+/// note's groups), over the sorted records; with `marks`, every box's group is marked too.
+LevelCells groupFloor(std::span<const CellKey> sorted, float cell, std::uint32_t m, int levels,
+                      CellMarks* marks) {
+    LevelCells most{};
     std::mutex merge;
     // Fixed blocks of boxes, each keeping its own groups: the same floor on any number of
     // threads.
     constexpr std::size_t kBlock = 4096;
+    const std::size_t used = sorted.size();
     parallel::forEach(0, (used + kBlock - 1) / kBlock, 1, [&](std::size_t block) {
         LevelCells part{};
-        GroupSearch search(sorted, cell, m, found);
+        GroupSearch search(sorted, cell, m, marks);
         for (std::size_t i = block * kBlock; i < std::min(used, (block + 1) * kBlock); ++i) {
             search.run(i);
         }
@@ -573,53 +635,6 @@ LevelCells groupFloor(std::vector<CellKey>& keys, float cell, std::uint32_t m, i
         }
     });
     return most;
-}
-
-/// Levels whose groups' distinct cells are counted on a bitmap of 8^l bits (16 MB at 9).
-constexpr int kMarkLevels = 10;
-/// Cells of one group's shared box marked per level at most (any subset keeps a floor).
-constexpr std::uint64_t kMarkCells = 64;
-
-/// Sets the bits of up to kMarkCells level-l cells in [first, last] (per axis).
-void markCells(std::span<std::uint64_t> bits, int l, const std::array<std::uint64_t, 3>& first,
-               const std::array<std::uint64_t, 3>& last) {
-    std::uint64_t marked = 0;
-    for (std::uint64_t z = first[2]; z <= last[2]; ++z) {
-        for (std::uint64_t y = first[1]; y <= last[1]; ++y) {
-            for (std::uint64_t x = first[0]; x <= last[0]; ++x) {
-                if (++marked > kMarkCells) {
-                    return;
-                }
-                const std::uint64_t cell = (z << (2 * l)) | (y << l) | x;
-                const std::uint64_t bit = std::uint64_t(1) << (cell & 63);
-                std::atomic_ref<std::uint64_t> word(bits[cell >> 6]);
-                if ((word.load(std::memory_order_relaxed) & bit) == 0) {
-                    word.fetch_or(bit, std::memory_order_relaxed);
-                }
-            }
-        }
-    }
-}
-
-/// Per level below min(levels, kMarkLevels), the distinct cells that every box of some group
-/// in `found` touches. Each is a split cell of the real tree and distinct cells are distinct
-/// nodes, so unlike the largest group's count these add up. Order-free: the same on any
-/// number of threads.
-LevelCells distinctGroupCells(std::span<const SharedBox> found, int levels) {
-    LevelCells cells{};
-    for (int l = 0; l < std::min(levels, kMarkLevels); ++l) {
-        std::vector<std::uint64_t> bits(((std::uint64_t(1) << (3 * l)) + 63) / 64);
-        parallel::forEach(0, found.size(), 4096, [&](std::size_t i) {
-            std::array<std::uint64_t, 3> first, last;
-            if (groupRange(found[i].lo, found[i].hi, l, first, last)) {
-                markCells(bits, l, first, last);
-            }
-        });
-        for (const std::uint64_t w : bits) {
-            cells[l] += static_cast<std::uint64_t>(std::popcount(w));
-        }
-    }
-    return cells;
 }
 
 /// The floor's nodes: the root and 8 per level-l split, l < levels, taking per level the
@@ -648,14 +663,15 @@ LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
     const std::uint64_t m = static_cast<std::uint64_t>(std::max(spec.maxObjects, 1));
     const float cell =
         groupGridCell(scene, spec, b, std::min<std::size_t>(scene.itemCount(), kPairItems));
-    std::vector<SharedBox> found;
-    LevelCells groups;
-    {
-        std::vector<CellKey> records = groupRecords(scene, spec, b, cell);
-        groups = groupFloor(records, cell, static_cast<std::uint32_t>(m), levels, found);
-    }
+    std::vector<CellKey> records = groupRecords(scene, spec, b, cell);
+    const std::span<const CellKey> sorted = sortRecords(records);
+    const auto mm = static_cast<std::uint32_t>(m);
+    LevelCells groups = groupFloor(sorted, cell, mm, levels, nullptr);
     if (floorBytes(c.items, nodesFloor(c, b, m, levels, groups)) <= spec.maxBytes) {
-        const LevelCells distinct = distinctGroupCells(found, levels);
+        // Not refused yet: search again, marking every box's group, and add the distinct cells.
+        CellMarks marks(levels);
+        (void)groupFloor(sorted, cell, mm, levels, &marks);
+        const LevelCells distinct = marks.counts();
         for (int l = 0; l < levels; ++l) {
             groups[l] = std::max(groups[l], distinct[l]);
         }
