@@ -248,35 +248,47 @@ struct LevelCounts {
     }
 };
 
-// Per axis, the item's reach and inner intervals in units of the bounds' size, so a level's
+/// What a pass of countLevels counts: the reach (the ceiling's) or the inner cells (the
+/// floor's, needed only when the ceiling passes the limit).
+enum class CountPass { Reach, Inner };
+
+// Per axis, the item's reach or inner interval in units of the bounds' size, so a level's
 // cell coordinates are these times 2^l: exact, as the cell steps are size * 2^-l exactly.
 void countItem(const Scene& scene, std::uint32_t item, const IndexSpec& spec, const Aabb& b,
-               int levels, LevelCounts& c) {
-    const OverlapShape s = OverlapShape::of(scene, item);
-    const Aabb in = innerBox(s, spec.mode);
-    const double tol = kReachTolerance * (absMax(s.aabb) + absMax(b));
-    std::array<double, 3> reachLo, reachHi, inLo, inHi;
-    for (int a = 0; a < 3; ++a) {
-        const double size = b.max[a] - b.min[a];
-        reachLo[a] = (s.aabb.min[a] - tol - b.min[a]) / size;
-        reachHi[a] = (s.aabb.max[a] + tol - b.min[a]) / size;
-        inLo[a] = (in.min[a] - b.min[a]) / size;
-        inHi[a] = (in.max[a] - b.min[a]) / size;
+               int levels, CountPass pass, LevelCounts& c) {
+    std::array<double, 3> lo, hi;
+    Aabb in{};
+    if (pass == CountPass::Reach) { // the AABB and scale only, not the whole shape
+        const OverlapBounds o = overlapBounds(scene, item);
+        const double tol = kReachTolerance * (absMax(o.aabb) + absMax(b));
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = (o.aabb.min[a] - tol - b.min[a]) / (b.max[a] - b.min[a]);
+            hi[a] = (o.aabb.max[a] + tol - b.min[a]) / (b.max[a] - b.min[a]);
+        }
+        ++c.items;
+    } else {
+        in = innerBox(OverlapShape::of(scene, item), spec.mode);
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = (in.min[a] - b.min[a]) / (b.max[a] - b.min[a]);
+            hi[a] = (in.max[a] - b.min[a]) / (b.max[a] - b.min[a]);
+        }
     }
-    ++c.items;
     bool hasInner = false;
     for (int l = 0; l < levels; ++l) {
         const std::uint64_t n = std::uint64_t(1) << l;
         const double cells = static_cast<double>(n); // 2^l: the products below are exact
-        std::uint64_t reach = 1, inside = 1;
+        std::uint64_t count = 1;
         for (int a = 0; a < 3; ++a) {
-            reach *= reachOnAxis(reachLo[a] * cells, reachHi[a] * cells, n);
-            inside *= insideOnAxis(inLo[a] * cells, inHi[a] * cells, n);
+            count *= pass == CountPass::Reach ? reachOnAxis(lo[a] * cells, hi[a] * cells, n)
+                                              : insideOnAxis(lo[a] * cells, hi[a] * cells, n);
         }
-        c.reach[l] = addSat(c.reach[l], reach);
-        c.inner[l] = addSat(c.inner[l], inside);
-        c.innerItems[l] += inside > 0;
-        hasInner = hasInner || inside > 0;
+        if (pass == CountPass::Reach) {
+            c.reach[l] = addSat(c.reach[l], count);
+        } else {
+            c.inner[l] = addSat(c.inner[l], count);
+            c.innerItems[l] += count > 0;
+            hasInner = hasInner || count > 0;
+        }
     }
     if (hasInner) {
         c.hull.min = glm::min(c.hull.min, in.min);
@@ -284,7 +296,8 @@ void countItem(const Scene& scene, std::uint32_t item, const IndexSpec& spec, co
     }
 }
 
-LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b, int levels) {
+LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b, int levels,
+                        CountPass pass) {
     LevelCounts total;
     std::mutex merge;
     parallel::forRanges(0, scene.itemCount(), 4096, [&](std::size_t first, std::size_t end) {
@@ -292,7 +305,7 @@ LevelCounts countLevels(const Scene& scene, const IndexSpec& spec, const Aabb& b
         for (std::size_t i = first; i < end; ++i) {
             const std::uint32_t item = scene.item(static_cast<std::uint32_t>(i));
             if (scene.isIndexed(item)) {
-                countItem(scene, item, spec, b, levels, part);
+                countItem(scene, item, spec, b, levels, pass, part);
             }
         }
         const std::lock_guard<std::mutex> lock(merge);
@@ -682,7 +695,7 @@ LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
 IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
     const Aabb b = partitionBounds(scene.bounds());
     const int splitLevels = Octree::splitLevels(b, spec.minLeafSize);
-    const LevelCounts c = countLevels(scene, spec, b, splitLevels + 1);
+    LevelCounts c = countLevels(scene, spec, b, splitLevels + 1, CountPass::Reach);
     const std::uint64_t m = static_cast<std::uint64_t>(std::max(spec.maxObjects, 1));
     // Upper bounds: nodes and entries per level, their totals, the largest level.
     std::uint64_t nodes = 1, totalNodes = 1, slots = 0, widest = 1, entries = 0;
@@ -699,11 +712,15 @@ IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
     IndexMemoryEstimate e;
     e.atMostBytes =
         detail::octreeBuildBytes({c.items, totalNodes, slots, widest, entries, entries});
-    // Lower bound: nodes the real tree has. The groups only matter when the ceiling passes
-    // the limit: under it the build fits whatever the floor says, and pays no group pass.
+    // Lower bound: nodes the real tree has. It only matters when the ceiling passes the limit:
+    // under it the build fits whatever the floor says, and pays neither the inner counts nor
+    // the group pass.
     const int splitting = std::min(reached, splitLevels);
-    const LevelCells groups =
-        e.atMostBytes > spec.maxBytes ? groupSplits(scene, spec, b, c, splitting) : LevelCells{};
+    LevelCells groups{};
+    if (e.atMostBytes > spec.maxBytes) {
+        c.add(countLevels(scene, spec, b, splitLevels + 1, CountPass::Inner));
+        groups = groupSplits(scene, spec, b, c, splitting);
+    }
     e.nodesAtLeast = nodesFloor(c, b, m, splitting, groups);
     e.atLeastBytes = floorBytes(c.items, e.nodesAtLeast);
     return e;

@@ -320,12 +320,8 @@ private:
     std::vector<std::uint32_t> mSlotOf; // per local id (Morton order): the item id
     // Per local id, one of: the item's AABB and scale when that is every item's whole test (Aabb
     // mode, or only axis-aligned boxes: 56 bytes an item), else its shape (192 bytes).
-    struct BoxBounds {
-        Aabb aabb;
-        double scale = 0.0;
-    };
     bool mAabbOnly = false;
-    std::vector<BoxBounds> mBoxes;
+    std::vector<OverlapBounds> mBoxes;
     std::vector<OverlapShape> mShapes;
     std::vector<std::uint32_t> mEntries; // the lists of the current level's nodes, back to back
     std::vector<std::uint64_t> mStart;   // per node of the level, + 1: where its list starts
@@ -402,11 +398,10 @@ void OctreeBuilder::sortByMorton(const Scene& scene, std::span<const std::uint32
     (mAabbOnly ? mBoxes.resize(mCount) : mShapes.resize(mCount));
     parallel::forEach(0, mCount, 4096, [&](std::size_t local) {
         mSlotOf[local] = items[static_cast<std::uint32_t>(keys[local])];
-        const OverlapShape s = OverlapShape::of(scene, mSlotOf[local]);
         if (mAabbOnly) {
-            mBoxes[local] = {s.aabb, s.scale};
+            mBoxes[local] = overlapBounds(scene, mSlotOf[local]);
         } else {
-            mShapes[local] = s;
+            mShapes[local] = OverlapShape::of(scene, mSlotOf[local]);
         }
     });
 }
@@ -514,7 +509,7 @@ void OctreeBuilder::classifyWith(const std::vector<Bounds>& bounds, const SplitC
         std::uint8_t m = 0;
         for (std::uint32_t o = 0; o < 8; ++o) {
             if ((reach >> o) & 1) {
-                if constexpr (std::is_same_v<Bounds, BoxBounds>) {
+                if constexpr (std::is_same_v<Bounds, OverlapBounds>) {
                     m |= std::uint8_t(overlapsAabb(s.aabb, s.scale, cells.child[o])) << o;
                 } else {
                     m |= std::uint8_t(overlaps(s, cells.child[o], mSpec.mode)) << o;

@@ -9,16 +9,36 @@ OverlapShape OverlapShape::of(const SceneObject& object) {
     return of(Scene::bodyOf(object));
 }
 
+namespace {
+
+/// A box's or sphere's tightest world AABB, given its oriented box.
+Aabb bodyAabb(const RenderBody& body, const Obb& obb) noexcept {
+    return body.shape == Shape::Sphere
+               ? Aabb{body.center - body.halfExtents, body.center + body.halfExtents}
+               : obb.aabb();
+}
+
+/// A box's or sphere's tolerance scale: largest |centre| coordinate plus largest half extent.
+double bodyScale(const RenderBody& body) noexcept {
+    return maxAbsComponent(body.center) +
+           std::max({body.halfExtents.x, body.halfExtents.y, body.halfExtents.z});
+}
+
+OverlapBounds triangleBounds(const TriangleCorners& corners) noexcept {
+    const Aabb aabb = triangleAabb(corners);
+    return {aabb, aabbScale(aabb)};
+}
+
+} // namespace
+
 OverlapShape OverlapShape::of(const RenderBody& body) noexcept {
     OverlapShape s;
     s.obb = body.obb();
     const bool sphere = body.shape == Shape::Sphere;
     s.kind = sphere ? OverlapShape::Kind::Sphere : OverlapShape::Kind::Box;
-    s.aabb = sphere ? Aabb{body.center - body.halfExtents, body.center + body.halfExtents}
-                    : s.obb.aabb();
+    s.aabb = bodyAabb(body, s.obb);
     s.radius = sphere ? body.halfExtents.x : 0.0;
-    s.scale = maxAbsComponent(body.center) +
-              std::max({body.halfExtents.x, body.halfExtents.y, body.halfExtents.z});
+    s.scale = bodyScale(body);
     s.axisAligned = !sphere;
     for (int i = 0; i < 3 && s.axisAligned && !body.axisAligned; ++i) {
         // each axis one of +-x, +-y, +-z, exactly (a quarter turn whose matrix came out exact)
@@ -32,8 +52,9 @@ OverlapShape OverlapShape::ofTriangle(const TriangleCorners& corners) noexcept {
     OverlapShape s;
     s.triangle = corners;
     s.kind = OverlapShape::Kind::Triangle;
-    s.aabb = triangleAabb(corners);
-    s.scale = aabbScale(s.aabb);
+    const OverlapBounds b = triangleBounds(corners);
+    s.aabb = b.aabb;
+    s.scale = b.scale;
     return s;
 }
 
@@ -47,8 +68,15 @@ Aabb itemAabb(const Scene& scene, std::uint32_t item) noexcept {
     }
     // SceneObject::aabb() from the render copy (the same oriented box, bit for bit).
     const RenderBody& b = scene.body(item);
-    return b.shape == Shape::Sphere ? Aabb{b.center - b.halfExtents, b.center + b.halfExtents}
-                                    : b.obb().aabb();
+    return bodyAabb(b, b.obb());
+}
+
+OverlapBounds overlapBounds(const Scene& scene, std::uint32_t item) noexcept {
+    if (isTriangleItem(item)) {
+        return triangleBounds(scene.triangleCorners(item));
+    }
+    const RenderBody& b = scene.body(item);
+    return {bodyAabb(b, b.obb()), bodyScale(b)};
 }
 
 Vec3 itemCenter(const Scene& scene, std::uint32_t item) noexcept {

@@ -55,6 +55,14 @@ static_assert(sizeof(OverlapShape) == 192, "per-item build memory; update estima
 /// An index item's tightest world AABB (m): a triangle item's corners' box, an object slot's
 /// SceneObject::aabb(). What a consumer of candidates tests first. [any thread]
 Aabb itemAabb(const Scene& scene, std::uint32_t item) noexcept;
+/// An item's tightest world AABB (m) and its tolerance scale: OverlapShape's `aabb` and
+/// `scale`, bit for bit, without preparing the rest of its shape.
+struct OverlapBounds {
+    Aabb aabb;          ///< The tightest world AABB (m).
+    double scale = 0.0; ///< The tolerance scale (m), as OverlapShape::scale.
+};
+/// An index item's OverlapBounds (the item must be indexed). [any thread]
+OverlapBounds overlapBounds(const Scene& scene, std::uint32_t item) noexcept;
 /// An index item's centre (m): a triangle's centroid, an object's centre. [any thread]
 Vec3 itemCenter(const Scene& scene, std::uint32_t item) noexcept;
 

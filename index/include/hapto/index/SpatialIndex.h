@@ -150,9 +150,11 @@ struct IndexMemoryEstimate {
 /// force exactly; the grid from its cells and, per item, the cells its AABB reaches (what the
 /// build allocates: the OBB and triangle tests only remove pairs later); the octree from two
 /// cell counts per item and level (index/src/IndexMemory.cpp's note): a floor from the cells
-/// surely listing more than M items, a ceiling from the cells items reach. Octree::build
-/// checks spec.maxBytes again before allocating each level. O(items * levels), no memory per
-/// item or node. [control]
+/// surely listing more than M items, a ceiling from the cells items reach; the floor is
+/// counted only when the ceiling passes spec.maxBytes (otherwise it is the items' share alone,
+/// still a floor). Octree::build checks spec.maxBytes again before allocating each level.
+/// O(items * levels); no memory per node, and per item (at most 2^20 of them) 32 bytes only
+/// while counting a floor. [control]
 IndexMemoryEstimate estimateIndexMemory(const Scene& scene, const IndexSpec& spec);
 
 /// estimateIndexMemory(scene, spec).atMostBytes: no build of this index holds more. [control]
