@@ -348,7 +348,7 @@ bool groupRange(const std::array<float, 3>& lo, const std::array<float, 3>& hi, 
         const double f = std::max(std::floor(static_cast<double>(lo[a]) * n), 0.0);
         const double e = std::min(std::ceil(static_cast<double>(hi[a]) * n) - 1.0, n - 1.0);
         if (!(e >= f)) {
-            return false; // also for a NaN low (no group)
+            return false; // also for NaN bounds
         }
         first[a] = static_cast<std::uint64_t>(f);
         last[a] = static_cast<std::uint64_t>(e);
