@@ -131,8 +131,7 @@ bool overlaps(const OverlapShape& shape, const OverlapCell& prepared, OverlapMod
     case OverlapShape::Kind::Sphere:
         return overlapsSphereAabb(shape.obb.center, shape.radius, cell);
     case OverlapShape::Kind::Triangle:
-        return overlapsTriangleAabb(shape.triangle, cell,
-                                    overlapToleranceFor(shape.scale, prepared.scale));
+        return overlapsTriangleAabb(shape.triangle, cell, overlapTolerance(shape, prepared));
     case OverlapShape::Kind::Box:
         break;
     }
