@@ -21,7 +21,9 @@
 ///
 /// Cost. One pass over the spans (an item an earlier span holds is skipped by a binary search
 /// of that sorted leaf list); two dot products reject most triangles by their plane; a corner
-/// well inside the ball spares the closest-point test. No allocation.
+/// well inside the ball spares the closest-point test. A tick solved again over more spans
+/// (extendNextUpdate) reads only the new ones: the spans are read in order, so the list so
+/// extended is the one a build over all of them gives. No allocation.
 
 #include "GodObjectParts.h"
 
@@ -168,17 +170,37 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
                                   const Vec3& center, double reach,
                                   std::uint32_t& tested) noexcept {
     mNearCenter = center;
+    mNearReach = reach;
     mNearRadius = reach + kTriangleNearMarginM;
     mNearCount = 0;
     mNearOverflow = false;
     mNearTriangles = false;
+    mNearSpans = 0;
+    mNearTriangleItems = 0;
+    addNearSpans(scene, candidates, tested);
+}
+
+bool GodObjectRenderer::extendsNearSpans(const CandidateSet& candidates) const noexcept {
+    if (mNearRadius < 0.0 || candidates.count < mNearSpans) {
+        return false;
+    }
+    if (mNearSpans == 0) {
+        return true;
+    }
+    const std::span<const std::uint32_t> last = candidates.spans[mNearSpans - 1];
+    return last.data() == mNearLastSpan.data() && last.size() == mNearLastSpan.size();
+}
+
+void GodObjectRenderer::addNearSpans(const Scene& scene, const CandidateSet& candidates,
+                                     std::uint32_t& tested) noexcept {
     // Triangles get a tight ball (the reach plus 1 µm) so that a fine mesh adds only the few
     // triangles the proxy can touch this tick; boxes and spheres keep a generous one (room for
-    // a friction lag up to mu_d = 1, plus 1 mm), as cheap as it is few.
-    const double radius = (1.0 + kFrictionCover) * reach + kNearMarginM;
+    // a friction lag up to mu_d = 1, plus 1 mm), as cheap as it is few. Spans are read in
+    // order, so a list extended by later spans is the list one build over them all gives.
+    const double radius = (1.0 + kFrictionCover) * mNearReach + kNearMarginM;
     const std::uint32_t n = scene.size();
-    std::uint32_t triangles = 0; // valid triangle candidates so far (an item once)
-    for (std::size_t s = 0; s < candidates.count && s < CandidateSet::kMaxSpans; ++s) {
+    const std::size_t count = std::min<std::size_t>(candidates.count, CandidateSet::kMaxSpans);
+    for (std::size_t s = mNearSpans; s < count; ++s) {
         tested += static_cast<std::uint32_t>(candidates.spans[s].size());
         for (const std::uint32_t item : candidates.spans[s]) {
             if (mNearOverflow) {
@@ -190,13 +212,15 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
             if (isTriangleItem(item)) {
                 if (validItem(scene, item)) {
                     mNearTriangles = true;
-                    considerTriangle(scene, item, triangles++);
+                    considerTriangle(scene, item, mNearTriangleItems++);
                 }
             } else if (item < n) {
                 considerObject(scene, item, radius);
             }
         }
     }
+    mNearSpans = static_cast<std::uint8_t>(count);
+    mNearLastSpan = count > 0 ? candidates.spans[count - 1] : std::span<const std::uint32_t>();
 }
 
 void GodObjectRenderer::considerTriangle(const Scene& scene, std::uint32_t item,

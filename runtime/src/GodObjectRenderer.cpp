@@ -62,10 +62,12 @@
 /// with a generous margin for objects and 1 µm for triangles (a fine mesh stays a few items).
 /// Each solver pass is one <= 3-plane solve (at most 8 tiny linear solves) plus one swept test
 /// per near item (slab clipping in the box frame, a quadratic for a sphere, a plane crossing and
-/// three edge tests for a triangle, after a plane test that rejects most; every pose, matrix,
+/// three edge tests for a triangle, after a plane test that rejects most; a box or sphere whose
+/// skin's bounding box the pass's segment misses ends at six comparisons; every pose, matrix,
 /// radius and triangle plane comes precomputed from the scene's render copy). Worst case per tick:
 /// 2 solves x maxIterations x near items; typically 2-3 passes over 1-5 objects or a handful of
-/// triangles. No allocation: the near list and plane sets are fixed arrays.
+/// triangles. A tick solved again over more spans (extendNextUpdate) reads only those spans
+/// into its near list. No allocation: the near list and plane sets are fixed arrays.
 
 #include "GodObjectParts.h"
 
@@ -132,11 +134,16 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
                                        const Vec3& deviceVelocity, double dtSeconds) noexcept {
     RenderOutput out;
     ++mState.counters.ticks;
-    mNearRadius = -1.0;
-    mNearCount = 0;
-    mTriangleCount = 0;
-    mNearOverflow = false;
-    mNearTriangles = false;
+    // The same tick solved again over more spans keeps its near list (extendNextUpdate).
+    const bool extend = mExtendNear && extendsNearSpans(candidates);
+    mExtendNear = false;
+    if (!extend) {
+        mNearRadius = -1.0;
+        mNearCount = 0;
+        mTriangleCount = 0;
+        mNearOverflow = false;
+        mNearTriangles = false;
+    }
     mVisitedCount = 0;
     mVisitedSecond = 0;
     if (!finite(devicePosition) || !finite(goal)) {
@@ -154,6 +161,9 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     visit(mState.proxy);
 
     std::uint32_t tested = 0;
+    if (extend) {
+        addNearSpans(scene, candidates, tested);
+    }
     ensureNear(scene, candidates, goal, glm::length(mState.proxy - goal), tested);
     const Vec3 start = startOfTick(scene, candidates, goal, tested);
     const Solve free = solve(scene, candidates, start, goal);

@@ -72,6 +72,11 @@ bool GodObjectRenderer::Solve::addPlane(const Plane& plane) noexcept {
 GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const CandidateSet& candidates,
                                                 const Vec3& from, const Vec3& to) const noexcept {
     Hit best;
+    // The segment's bounding box: a box or sphere whose skin's bounding box it misses cannot
+    // be entered (the entry test's surface lies kShrinkM inside that skin, far more than
+    // rounding), so most of a long near list ends at six comparisons.
+    const Vec3 mid = 0.5 * (from + to);
+    const Vec3 half = 0.5 * glm::abs(to - from);
     forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t near) {
         SweptEntry e;
         if (near != kNotCached) {
@@ -87,6 +92,11 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
                 kShrinkM, kOnM);
         } else {
             const RenderBody& o = bodyAt(scene, item);
+            const Vec3 reach = half + (o.axisAligned ? o.halfExtents : Vec3(o.radius)) + kSkinM;
+            const Vec3 apart = glm::abs(o.center - mid);
+            if ((apart.x > reach.x || apart.y > reach.y || apart.z > reach.z)) {
+                return;
+            }
             if (o.shape == Shape::Sphere) {
                 e = sweepSphere(o.center, o.halfExtents.x, from, to, kSkinM, kShrinkM);
             } else {

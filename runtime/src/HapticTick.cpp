@@ -76,6 +76,12 @@ template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::stamp(std::
     }
 }
 
+template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::extendNext() noexcept {
+    if constexpr (requires { mRenderer.extendNextUpdate(); }) {
+        mRenderer.extendNextUpdate();
+    }
+}
+
 template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::reset() noexcept {
     mFresh = true;
     mSafety.reset();
@@ -201,28 +207,37 @@ void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const
     // than one tick's motion, with the device in an empty leaf under the surface) can slide
     // off the triangles it knows, over a leaf nobody listed, and through the surface. So the
     // way the proxy went is walked leaf by leaf: every segment of the renderer's visited paths
-    // (its start, each solver pass's end); at the first leaf that was not a candidate the tick
-    // is solved again from the same start with that leaf's items too, up to kExtraLeaves
-    // times; then, if the way still leaves the listed leaves, the goal is pulled back.
+    // (its start, each solver pass's end); when a leaf was not a candidate, the tick is solved
+    // again from the same start with the items of every such leaf on the way too (the renderer
+    // keeps its near list and reads only theirs), up to kExtraLeaves leaves in all; then, if
+    // the way still leaves the listed leaves, the goal is pulled back.
     const typename Algorithm::State start = mRenderer.state(); // a plain copy: no allocation
     out.render = mRenderer.update(scene, mCandidates, p, v, dtS);
     out.solves = 1;
     std::uint32_t tested = out.render.objectsTested;
     for (;;) {
-        const SegmentWalk missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, listed.known());
-        if (missed.covered()) {
+        SegmentWalk missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, listed.known());
+        // Every leaf the paths cross that no span lists joins before solving again (as room
+        // allows): the way solved again crosses most of them, so a proxy trapped far behind
+        // a fast hand solves a few times, not once per leaf.
+        std::size_t added = 0;
+        while (!missed.covered() && !missed.unknown && listed.count < listed.leaves.size() &&
+               mCandidates.add(missed.at.candidates)) {
+            listed.leaves[listed.count++] = missed.at.leaf;
+            ++out.extraLeaves;
+            ++added;
+            missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, listed.known());
+        }
+        if (added == 0) {
+            if (!missed.covered()) {
+                pullBack(scene, p, v, dtS, from, start, listed.known(), tested, out);
+            }
             break;
         }
-        if (missed.unknown || listed.count == listed.leaves.size() ||
-            !mCandidates.add(missed.at.candidates)) {
-            pullBack(scene, p, v, dtS, from, start, listed.known(), tested, out);
-            break;
-        }
-        listed.leaves[listed.count++] = missed.at.leaf;
         mRenderer.restore(start);
+        extendNext();
         out.render = mRenderer.update(scene, mCandidates, p, v, dtS);
         tested += out.render.objectsTested;
-        ++out.extraLeaves;
         ++out.solves;
     }
     out.render.objectsTested = tested;
@@ -258,6 +273,7 @@ void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, con
         const double keep = k == 0 ? firstHalf : 0.5;
         goal = k + 2 < kPullBacks ? from + keep * (goal - from) : k + 1 < kPullBacks ? nudge : from;
         mRenderer.restore(start);
+        extendNext();
         out.render = mRenderer.update(scene, mCandidates, p, goal, v, dtS);
         tested += out.render.objectsTested;
         ++out.pullBacks;

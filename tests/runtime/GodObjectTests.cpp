@@ -3,6 +3,7 @@
 #include "hapto/runtime/GodObjectRenderer.h"
 #include "hapto/scenes/Generators.h"
 
+#include "MeshShapes.h"
 #include "RenderTestSupport.h"
 
 #include <catch2/catch.hpp>
@@ -10,8 +11,10 @@
 #include <glm/gtc/constants.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 using namespace hapto;
 using hapto::test::pressFrom;
@@ -471,4 +474,84 @@ TEST_CASE("random walks in random rotated scenes: proxy never inside, force neve
     CHECK(worstRaw > 8.5);      // ... hard enough for the clamp to matter
     INFO("multi-contact ticks: " << multiContactTicks);
     CHECK(safety.counters().clamped > 0);
+}
+
+TEST_CASE("a tick solved again over more candidate spans gives what a fresh solve gives, "
+          "reading only the new spans") {
+    // HapticTick solves a tick again when the proxy reached leaves no span listed, with their
+    // spans appended; the renderer then keeps its near list and reads only the new spans
+    // (extendNextUpdate). Each tick here is solved over the first k of four spans, then again
+    // over all four, by a renderer told to extend and by one building afresh: the two must
+    // agree bit for bit, and the extending one must read fewer candidates.
+    const bool mesh = GENERATE(false, true);
+    RandomOptions options;
+    options.count = 160;
+    options.seed = 7;
+    options.rotate = true;
+    options.cubeSize = 0.03;
+    options.keepClear = 0.03;
+    const Scene cubes = makeRandomScene(options);
+    std::vector<SceneObject> objects(cubes.objects().begin(), cubes.objects().end());
+    if (mesh) { // a fine torus (3 200 triangles) in the middle of the cubes, and a sphere
+        objects.push_back(makeMesh(1000, Vec3(0.0), test::torusMesh(0.06, 0.025, 80, 20)));
+        objects.push_back(makeSphere(1001, Vec3(0.0, 0.0, 0.09), 0.02));
+    }
+    const Scene scene(Aabb{Vec3(-1.0), Vec3(1.0)}, std::move(objects));
+    const std::vector<std::uint32_t> items = test::indexedItems(scene);
+    // Four sorted spans, as leaves are: items dealt round-robin.
+    std::array<std::vector<std::uint32_t>, 4> parts;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        parts[i % 4].push_back(items[i]);
+    }
+    GodObjectRenderer extending, fresh;
+    hapto::Random rng(mesh ? 11 : 5);
+    Vec3 p(0.0, 0.0, 0.12);
+    Vec3 v(0.0);
+    extending.reset(p);
+    fresh.reset(p);
+    std::uint64_t contactTicks = 0, readExtending = 0, readFresh = 0;
+    for (int tick = 0; tick < 10000; ++tick) {
+        v += Vec3(rng.normal(), rng.normal(), rng.normal()) * 0.05;
+        if (glm::length(v) > 1.0) {
+            v = glm::normalize(v); // at most 1 mm per tick
+        }
+        p = glm::clamp(p + v * 1e-3, Vec3(-0.12), Vec3(0.12));
+        const std::size_t k = static_cast<std::size_t>(rng.uniform() * 4.0);
+        CandidateSet first, all;
+        for (std::size_t s = 0; s < 4; ++s) {
+            if (s < k) {
+                first.add(parts[s]);
+            }
+            all.add(parts[s]);
+        }
+        const GodObjectRenderer::State start = fresh.state();
+        REQUIRE(start.proxy == extending.proxy());
+        (void)extending.update(scene, first, p, v, 1e-3);
+        extending.restore(start);
+        extending.extendNextUpdate();
+        const RenderOutput got = extending.update(scene, all, p, v, 1e-3);
+        const RenderOutput want = fresh.update(scene, all, p, v, 1e-3);
+        INFO("tick " << tick << ", first solve over " << k << " spans");
+        REQUIRE(got.status == want.status);
+        REQUIRE(got.proxy == want.proxy);
+        REQUIRE(got.force == want.force);
+        REQUIRE(got.contactCount == want.contactCount);
+        for (std::uint32_t c = 0; c < got.contactCount; ++c) {
+            REQUIRE(got.contacts[c].slot == want.contacts[c].slot);
+            REQUIRE(got.contacts[c].normal == want.contacts[c].normal);
+        }
+        // It reads the new spans, plus a full list only when the kept one does not cover
+        // this solve (the friction solve's tight triangle list, say).
+        std::size_t added = 0;
+        for (std::size_t s = k; s < 4; ++s) {
+            added += parts[s].size();
+        }
+        REQUIRE(got.objectsTested <= want.objectsTested + added);
+        readExtending += got.objectsTested;
+        readFresh += want.objectsTested;
+        contactTicks += got.contactCount > 0;
+    }
+    CHECK(contactTicks > 300); // the walk touched things (5-6 % of its ticks)
+    INFO("candidates read: " << readExtending << " extending, " << readFresh << " afresh");
+    CHECK(readExtending < 0.8 * readFresh);
 }

@@ -10,7 +10,7 @@ namespace hapto {
 
 /// Up to sixteen spans of candidate items (object slots and triangle items of `scene`): the
 /// device point's leaf, the proxy's leaf, the snapshot's moving objects, and up to thirteen
-/// leaves the proxy slid into during the tick (HapticTick solves again with each). The spans
+/// leaves the proxy slid into during the tick (HapticTick solves again with them). The spans
 /// are views; whoever fills the set keeps the storage alive for the tick. Slots may repeat
 /// across (and within) spans: the renderer treats duplicates as one object.
 struct CandidateSet {

@@ -112,6 +112,13 @@ public:
     /// is read from here, never from the scene, and its items the static index lists are
     /// skipped (DynamicBodySet.h). The set must stay unchanged while an update() runs. [servo]
     void useDynamicBodies(const DynamicBodySet* bodies) noexcept { mDynamic = bodies; }
+    /// Says that the next update() solves the same tick again (after restore(), with the same
+    /// scene, bodies and device point) over candidates that extend this update's: the same
+    /// spans in the same order, then maybe more. That update keeps the near list and reads only
+    /// the new spans' items, which gives the list a full build would, so a tick solved again
+    /// for one more leaf costs that leaf, not every candidate again (HapticTick's re-solves and
+    /// pull-backs). The next update() with other spans builds its list afresh. [servo]
+    void extendNextUpdate() noexcept { mExtendNear = true; }
 
     /// What carries over from one tick to the next (the proxy, the friction and contact state,
     /// the counters), without the per-tick scratch: a tick solved again restores it. [servo]
@@ -229,6 +236,12 @@ private:
                     double need, std::uint32_t& tested) noexcept;
     void buildNear(const Scene& scene, const CandidateSet& candidates, const Vec3& center,
                    double radius, std::uint32_t& tested) noexcept;
+    /// Adds the items of the spans after those the list has read (all of them after a fresh
+    /// buildNear) within the list's ball.
+    void addNearSpans(const Scene& scene, const CandidateSet& candidates,
+                      std::uint32_t& tested) noexcept;
+    /// True when `candidates` begins with the spans the near list has read (extendNextUpdate).
+    bool extendsNearSpans(const CandidateSet& candidates) const noexcept;
     /// Lists a candidate triangle (the tick's k-th) if it is within the near ball.
     void considerTriangle(const Scene& scene, std::uint32_t item, std::uint32_t k) noexcept;
     /// Lists a box or sphere, or a mesh's triangles, within the ball of `radius` (m).
@@ -282,8 +295,13 @@ private:
     /// The near ball's radius for triangles (m): the proxy's reach + 1 µm (objects get twice
     /// the reach + 1 mm); < 0: no list built this tick.
     double mNearRadius = -1.0;
+    double mNearReach = 0.0; ///< The proxy's reach the list was built for (m).
     bool mNearOverflow = false;
     bool mNearTriangles = false; ///< The list saw triangles: its triangle ball is the tight one.
+    bool mExtendNear = false;    ///< extendNextUpdate() was called since the last update().
+    std::uint8_t mNearSpans = 0; ///< Candidate spans the list has read.
+    std::span<const std::uint32_t> mNearLastSpan; ///< The last of them, to recognise the set.
+    std::uint32_t mNearTriangleItems = 0;         ///< Candidate triangles the list has read.
     std::uint32_t mNearCount = 0;
     std::array<std::uint32_t, kMaxNearObjects> mNear{};
     /// mNear[i]'s place in mTriangleData, or kNotCached (boxes, spheres, triangles past it).

@@ -36,15 +36,15 @@ struct TickOutput {
     std::uint32_t deviceLeaf = 0xFFFFFFFFu; ///< The device point's leaf (kNoLeaf outside).
     std::uint8_t extraLeaves = 0; ///< Leaves beyond the device's and the proxy's that the tick
                                   ///< listed: the slide's, before solving, and those the
-                                  ///< solved proxy reached, each solved again
+                                  ///< solved proxy reached, solved again with them
                                   ///< (HapticTick::kExtraLeaves at most).
     /// Times the goal was pulled back toward the proxy's start because the proxy's path still
     /// crossed a leaf no span listed after kExtraLeaves (HapticTick::kPullBacks at most; the
     /// contacts and force stay the device point's; only the last, which keeps the proxy where
     /// it was, has no contact and no force).
     std::uint8_t pullBacks = 0;
-    /// Times the renderer solved this tick: 1, plus one per leaf the solved proxy reached,
-    /// plus one per pull-back.
+    /// Times the renderer solved this tick: 1, plus one per time the solved proxy reached
+    /// leaves no span listed (all of them join before it solves again), plus one per pull-back.
     std::uint8_t solves = 0;
     bool newSnapshot = false; ///< The snapshot differs from the previous tick's (cursors re-bound).
     /// The part of the force to send that dynamic bodies exert on the hand (N, world): what
@@ -54,7 +54,7 @@ struct TickOutput {
 };
 
 namespace detail {
-/// Leaves the proxy may slide into in one tick, each solved again with its items
+/// Leaves the proxy may slide into in one tick, solved again with their items
 /// (CandidateSet has a span for each: device, proxy, moving, and these).
 inline constexpr std::size_t kTickExtraLeaves = CandidateSet::kMaxSpans - 3;
 /// Goals pulled back when the proxy's path crosses more unlisted leaves than kTickExtraLeaves
@@ -177,6 +177,9 @@ private:
     /// The leaves this tick's candidate spans list: the device's, the proxy's, the extra ones.
     using ListedLeaves = detail::ListedLeaves<2 + kExtraLeaves>;
 
+    /// Tells the renderer that its next update() solves this tick again over more candidate
+    /// spans, when it can use that (GodObjectRenderer::extendNextUpdate). [servo]
+    void extendNext() noexcept;
     /// Writes the clock as stage `i`'s end when stages are timed. [servo]
     void stamp(std::size_t i) noexcept;
     /// Binds the cursors to a new snapshot's index, and the proxy to `p` on a fresh start.
