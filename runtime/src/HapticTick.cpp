@@ -184,11 +184,14 @@ template <ForceAlgorithm Algorithm>
 void BasicHapticTick<Algorithm>::listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed,
                                            TickOutput& out) noexcept {
     // The likely slide (from the start along last tick's contact plane to the device point's
-    // projection on it) is known before solving, so its leaves are listed first: a slide over
-    // small leaves usually solves once.
+    // projection on it) is known before solving, so its first kSlideLeaves leaves are listed
+    // first: a slide over small leaves usually solves once. Not more: a proxy trapped far
+    // behind the hand has a slide centimetres long that it will not go far along, and its
+    // leaves would cost their walks and items and take the room the solved way needs.
     const Vec3 slide =
         mRenderer.inContact() ? p - glm::dot(p - from, mSlideNormal) * mSlideNormal : from;
-    while (listed.count < listed.leaves.size() && mRenderer.inContact()) {
+    while (listed.count < listed.leaves.size() && listed.count < 2 + kSlideLeaves &&
+           mRenderer.inContact()) {
         const SegmentWalk missed = mProxyCursor.firstLeafNotIn(from, slide, listed.known());
         if (missed.at.leaf == kNoLeaf || !mCandidates.add(missed.at.candidates)) {
             break;

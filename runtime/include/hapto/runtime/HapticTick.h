@@ -57,6 +57,10 @@ namespace detail {
 /// Leaves the proxy may slide into in one tick, solved again with their items
 /// (CandidateSet has a span for each: device, proxy, moving, and these).
 inline constexpr std::size_t kTickExtraLeaves = CandidateSet::kMaxSpans - 3;
+/// Of those, the most the tick lists before solving, along the likely slide (listSlide() in
+/// HapticTick.cpp): a slide over small leaves then solves once, and room is left for the
+/// leaves the solved way reaches.
+inline constexpr std::size_t kTickSlideLeaves = 4;
 /// Goals pulled back when the proxy's path crosses more unlisted leaves than kTickExtraLeaves
 /// (pullBack() in HapticTick.cpp): three halvings toward the proxy's start, kTickNudgeM from
 /// it, the start itself; contacts and force stay the device point's, as hard as a full tick's.
@@ -112,6 +116,7 @@ using TickStageStamps = std::array<std::uint64_t, 5>;
 template <ForceAlgorithm Algorithm> class alignas(64) BasicHapticTick {
 public:
     static constexpr std::size_t kExtraLeaves = detail::kTickExtraLeaves; ///< See there.
+    static constexpr std::size_t kSlideLeaves = detail::kTickSlideLeaves; ///< See there.
     static constexpr int kPullBacks = detail::kTickPullBacks;             ///< See there.
     static constexpr double kNudgeM = detail::kTickNudgeM;                ///< See there (m).
 
