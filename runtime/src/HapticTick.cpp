@@ -202,6 +202,44 @@ void BasicHapticTick<Algorithm>::listSlide(const Vec3& p, const Vec3& from, List
 }
 
 template <ForceAlgorithm Algorithm>
+std::size_t BasicHapticTick<Algorithm>::listPaths(ListedLeaves& listed, bool& covered,
+                                                  TickOutput& out) noexcept {
+    // One walk over each segment: after a leaf is added the walk goes on from where the
+    // segment enters it, so n leaves cost n steps along the way, not n walks from its start.
+    covered = true;
+    std::size_t added = 0;
+    for (int which = 0; which < 2; ++which) {
+        const std::span<const Vec3> path = mRenderer.visitedPath(which);
+        // The listed leaf box the last segment ended in: a segment inside it (a box is
+        // convex) needs no walk.
+        Aabb box{Vec3(1.0), Vec3(-1.0)};
+        for (std::size_t i = 1; i < path.size(); ++i) {
+            if (path[i] == path[i - 1] || (box.contains(path[i - 1]) && box.contains(path[i]))) {
+                continue;
+            }
+            Vec3 a = path[i - 1];
+            for (;;) {
+                const SegmentWalk missed = mProxyCursor.firstLeafNotIn(a, path[i], listed.known());
+                box = missed.endBox;
+                if (missed.covered()) {
+                    break;
+                }
+                if (missed.unknown || listed.count == listed.leaves.size() ||
+                    !mCandidates.add(missed.at.candidates)) {
+                    covered = false;
+                    return added;
+                }
+                listed.leaves[listed.count++] = missed.at.leaf;
+                ++out.extraLeaves;
+                ++added;
+                a += missed.t * (path[i] - a); // inside the leaf just listed
+            }
+        }
+    }
+    return added;
+}
+
+template <ForceAlgorithm Algorithm>
 void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const Vec3& v,
                                         double dtS, const Vec3& from, ListedLeaves& listed,
                                         TickOutput& out) noexcept {
@@ -219,20 +257,12 @@ void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const
     out.solves = 1;
     std::uint32_t tested = out.render.objectsTested;
     for (;;) {
-        SegmentWalk missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, listed.known());
         // Every leaf the paths cross that no span lists joins before solving again (as room
         // allows): the way solved again crosses most of them, so a proxy trapped far behind
         // a fast hand solves a few times, not once per leaf.
-        std::size_t added = 0;
-        while (!missed.covered() && !missed.unknown && listed.count < listed.leaves.size() &&
-               mCandidates.add(missed.at.candidates)) {
-            listed.leaves[listed.count++] = missed.at.leaf;
-            ++out.extraLeaves;
-            ++added;
-            missed = firstUnlistedOnPaths(mProxyCursor, mRenderer, listed.known());
-        }
-        if (added == 0) {
-            if (!missed.covered()) {
+        bool covered = true;
+        if (listPaths(listed, covered, out) == 0) {
+            if (!covered) {
                 pullBack(scene, p, v, dtS, from, start, listed.known(), tested, out);
             }
             break;

@@ -191,7 +191,10 @@ private:
     void bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& out) noexcept;
     /// Lists the leaves of the likely slide (`from` along the last contact plane) first.
     void listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept;
-    /// Solves again with each unlisted leaf the proxy's way crosses; then pulls back.
+    /// Lists every leaf the renderer's last paths cross that no span lists, as room allows;
+    /// returns how many, and whether the paths are now all in listed leaves (`covered`).
+    std::size_t listPaths(ListedLeaves& listed, bool& covered, TickOutput& out) noexcept;
+    /// Solves again with the unlisted leaves the proxy's way crosses; then pulls back.
     void render(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
                 ListedLeaves& listed, TickOutput& out) noexcept;
     /// Solves toward goals pulled back from `p` toward `from` (TickOutput::pullBacks).
