@@ -94,7 +94,7 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
             const RenderBody& o = bodyAt(scene, item);
             const Vec3 reach = half + (o.axisAligned ? o.halfExtents : Vec3(o.radius)) + kSkinM;
             const Vec3 apart = glm::abs(o.center - mid);
-            if ((apart.x > reach.x || apart.y > reach.y || apart.z > reach.z)) {
+            if (apart.x > reach.x || apart.y > reach.y || apart.z > reach.z) {
                 return;
             }
             if (o.shape == Shape::Sphere) {

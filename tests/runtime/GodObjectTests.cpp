@@ -482,7 +482,8 @@ TEST_CASE("a tick solved again over more candidate spans gives what a fresh solv
     // spans appended; the renderer then keeps its near list and reads only the new spans
     // (extendNextUpdate). Each tick here is solved over the first k of four spans, then again
     // over all four, by a renderer told to extend and by one building afresh: the two must
-    // agree bit for bit, and the extending one must read fewer candidates.
+    // agree bit for bit, and the extending one must read fewer candidates over the walk (and
+    // in a tick at most the new spans more, when its kept list does not cover the solve).
     const bool mesh = GENERATE(false, true);
     RandomOptions options;
     options.count = 160;
