@@ -39,11 +39,14 @@ namespace hapto {
 
 namespace {
 
-/// The first leaf not in `listed` along any segment of the renderer's visited paths (where the
-/// proxy went in its last update), if any; `walker` is the proxy's cursor. [servo]
-template <ForceAlgorithm Algorithm>
-SegmentWalk firstUnlistedOnPaths(const Cursor& walker, const Algorithm& renderer,
-                                 std::span<const std::uint32_t> listed) noexcept {
+/// Walks every segment of the renderer's visited paths (where the proxy went in its last
+/// update) leaf by leaf, from the proxy's cursor `walker`. At each leaf not in `listed()` it
+/// calls `onMissed(missed)`, which lists that leaf and returns true to walk on from where the
+/// segment enters it, or returns false to stop there. Returns true when every leaf on the way
+/// was listed, false when it stopped. [servo]
+template <ForceAlgorithm Algorithm, class Listed, class OnMissed>
+bool walkPaths(const Cursor& walker, const Algorithm& renderer, Listed&& listed,
+               OnMissed&& onMissed) noexcept {
     for (int which = 0; which < 2; ++which) {
         const std::span<const Vec3> path = renderer.visitedPath(which);
         // The listed leaf box the last segment ended in: a segment inside it (a box is
@@ -53,14 +56,21 @@ SegmentWalk firstUnlistedOnPaths(const Cursor& walker, const Algorithm& renderer
             if (path[i] == path[i - 1] || (box.contains(path[i - 1]) && box.contains(path[i]))) {
                 continue;
             }
-            const SegmentWalk missed = walker.firstLeafNotIn(path[i - 1], path[i], listed);
-            box = missed.endBox;
-            if (!missed.covered()) {
-                return missed;
+            Vec3 a = path[i - 1];
+            for (;;) {
+                const SegmentWalk missed = walker.firstLeafNotIn(a, path[i], listed());
+                box = missed.endBox;
+                if (missed.covered()) {
+                    break;
+                }
+                if (!onMissed(missed)) {
+                    return false;
+                }
+                a += missed.t * (path[i] - a); // inside the leaf just listed
             }
         }
     }
-    return {};
+    return true;
 }
 
 } // namespace
@@ -206,36 +216,19 @@ std::size_t BasicHapticTick<Algorithm>::listPaths(ListedLeaves& listed, bool& co
                                                   TickOutput& out) noexcept {
     // One walk over each segment: after a leaf is added the walk goes on from where the
     // segment enters it, so n leaves cost n steps along the way, not n walks from its start.
-    covered = true;
     std::size_t added = 0;
-    for (int which = 0; which < 2; ++which) {
-        const std::span<const Vec3> path = mRenderer.visitedPath(which);
-        // The listed leaf box the last segment ended in: a segment inside it (a box is
-        // convex) needs no walk.
-        Aabb box{Vec3(1.0), Vec3(-1.0)};
-        for (std::size_t i = 1; i < path.size(); ++i) {
-            if (path[i] == path[i - 1] || (box.contains(path[i - 1]) && box.contains(path[i]))) {
-                continue;
+    covered = walkPaths(
+        mProxyCursor, mRenderer, [&] { return listed.known(); },
+        [&](const SegmentWalk& missed) {
+            if (missed.unknown || listed.count == listed.leaves.size() ||
+                !mCandidates.add(missed.at.candidates)) {
+                return false;
             }
-            Vec3 a = path[i - 1];
-            for (;;) {
-                const SegmentWalk missed = mProxyCursor.firstLeafNotIn(a, path[i], listed.known());
-                box = missed.endBox;
-                if (missed.covered()) {
-                    break;
-                }
-                if (missed.unknown || listed.count == listed.leaves.size() ||
-                    !mCandidates.add(missed.at.candidates)) {
-                    covered = false;
-                    return added;
-                }
-                listed.leaves[listed.count++] = missed.at.leaf;
-                ++out.extraLeaves;
-                ++added;
-                a += missed.t * (path[i] - a); // inside the leaf just listed
-            }
-        }
-    }
+            listed.leaves[listed.count++] = missed.at.leaf;
+            ++out.extraLeaves;
+            ++added;
+            return true;
+        });
     return added;
 }
 
@@ -311,7 +304,9 @@ void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, con
         tested += out.render.objectsTested;
         ++out.pullBacks;
         ++out.solves;
-        covered = firstUnlistedOnPaths(mProxyCursor, mRenderer, known).covered();
+        covered = walkPaths(
+            mProxyCursor, mRenderer, [&] { return known; },
+            [](const SegmentWalk&) { return false; });
     }
 }
 
