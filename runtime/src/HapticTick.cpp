@@ -73,6 +73,14 @@ bool walkPaths(const Cursor& walker, const Algorithm& renderer, Listed&& listed,
     return true;
 }
 
+/// Tells the renderer that its next update() solves this tick again over more candidate
+/// spans, when it can use that (GodObjectRenderer::extendNextUpdate). [servo]
+template <ForceAlgorithm Algorithm> void solveAgainNext(Algorithm& renderer) noexcept {
+    if constexpr (requires { renderer.extendNextUpdate(); }) {
+        renderer.extendNextUpdate();
+    }
+}
+
 } // namespace
 
 template <ForceAlgorithm Algorithm>
@@ -83,12 +91,6 @@ BasicHapticTick<Algorithm>::BasicHapticTick(const RendererConfig& renderer,
 template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::stamp(std::size_t i) noexcept {
     if (mStamps != nullptr) {
         (*mStamps)[i] = rt::nowNs();
-    }
-}
-
-template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::extendNext() noexcept {
-    if constexpr (requires { mRenderer.extendNextUpdate(); }) {
-        mRenderer.extendNextUpdate();
     }
 }
 
@@ -261,7 +263,7 @@ void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const
             break;
         }
         mRenderer.restore(start);
-        extendNext();
+        solveAgainNext(mRenderer);
         out.render = mRenderer.update(scene, mCandidates, p, v, dtS);
         tested += out.render.objectsTested;
         ++out.solves;
@@ -299,7 +301,7 @@ void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, con
         const double keep = k == 0 ? firstHalf : 0.5;
         goal = k + 2 < kPullBacks ? from + keep * (goal - from) : k + 1 < kPullBacks ? nudge : from;
         mRenderer.restore(start);
-        extendNext();
+        solveAgainNext(mRenderer);
         out.render = mRenderer.update(scene, mCandidates, p, goal, v, dtS);
         tested += out.render.objectsTested;
         ++out.pullBacks;

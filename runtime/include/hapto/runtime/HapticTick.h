@@ -182,17 +182,13 @@ private:
     /// The leaves this tick's candidate spans list: the device's, the proxy's, the extra ones.
     using ListedLeaves = detail::ListedLeaves<2 + kExtraLeaves>;
 
-    /// Tells the renderer that its next update() solves this tick again over more candidate
-    /// spans, when it can use that (GodObjectRenderer::extendNextUpdate). [servo]
-    void extendNext() noexcept;
     /// Writes the clock as stage `i`'s end when stages are timed. [servo]
     void stamp(std::size_t i) noexcept;
     /// Binds the cursors to a new snapshot's index, and the proxy to `p` on a fresh start.
     void bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& out) noexcept;
     /// Lists the leaves of the likely slide (`from` along the last contact plane) first.
     void listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept;
-    /// Lists every leaf the renderer's last paths cross that no span lists, as room allows;
-    /// returns how many, and whether the paths are now all in listed leaves (`covered`).
+    /// Lists the unlisted leaves the last paths cross (room allowing): how many; `covered`.
     std::size_t listPaths(ListedLeaves& listed, bool& covered, TickOutput& out) noexcept;
     /// Solves again with the unlisted leaves the proxy's way crosses; then pulls back.
     void render(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
@@ -201,7 +197,6 @@ private:
     void pullBack(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
                   const typename Algorithm::State& start, std::span<const std::uint32_t> known,
                   std::uint32_t& tested, TickOutput& out) noexcept;
-
     /// Places the dynamic bodies near `p` and the proxy for the renderer and the candidates.
     void placeDynamic(const WorldSnapshot& snapshot, const Vec3& p, double dtS) noexcept;
 
