@@ -215,6 +215,10 @@ TEST_CASE("one name, one meaning: a renamed option or command is refused naming 
     const auto run =
         test::runHapto("run --view --view-port 0 --duration 0.2 --no-realtime --quiet");
     INFO(run.output);
-    CHECK(run.exitCode == 0);
+    // Accepted and run: not refused (2). Its verdict (0, or 1 when a loaded machine stalls a
+    // servo thread past the watchdog, as under a sanitizer beside a build) is the wall
+    // clock's, not the spelling's.
+    CHECK(run.exitCode != 2);
+    CHECK_THAT(run.output, Catch::Contains("hapto run: 2 devices"));
     CHECK_THAT(run.output, Catch::Contains("http://127.0.0.1:"));
 }
