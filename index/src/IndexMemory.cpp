@@ -53,6 +53,13 @@
 //   the groups' cells), one byte a cell up to M + 1, and its cells over M are the level's
 //   splits: exactly what the boxes force there. At 10^6 cubes with 0.5 mm gaps and M = 2 the
 //   floor rises from 1.2 x 10^7 to 2.5 x 10^7 nodes, past the default limit.
+// - level checks: a tree of few nodes can still be refused for its wide levels, where the
+//   build holds per-node arrays and long lists while it starts the next. The build's check
+//   as it starts level l counts octreeBuildBytes of its nodes so far and the level's children,
+//   the level's nodes and its lists' entries; with a split floor s(l) > 0 (so the build gets
+//   there) these are at least the floor's nodes through l plus 8 s(l), max(8 s(l - 1), s(l))
+//   and (M + 1) s(l) (each split node lists more than M items). The floor in bytes is the
+//   larger of that, over the levels, and what the finished tree holds.
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
 // Cost: O(items * levels) time; memory per item (at most kPairItems of them) one inner box
@@ -471,37 +478,32 @@ constexpr std::uint64_t kCountCells = 64;
 
 /// Per level below min(levels, kCountLevels), the cells that more than m boxes touch
 /// (strictly, as groupRange): each lists those items, so it splits, and so did its ancestors.
-/// One byte per cell, counted up to m + 1 with relaxed atomic adds (a cell seen at m by two
-/// threads at once may end a little above m + 1; none near 255, so the cells over m are the
-/// same on any number of threads); one level's counters alive at a time.
+/// One byte per cell, counted up to m + 1; one level's counters alive at a time. One thread:
+/// the boxes come sorted by cell, so the counters are written nearly in order, and plain
+/// stores cost less than the atomic adds two threads would need.
 LevelCells countedSplits(std::span<const CellKey> sorted, std::uint32_t m, int levels) {
     LevelCells splits{};
-    if (m > 200) {
+    if (m > 254) {
         return splits; // a byte holds no such count (and so many items a cell rarely split)
     }
     std::vector<std::uint8_t> counts;
     for (int l = 0; l < std::min(levels, kCountLevels); ++l) {
         counts.assign(std::size_t(1) << (3 * l), 0);
-        parallel::forRanges(0, sorted.size(), 4096, [&](std::size_t first, std::size_t end) {
-            std::array<std::uint64_t, 3> lo, hi;
-            for (std::size_t i = first; i < end; ++i) {
-                const UnitBox& u = sorted[i].box;
-                if (!groupRange(u.lo, u.hi, l, lo, hi) ||
-                    (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) > kCountCells) {
-                    continue;
-                }
-                for (std::uint64_t z = lo[2]; z <= hi[2]; ++z) {
-                    for (std::uint64_t y = lo[1]; y <= hi[1]; ++y) {
-                        for (std::uint64_t x = lo[0]; x <= hi[0]; ++x) {
-                            std::atomic_ref<std::uint8_t> c(counts[(z << (2 * l)) | (y << l) | x]);
-                            if (c.load(std::memory_order_relaxed) <= m) {
-                                c.fetch_add(1, std::memory_order_relaxed);
-                            }
-                        }
+        std::array<std::uint64_t, 3> lo, hi;
+        for (const CellKey& k : sorted) {
+            if (!groupRange(k.box.lo, k.box.hi, l, lo, hi) ||
+                (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) > kCountCells) {
+                continue;
+            }
+            for (std::uint64_t z = lo[2]; z <= hi[2]; ++z) {
+                for (std::uint64_t y = lo[1]; y <= hi[1]; ++y) {
+                    for (std::uint64_t x = lo[0]; x <= hi[0]; ++x) {
+                        std::uint8_t& c = counts[(z << (2 * l)) | (y << l) | x];
+                        c = static_cast<std::uint8_t>(c + (c <= m ? 1 : 0));
                     }
                 }
             }
-        });
+        }
         splits[l] = static_cast<std::uint64_t>(
             std::count_if(counts.begin(), counts.end(), [m](std::uint8_t c) { return c > m; }));
     }
@@ -721,6 +723,34 @@ std::uint64_t floorBytes(std::uint64_t items, std::uint64_t nodes) {
         addSat(mulSat(nodes, sizeof(OctreeNode)), mulSat(nodes / 8, sizeof(std::uint32_t))));
 }
 
+/// At least what the build's own check counts as it starts allocating a level (the note's
+/// level checks): at level l with a split floor s(l) > 0 (the level is reached) the tree then
+/// holds at least the floor's nodes through l plus 8 s(l) children, the level has at least
+/// max(8 s(l - 1), s(l)) nodes, and its lists at least (M + 1) s(l) entries.
+std::uint64_t levelChecksFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int levels,
+                               const LevelCells& groups) {
+    std::uint64_t through = 1, width = 1, most = 0;
+    for (int l = 0; l < levels; ++l) {
+        const std::uint64_t splits = std::max(splitsAtLeast(c, b, l, m), groups[l]);
+        const std::uint64_t children = mulSat(8, splits);
+        if (splits > 0) {
+            most = std::max(most, detail::octreeBuildBytes({c.items, addSat(through, children), 0,
+                                                            std::max(width, splits),
+                                                            mulSat(m + 1, splits), 0}));
+        }
+        through = addSat(through, children);
+        width = children;
+    }
+    return most;
+}
+
+/// The floor in bytes: what the finished tree holds, or the most a level's check counts.
+std::uint64_t bytesFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int levels,
+                         const LevelCells& groups) {
+    return std::max(floorBytes(c.items, nodesFloor(c, b, m, levels, groups)),
+                    levelChecksFloor(c, b, m, levels, groups));
+}
+
 /// The groups' split cells per level below `levels` (the note's groups): the largest kept
 /// group's, and when the floor with them still fits the limit, the groups' distinct cells.
 LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
@@ -732,7 +762,7 @@ LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
     const std::span<const CellKey> sorted = sortRecords(records);
     const auto mm = static_cast<std::uint32_t>(m);
     LevelCells groups = groupFloor(sorted, cell, mm, levels, nullptr);
-    if (floorBytes(c.items, nodesFloor(c, b, m, levels, groups)) <= spec.maxBytes) {
+    if (bytesFloor(c, b, m, levels, groups) <= spec.maxBytes) {
         // Not refused yet: search again, marking every box's group, and add the distinct cells.
         CellMarks marks(levels);
         (void)groupFloor(sorted, cell, mm, levels, &marks);
@@ -741,7 +771,7 @@ LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
             groups[l] = std::max(groups[l], distinct[l]);
         }
     }
-    if (floorBytes(c.items, nodesFloor(c, b, m, levels, groups)) <= spec.maxBytes) {
+    if (bytesFloor(c, b, m, levels, groups) <= spec.maxBytes) {
         // Still not refused: count every shallow cell's boxes (the note's cell counts).
         const LevelCells counted = countedSplits(sorted, mm, levels);
         for (int l = 0; l < levels; ++l) {
@@ -781,7 +811,7 @@ IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
         groups = groupSplits(scene, spec, b, c, splitting);
     }
     e.nodesAtLeast = nodesFloor(c, b, m, splitting, groups);
-    e.atLeastBytes = floorBytes(c.items, e.nodesAtLeast);
+    e.atLeastBytes = bytesFloor(c, b, m, splitting, groups);
     return e;
 }
 

@@ -446,6 +446,21 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
         CHECK(floor <= real);
         CHECK(floor >= real / 3);
     }
+    // At M = 4 and 6 only cells spanning gaps in all three axes split: few nodes, but the
+    // levels the build starts are wide and their lists long. The build's own check as it starts
+    // a level, bounded from the split floor, takes the floor in bytes past half the real peak
+    // (the finished tree's nodes and items alone are about a third of it).
+    for (const int m : {4, 6}) {
+        INFO("M = " << m);
+        IndexSpec wide = IndexSpec::octree(m, 1e-9);
+        wide.maxBytes = 4ull << 30;
+        const std::uint64_t peak = buildIndex(near, wide)->stats().buildPeakBytes;
+        wide.maxBytes = 1;
+        wide.maxBytes = estimateIndexMemory(near, wide).atMostBytes - 1;
+        const std::uint64_t floor = estimateIndexMemory(near, wide).atLeastBytes;
+        CHECK(floor <= peak);
+        CHECK(floor >= peak / 2);
+    }
 
     // Against real builds: scenes that overlap densely, here and there, touch or nearly touch,
     // at specs down to the smallest MIN that still fits.
