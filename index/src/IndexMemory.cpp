@@ -48,24 +48,30 @@
 //   to the group stay under a grid cell, taken greedily, once more than M (a cell spanning
 //   the gaps lists them all: a lattice's corners).
 // - cell counts: each box marks one group, so at M > 1 a lattice's cells spanning its gaps
-//   along the edges (three or four cubes each) are mostly missed. When the floor still fits,
+//   along the edges (three or four cubes each) are mostly missed, and boxes larger than a
+//   grid cell (five large overlapping boxes) are in no group. When the floor still fits,
 //   every cell of the levels below kCountLevels counts the boxes that touch it (strictly, as
-//   the groups' cells), one byte a cell up to M + 1, and its cells over M are the level's
-//   splits: exactly what the boxes force there. At 10^6 cubes with 0.5 mm gaps and M = 2 the
-//   floor rises from 1.2 x 10^7 to 2.5 x 10^7 nodes, past the default limit.
+//   the groups' cells): each box adds +1 and -1 at the eight corners of its cell range in a
+//   difference array, and prefix sums along the three axes give every cell's count, O(1) a
+//   box whatever its size. Cells counted over M are the level's splits, exactly what the
+//   boxes force there; a cell whose parent is counted over M is a node, and its count is a
+//   floor of its list. At 10^6 cubes with 0.5 mm gaps and M = 8 the floor is the real tree's
+//   1 884 745 nodes; at M = 2 it rises from 1.2 x 10^7 to 2.5 x 10^7.
 // - level checks: a tree of few nodes can still be refused for its wide levels, where the
-//   build holds per-node arrays and long lists while it starts the next. The build's check
-//   as it starts level l counts octreeBuildBytes of its nodes so far and the level's children,
-//   the level's nodes and its lists' entries; with a split floor s(l) > 0 (so the build gets
-//   there) these are at least the floor's nodes through l plus 8 s(l), max(8 s(l - 1), s(l))
-//   and (M + 1) s(l) (each split node lists more than M items). The floor in bytes is the
-//   larger of that, over the levels, and what the finished tree holds.
+//   build holds per-node arrays and long lists while it makes the next. The build's check
+//   after it places level l counts octreeBuildBytes of its nodes through level l + 1, the
+//   level's nodes, its lists' entries and the next level's; with a split floor s(l) > 0 (so
+//   the build gets there) these are at least the floor's nodes through l plus 8 s(l),
+//   max(8 s(l - 1), s(l)), the larger of (M + 1) s(l) and the counted lists of level l, and
+//   the counted lists of level l + 1. The floor in bytes is the larger of that, over the
+//   levels, and what the finished tree holds.
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
 // Cost: O(items * levels) time; memory per item (at most kPairItems of them) one inner box
 // and its sort key (32 bytes, 32 MB at 10^6 items), none per node; the second search's
-// bitmaps, 8^l bits at level l, 19 MB for levels 0 to 9; then the cell counts, 8^l bytes
-// for one level at a time, 16 MB at level 8, O(boxes x 64) per level.
+// bitmaps, 8^l bits at level l, 19 MB for levels 0 to 9; then the cell counts, (2^l + 1)^3
+// bytes a level, 19.6 MB for levels 0 to 8, and 8^l bits for two levels at a time, O(boxes +
+// cells) per level.
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/SpatialIndex.h"
@@ -470,42 +476,108 @@ private:
     std::array<std::vector<std::uint64_t>, kMarkLevels> mBits;
 };
 
-/// Levels whose cells are counted one byte each (the note's cell counts): 16 MB at level 8.
+/// Levels whose cells are counted (the note's cell counts): 17 MB of counters at level 8.
 constexpr int kCountLevels = 9;
-/// Level-l cells one box adds itself to at most; a box reaching more is left out there (fewer
-/// boxes, lower counts, still a floor).
-constexpr std::uint64_t kCountCells = 64;
+
+/// row[x] += from[x] (mod 256) for x < n.
+void addRow(std::uint8_t* row, const std::uint8_t* from, std::size_t n) {
+    for (std::size_t x = 0; x < n; ++x) {
+        row[x] = static_cast<std::uint8_t>(row[x] + from[x]);
+    }
+}
+
+/// Turns a difference array of n^3 byte counters into its prefix sums along x, then y, then
+/// z (mod 256): each pass reads rows in memory order.
+void prefixSums(std::uint8_t* d, std::size_t n) {
+    for (std::size_t r = 0; r < n * n; ++r) {
+        std::uint8_t* row = d + r * n;
+        for (std::size_t x = 1; x < n; ++x) {
+            row[x] = static_cast<std::uint8_t>(row[x] + row[x - 1]);
+        }
+    }
+    for (std::size_t z = 0; z < n; ++z) {
+        for (std::size_t y = 1; y < n; ++y) {
+            addRow(d + (z * n + y) * n, d + (z * n + y - 1) * n, n);
+        }
+    }
+    for (std::size_t z = 1; z < n; ++z) {
+        for (std::size_t y = 0; y < n; ++y) {
+            addRow(d + (z * n + y) * n, d + ((z - 1) * n + y) * n, n);
+        }
+    }
+}
 
 /// Per level below min(levels, kCountLevels), the cells that more than m boxes touch
 /// (strictly, as groupRange): each lists those items, so it splits, and so did its ancestors.
-/// One byte per cell, counted up to m + 1; one level's counters alive at a time. One thread:
-/// the boxes come sorted by cell, so the counters are written nearly in order, and plain
-/// stores cost less than the atomic adds two threads would need.
-LevelCells countedSplits(std::span<const CellKey> sorted, std::uint32_t m, int levels) {
+/// Each box adds +1 and -1 at the eight corners of its cell range in a difference array of
+/// (2^l + 1)^3 counters, whose prefix sums along x, y and z are then every cell's count: O(1)
+/// per box whatever its size, O(cells) per level, every level's array filled in one pass over
+/// the boxes (19.6 MB for levels 0 to 8, each freed once summed). The counters are bytes and
+/// the sums exact modulo 256, so a cell that 256 boxes or more touch may count as fewer: a
+/// lower floor, still a floor. One thread, the same counts on any machine.
+LevelCells countedSplits(std::span<const CellKey> records, std::uint32_t m, int levels,
+                         LevelCells& entries) {
     LevelCells splits{};
-    if (m > 254) {
-        return splits; // a byte holds no such count (and so many items a cell rarely split)
+    if (m >= 0xff) {
+        return splits;
     }
-    std::vector<std::uint8_t> counts;
-    for (int l = 0; l < std::min(levels, kCountLevels); ++l) {
-        counts.assign(std::size_t(1) << (3 * l), 0);
-        std::array<std::uint64_t, 3> lo, hi;
-        for (const CellKey& k : sorted) {
-            if (!groupRange(k.box.lo, k.box.hi, l, lo, hi) ||
-                (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) > kCountCells) {
-                continue;
+    // One pass over the boxes fills every level's difference array: a box's cell range at a
+    // level is its range at the deepest one shifted (floor(lo 2^l) and ceil(hi 2^l) - 1 halve
+    // with the cells). A box with no cell at the deepest level is left out: still a floor.
+    const int count = std::min(levels, kCountLevels);
+    std::array<std::vector<std::uint8_t>, kCountLevels> diff;
+    for (int l = 0; l < count; ++l) {
+        const std::size_t n = (std::size_t(1) << l) + 1; // counters per axis
+        diff[l].assign(n * n * n, 0);
+    }
+    std::array<std::uint64_t, 3> lo, hi;
+    for (const CellKey& k : records) {
+        if (count == 0 || k.box.empty() || !groupRange(k.box.lo, k.box.hi, count - 1, lo, hi)) {
+            continue;
+        }
+        for (int l = 0; l < count; ++l) {
+            const int shift = count - 1 - l;
+            const std::size_t n = (std::size_t(1) << l) + 1;
+            for (int corner = 0; corner < 8; ++corner) {
+                const std::size_t x = corner & 1 ? (hi[0] >> shift) + 1 : lo[0] >> shift;
+                const std::size_t y = corner & 2 ? (hi[1] >> shift) + 1 : lo[1] >> shift;
+                const std::size_t z = corner & 4 ? (hi[2] >> shift) + 1 : lo[2] >> shift;
+                std::uint8_t& c = diff[l][(z * n + y) * n + x];
+                c = static_cast<std::uint8_t>(std::popcount(unsigned(corner)) % 2 == 0 ? c + 1
+                                                                                       : c - 1);
             }
-            for (std::uint64_t z = lo[2]; z <= hi[2]; ++z) {
-                for (std::uint64_t y = lo[1]; y <= hi[1]; ++y) {
-                    for (std::uint64_t x = lo[0]; x <= hi[0]; ++x) {
-                        std::uint8_t& c = counts[(z << (2 * l)) | (y << l) | x];
-                        c = static_cast<std::uint8_t>(c + (c <= m ? 1 : 0));
+        }
+    }
+    std::vector<std::uint64_t> parentOver, over; // a bit per cell counted over m
+    for (int l = 0; l < count; ++l) {
+        const std::size_t n = (std::size_t(1) << l) + 1;
+        std::vector<std::uint8_t>& counts = diff[l];
+        std::uint8_t* const d = counts.data();
+        prefixSums(d, n);
+        // A cell whose parent is counted over m is a node: it lists at least its count.
+        const std::size_t side = n - 1, half = side / 2;
+        over.assign((side * side * side + 63) / 64, 0);
+        std::uint64_t split = 0, listed = 0;
+        for (std::size_t z = 0; z < side; ++z) {
+            for (std::size_t y = 0; y < side; ++y) {
+                const std::uint8_t* row = d + (z * n + y) * n;
+                for (std::size_t x = 0; x < side; ++x) {
+                    const std::size_t parent = ((z / 2) * half + y / 2) * half + x / 2;
+                    if (l == 0 || ((parentOver[parent >> 6] >> (parent & 63)) & 1)) {
+                        listed += row[x];
+                    }
+                    if (row[x] > m) {
+                        const std::size_t cell = (z * side + y) * side + x;
+                        over[cell >> 6] |= std::uint64_t(1) << (cell & 63);
+                        ++split;
                     }
                 }
             }
         }
-        splits[l] = static_cast<std::uint64_t>(
-            std::count_if(counts.begin(), counts.end(), [m](std::uint8_t c) { return c > m; }));
+        splits[l] = split;
+        entries[l] = listed;
+        parentOver.swap(over);
+        counts = std::vector<std::uint8_t>(); // its memory back before the next level's sums
     }
     return splits;
 }
@@ -723,20 +795,24 @@ std::uint64_t floorBytes(std::uint64_t items, std::uint64_t nodes) {
         addSat(mulSat(nodes, sizeof(OctreeNode)), mulSat(nodes / 8, sizeof(std::uint32_t))));
 }
 
-/// At least what the build's own check counts as it starts allocating a level (the note's
-/// level checks): at level l with a split floor s(l) > 0 (the level is reached) the tree then
-/// holds at least the floor's nodes through l plus 8 s(l) children, the level has at least
-/// max(8 s(l - 1), s(l)) nodes, and its lists at least (M + 1) s(l) entries.
+/// At least what the build's own check counts after it places a level (the note's level
+/// checks): at level l with a split floor s(l) > 0 (the level is reached) the tree then holds
+/// at least the floor's nodes through l plus 8 s(l) children, the level has at least
+/// max(8 s(l - 1), s(l)) nodes, its lists at least max((M + 1) s(l), listed[l]) entries (each
+/// split node lists more than M items; `listed`: the cell counts' lists, or zeros) and the
+/// next level's at least listed[l + 1].
 std::uint64_t levelChecksFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int levels,
-                               const LevelCells& groups) {
+                               const LevelCells& groups, const LevelCells& entries) {
     std::uint64_t through = 1, width = 1, most = 0;
     for (int l = 0; l < levels; ++l) {
         const std::uint64_t splits = std::max(splitsAtLeast(c, b, l, m), groups[l]);
         const std::uint64_t children = mulSat(8, splits);
         if (splits > 0) {
-            most = std::max(most, detail::octreeBuildBytes({c.items, addSat(through, children), 0,
-                                                            std::max(width, splits),
-                                                            mulSat(m + 1, splits), 0}));
+            const std::uint64_t next = l + 1 < kLevels ? entries[l + 1] : 0;
+            most =
+                std::max(most, detail::octreeBuildBytes(
+                                   {c.items, addSat(through, children), 0, std::max(width, splits),
+                                    std::max(mulSat(m + 1, splits), entries[l]), next}));
         }
         through = addSat(through, children);
         width = children;
@@ -746,15 +822,15 @@ std::uint64_t levelChecksFloor(const LevelCounts& c, const Aabb& b, std::uint64_
 
 /// The floor in bytes: what the finished tree holds, or the most a level's check counts.
 std::uint64_t bytesFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int levels,
-                         const LevelCells& groups) {
+                         const LevelCells& groups, const LevelCells& entries = {}) {
     return std::max(floorBytes(c.items, nodesFloor(c, b, m, levels, groups)),
-                    levelChecksFloor(c, b, m, levels, groups));
+                    levelChecksFloor(c, b, m, levels, groups, entries));
 }
 
 /// The groups' split cells per level below `levels` (the note's groups): the largest kept
 /// group's, and when the floor with them still fits the limit, the groups' distinct cells.
 LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
-                       const LevelCounts& c, int levels) {
+                       const LevelCounts& c, int levels, LevelCells& entries) {
     const std::uint64_t m = static_cast<std::uint64_t>(std::max(spec.maxObjects, 1));
     const float cell =
         groupGridCell(scene, spec, b, std::min<std::size_t>(scene.itemCount(), kPairItems));
@@ -772,8 +848,9 @@ LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
         }
     }
     if (bytesFloor(c, b, m, levels, groups) <= spec.maxBytes) {
-        // Still not refused: count every shallow cell's boxes (the note's cell counts).
-        const LevelCells counted = countedSplits(sorted, mm, levels);
+        // Still not refused: count every shallow cell's boxes (the note's cell counts), down
+        // to the level below the last that splits (its lists are that level's next entries).
+        const LevelCells counted = countedSplits(records, mm, levels + 1, entries);
         for (int l = 0; l < levels; ++l) {
             groups[l] = std::max(groups[l], counted[l]);
         }
@@ -805,13 +882,13 @@ IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
     // under it the build fits whatever the floor says, and pays neither the inner counts nor
     // the group pass.
     const int splitting = std::min(reached, splitLevels);
-    LevelCells groups{};
+    LevelCells groups{}, listed{};
     if (e.atMostBytes > spec.maxBytes) {
         c.add(countLevels(scene, spec, b, splitLevels + 1, CountPass::Inner));
-        groups = groupSplits(scene, spec, b, c, splitting);
+        groups = groupSplits(scene, spec, b, c, splitting, listed);
     }
     e.nodesAtLeast = nodesFloor(c, b, m, splitting, groups);
-    e.atLeastBytes = bytesFloor(c, b, m, splitting, groups);
+    e.atLeastBytes = bytesFloor(c, b, m, splitting, groups, listed);
     return e;
 }
 

@@ -345,6 +345,11 @@ TEST_CASE("an octree's memory floor refuses a spec at once and never refuses wha
     CHECK(e.atLeastBytes > huge.maxBytes);
     CHECK(e.nodesAtLeast > (std::uint64_t(1) << 26)); // more than Octree::kMaxNodes
     CHECK_THROWS_AS(buildIndex(five, huge), IndexTooLargeError);
+    // A coarser spec whose tree has some 10^7 nodes by depth 8: refused by the floor (its cell
+    // counts and the level's check it bounds), not by the build after the levels that fit.
+    const IndexSpec deep = IndexSpec::octree(1, 0.0002);
+    CHECK(estimateIndexMemory(five, deep).atLeastBytes > deep.maxBytes);
+    CHECK_THROWS_WITH(buildIndex(five, deep), Catch::Contains("nodes over 5 items"));
 
     // Specs that fit: the build passes with its limit at its own peak accounting, and is
     // refused one byte below it (by the floor or by the check before a level's allocation,
