@@ -776,13 +776,19 @@ LevelCells groupFloor(std::span<const CellKey> sorted, float cell, std::uint32_t
     return most;
 }
 
-/// The floor's nodes: the root and 8 per level-l split, l < levels, taking per level the
-/// larger of the global count and `groups`.
+/// The floor's level-l splits: the larger of the global count and `groups` (the groups' and
+/// the cells' counts).
+std::uint64_t splitsFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int l,
+                          const LevelCells& groups) {
+    return std::max(splitsAtLeast(c, b, l, m), groups[l]);
+}
+
+/// The floor's nodes: the root and 8 per level-l split (splitsFloor), l < levels.
 std::uint64_t nodesFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int levels,
                          const LevelCells& groups) {
     std::uint64_t nodes = 1;
     for (int l = 0; l < levels; ++l) {
-        nodes = addSat(nodes, mulSat(8, std::max(splitsAtLeast(c, b, l, m), groups[l])));
+        nodes = addSat(nodes, mulSat(8, splitsFloor(c, b, m, l, groups)));
     }
     return nodes;
 }
@@ -805,7 +811,7 @@ std::uint64_t levelChecksFloor(const LevelCounts& c, const Aabb& b, std::uint64_
                                const LevelCells& groups, const LevelCells& entries) {
     std::uint64_t through = 1, width = 1, most = 0;
     for (int l = 0; l < levels; ++l) {
-        const std::uint64_t splits = std::max(splitsAtLeast(c, b, l, m), groups[l]);
+        const std::uint64_t splits = splitsFloor(c, b, m, l, groups);
         const std::uint64_t children = mulSat(8, splits);
         if (splits > 0) {
             const std::uint64_t next = l + 1 < kLevels ? entries[l + 1] : 0;
