@@ -101,7 +101,7 @@ std::uint64_t octreeBuildBytes(const OctreeBuildFigures& f) noexcept {
     b = addSat(b, mulSat(addSat(f.slots, 1), 2 * sizeof(std::uint32_t)));
     b = addSat(b, mulSat(f.levelEntries, sizeof(std::uint32_t) + 1));
     b = addSat(b, mulSat(f.nextEntries, sizeof(std::uint32_t)));
-    b = addSat(b, mulSat(addSat(f.levelNodes, 1), 57 + 8 * sizeof(std::uint64_t)));
+    b = addSat(b, mulSat(addSat(f.levelNodes, 1), 12 + 8 * sizeof(std::uint64_t)));
     return b;
 }
 

@@ -41,7 +41,7 @@ struct OctreeBuildFigures {
 /// outside flag and entry, local id, 192-byte shape, Morton key and flags; every node (40 B)
 /// and its parent share twice, and every slot twice (a vector growing by one level copies the
 /// old array into the new one, both alive); per level entry its id and mask; per next entry
-/// its id; per level node its child counts, flags and offsets (57 B) and its children's list
+/// its id; per level node its list's start and split rank (12 B) and its children's list
 /// starts (64 B). An upper bound of the builder's live arrays, used both by the build's check
 /// before each level's allocations and by the estimate's upper bound. [any thread]
 std::uint64_t octreeBuildBytes(const OctreeBuildFigures& f) noexcept;

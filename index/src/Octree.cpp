@@ -9,11 +9,16 @@
 // children's object lists are then cut from the parent's by those masks, which keeps every
 // list sorted by slot and the result identical on any number of threads. A node that does
 // not split becomes a leaf and its list is appended to one slot array (CSR: each leaf one
-// contiguous run). Neighbour links of a new level come from the level above in O(1) each:
-// across an inner face the neighbour is a sibling; across an outer face it is the parent's
-// neighbour's mirrored child when that neighbour split, else the parent's neighbour itself
-// (equal size, or the smallest larger node covering the face).
-// Invariant: node cells are given by (level, integer coordinates) and every coordinate is
+// contiguous run, in node order); when the children are at the minimum size (they cannot
+// split), their lists are cut straight into the slots and the build ends. Per node of a level
+// the build keeps only its list's start and split rank (a node splits when its list is longer
+// than M, known before classifying), and its scratch arrays are left uninitialised, so the
+// threads that fill them touch their pages first (a fresh page's fault costs about 11 us on
+// the 2-core VM, and a 10^6 build's time follows the fresh memory it touches). Neighbour links of a
+// new level come from the level above in O(1) each: across an inner face the neighbour is a
+// sibling; across an outer face it is the parent's neighbour's mirrored child when that neighbour
+// split, else the parent's neighbour itself (equal size, or the smallest larger node covering the
+// face). Invariant: node cells are given by (level, integer coordinates) and every coordinate is
 // computed by one formula, min + i * size / 2^level, so a face shared by two nodes of any
 // levels is the same double in both, and "which leaf holds p" has one answer everywhere:
 // the half-open cell [lo, hi) that holds p, closed on the bounds' upper faces.
@@ -29,6 +34,7 @@
 #include "IndexItems.h"
 #include "IndexMemory.h"
 #include "Parallel.h"
+#include "ScratchArray.h"
 
 #include "hapto/io/InputError.h"
 
@@ -44,16 +50,10 @@
 namespace hapto {
 namespace {
 
+using detail::ScratchArray;
+
 // A node's object list is split over threads only above this many objects.
 constexpr std::size_t kNestedGrain = 4096;
-
-// Frees a vector's array, then allocates exactly `size` value-initialised elements (assign()
-// and resize() would keep a larger array of an earlier level, and a new vector swapped in
-// would hold both at once).
-template <class T> void freshArray(std::vector<T>& v, std::size_t size) {
-    std::vector<T>().swap(v);
-    v.resize(size);
-}
 
 } // namespace
 
@@ -303,14 +303,16 @@ private:
     SplitCells splitCells(std::uint64_t node) const;
     void classifyObjects(const SplitCells& cells, std::size_t lo, std::size_t hi);
     template <class Bounds>
-    void classifyWith(const std::vector<Bounds>& bounds, const SplitCells& cells, std::size_t lo,
+    void classifyWith(const ScratchArray<Bounds>& bounds, const SplitCells& cells, std::size_t lo,
                       std::size_t hi);
     bool overlapsCell(std::uint32_t local, const OverlapCell& cell) const;
     void allocateLevel();
     void refuseAbove(std::uint64_t nodes, std::uint64_t slots, std::uint64_t next) const;
-    void placeNode(std::size_t k, std::uint64_t& leafTotal, std::uint64_t& nextTotal);
+    void placeNode(std::size_t k, std::uint64_t& leafTotal);
     void fillLists();
     void cutChildLists(std::size_t k, std::uint64_t childBase);
+    template <class Value>
+    void cutInto(std::size_t k, std::uint64_t childBase, std::uint32_t* to, const Value& value);
     void linkLevel(std::uint64_t begin, std::uint64_t end);
 
     Octree& mTree;
@@ -321,21 +323,29 @@ private:
     // Per local id, one of: the item's AABB and scale when that is every item's whole test (Aabb
     // mode, or only axis-aligned boxes: 56 bytes an item), else its shape (192 bytes).
     bool mAabbOnly = false;
-    std::vector<OverlapBounds> mBoxes;
-    std::vector<OverlapShape> mShapes;
-    std::vector<std::uint32_t> mEntries; // the lists of the current level's nodes, back to back
-    std::vector<std::uint64_t> mStart;   // per node of the level, + 1: where its list starts
-    std::vector<std::uint8_t> mMasks;    // per entry: the octants it overlaps (nodes that split)
-    std::vector<std::uint32_t> mNext;    // the next level's lists
-    std::vector<std::uint64_t> mNextStart;
+    ScratchArray<OverlapBounds> mBoxes;
+    ScratchArray<OverlapShape> mShapes;
+    ScratchArray<std::uint32_t> mEntries; // the lists of the current level's nodes, back to back
+    ScratchArray<std::uint64_t> mStart;   // per node of the level, + 1: where its list starts
+    ScratchArray<std::uint8_t> mMasks;    // per entry of the nodes that split: its octants
+    ScratchArray<std::uint32_t> mNext;    // the next level's lists
+    // Per child of the level's nodes that split (8 per node, by split rank), + 1: where its list
+    // starts in mNext; the classification writes each child's count there, allocateLevel sums.
+    ScratchArray<std::uint64_t> mNextStart;
     // The level being built: nodes [mLevelBegin, mLevelEnd), all of depth mLevel.
     std::uint64_t mLevelBegin = 0, mLevelEnd = 1;
     int mLevel = 0;
     std::size_t mWidth = 0;
-    std::vector<std::uint8_t> mSplits;                     // per node: 1 if it splits
-    std::vector<std::array<std::uint32_t, 8>> mChildCount; // per node that splits, per octant
-    std::vector<std::uint64_t> mLeafAt;                    // per node that stays a leaf: 1st slot
+    // Per node of the level: its rank among the nodes that split, or kStaysLeaf. A node splits
+    // when its list is longer than M and its level can split, known before classifying.
+    static constexpr std::uint32_t kStaysLeaf = std::numeric_limits<std::uint32_t>::max();
+    ScratchArray<std::uint32_t> mSplitRank;
     std::uint64_t mSplitCount = 0, mSlotBase = 0;
+    std::uint64_t mLeafEntries = 0; // entries of the level's nodes that stay leaves
+    // The next level cannot split (it is at the minimum size), so the children are leaves: their
+    // lists go straight into the slots, from mChildSlots on, and the build ends with them.
+    bool mChildrenAreLeaves = false;
+    std::uint64_t mChildSlots = 0;
     mutable std::uint64_t mPeakBytes = 0; // the largest accounting checked (bytes)
 };
 
@@ -355,10 +365,13 @@ void OctreeBuilder::run() {
         fillLists();
         const std::uint64_t newBegin = mLevelEnd, newEnd = mTree.mNodes.size();
         linkLevel(newBegin, newEnd);
+        if (mChildrenAreLeaves) {
+            break; // the new level's leaves are written: nothing is left to split
+        }
         mEntries.swap(mNext);
         mStart.swap(mNextStart);
-        freshArray(mNext, 0); // the level above's lists: no longer needed
-        freshArray(mNextStart, 0);
+        mNext.reset(0); // the level above's lists: no longer needed
+        mNextStart.reset(0);
         mLevelBegin = newBegin;
         mLevelEnd = newEnd;
     }
@@ -369,7 +382,8 @@ void OctreeBuilder::run() {
 // become item ids again when leaves are written.
 void OctreeBuilder::sortByMorton(const Scene& scene, std::span<const std::uint32_t> items) {
     const Aabb box = mTree.bounds();
-    std::vector<std::uint64_t> keys(mCount);
+    ScratchArray<std::uint64_t> keys;
+    keys.reset(mCount);
     const bool aabbMode = mSpec.mode == OverlapMode::Aabb;
     std::atomic<bool> anyExact{false};
     parallel::forEach(0, mCount, 4096, [&](std::size_t i) {
@@ -395,7 +409,7 @@ void OctreeBuilder::sortByMorton(const Scene& scene, std::span<const std::uint32
     parallel::sort(keys.begin(), keys.end());
     mSlotOf.resize(mCount);
     mAabbOnly = !anyExact.load();
-    (mAabbOnly ? mBoxes.resize(mCount) : mShapes.resize(mCount));
+    (mAabbOnly ? mBoxes.reset(mCount) : mShapes.reset(mCount));
     parallel::forEach(0, mCount, 4096, [&](std::size_t local) {
         mSlotOf[local] = items[static_cast<std::uint32_t>(keys[local])];
         if (mAabbOnly) {
@@ -419,29 +433,43 @@ void OctreeBuilder::listRoot() {
     parallel::forEach(0, mCount, 4096, [&](std::size_t i) {
         keep[i] = overlapsCell(static_cast<std::uint32_t>(i), cell);
     });
-    mEntries.reserve(mCount);
-    for (std::uint32_t i = 0; i < mCount; ++i) {
+    mEntries.reset(static_cast<std::size_t>(std::count(keep.begin(), keep.end(), 1)));
+    for (std::uint32_t i = 0, out = 0; i < mCount; ++i) {
         if (keep[i]) {
-            mEntries.push_back(i);
+            mEntries[out++] = i;
         }
     }
-    mStart = {0, mEntries.size()};
+    mStart.reset(2);
+    mStart[0] = 0;
+    mStart[1] = mEntries.size();
     mTree.mNodes.emplace_back();
 }
 
-// Step 1, in parallel: which nodes of the level split, and for their objects, which octants
-// each overlaps; then each child's object count.
+// Step 1: which nodes of the level split (serially, by their lists' lengths), then in parallel
+// for their objects which octants each overlaps, and each child's object count. Nothing is
+// allocated per node beyond its split rank, and no masks when no node splits (the last level).
 void OctreeBuilder::classifyLevel() {
     const bool splittable = mTree.canSplit(mLevel);
-    freshArray(mChildCount, mWidth);
-    freshArray(mSplits, mWidth);
-    freshArray(mMasks, mEntries.size());
+    mSplitRank.reset(mWidth);
+    mSplitCount = 0;
+    mLeafEntries = 0;
+    for (std::size_t k = 0; k < mWidth; ++k) {
+        const bool splits = splittable && mStart[k + 1] - mStart[k] > mMaxObjects;
+        mSplitRank[k] = splits ? static_cast<std::uint32_t>(mSplitCount++) : kStaysLeaf;
+        mLeafEntries += splits ? 0 : mStart[k + 1] - mStart[k];
+    }
+    mChildrenAreLeaves = mSplitCount > 0 && !mTree.canSplit(mLevel + 1);
+    mNextStart.reset(8 * mSplitCount + 1); // every count is written below
+    mNextStart[0] = 0;
+    mMasks.reset(mSplitCount > 0 ? mEntries.size() : 0);
+    if (mSplitCount == 0) {
+        return;
+    }
     parallel::forEach(0, mWidth, 16, [&](std::size_t k) {
-        const std::uint64_t b = mStart[k], e = mStart[k + 1];
-        if (!splittable || e - b <= mMaxObjects) {
+        if (mSplitRank[k] == kStaysLeaf) {
             return;
         }
-        mSplits[k] = 1;
+        const std::uint64_t b = mStart[k], e = mStart[k + 1];
         const SplitCells cells = splitCells(mLevelBegin + k);
         if (e - b > kNestedGrain) { // only big lists are worth a nested parallel loop
             parallel::forRanges(b, e, kNestedGrain / 4, [&](std::size_t lo, std::size_t hi) {
@@ -450,13 +478,13 @@ void OctreeBuilder::classifyLevel() {
         } else {
             classifyObjects(cells, b, e);
         }
-        std::array<std::uint32_t, 8> c{};
+        std::array<std::uint64_t, 8> c{};
         for (std::uint64_t i = b; i < e; ++i) {
-            for (std::uint32_t o = 0; o < 8; ++o) {
-                c[o] += (mMasks[i] >> o) & 1;
+            for (unsigned m = mMasks[i]; m != 0; m &= m - 1) {
+                ++c[std::countr_zero(m)];
             }
         }
-        mChildCount[k] = c;
+        std::copy(c.begin(), c.end(), mNextStart.begin() + 1 + 8 * std::size_t(mSplitRank[k]));
     });
 }
 
@@ -492,7 +520,7 @@ void OctreeBuilder::classifyObjects(const SplitCells& cells, std::size_t lo, std
 }
 
 template <class Bounds>
-void OctreeBuilder::classifyWith(const std::vector<Bounds>& bounds, const SplitCells& cells,
+void OctreeBuilder::classifyWith(const ScratchArray<Bounds>& bounds, const SplitCells& cells,
                                  std::size_t lo, std::size_t hi) {
     for (std::size_t i = lo; i < hi; ++i) {
         const Bounds& s = bounds[mEntries[i]];
@@ -527,10 +555,6 @@ void OctreeBuilder::classifyWith(const std::vector<Bounds>& bounds, const SplitC
 // capacity of an earlier, larger level), so the limit bounds the build's resident memory.
 void OctreeBuilder::allocateLevel() {
     std::vector<OctreeNode>& nodes = mTree.mNodes;
-    mSplitCount = 0;
-    for (std::size_t k = 0; k < mWidth; ++k) {
-        mSplitCount += mSplits[k];
-    }
     const std::uint64_t newNodes = nodes.size() + 8 * mSplitCount;
     refuseAbove(newNodes, mTree.mSlots.size(), 0);
     if (newNodes > Octree::kMaxNodes) {
@@ -544,23 +568,27 @@ void OctreeBuilder::allocateLevel() {
     // (a reallocation per level copies the nodes so far: a geometric sum, cheap).
     nodes.reserve(newNodes);
     mTree.mGroupParent.reserve(mTree.mGroupParent.size() + mSplitCount);
-    freshArray(mLeafAt, mWidth);
-    std::uint64_t leafTotal = 0, nextTotal = 0;
-    freshArray(mNextStart, 0);
-    mNextStart.reserve(8 * mSplitCount + 1);
-    mNextStart.push_back(0);
-    for (std::size_t k = 0; k < mWidth; ++k) {
-        placeNode(k, leafTotal, nextTotal);
+    for (std::size_t i = 1; i < mNextStart.size(); ++i) { // the children's counts to starts
+        mNextStart[i] += mNextStart[i - 1];
     }
-    if (mSlotBase + leafTotal >= std::numeric_limits<std::uint32_t>::max() ||
-        nextTotal >= std::numeric_limits<std::uint32_t>::max()) {
+    const std::uint64_t nextTotal = mNextStart[mNextStart.size() - 1];
+    // Slots in node order: the level's leaves, then (when they are leaves) its children's.
+    mChildSlots = mSlotBase + mLeafEntries;
+    const std::uint64_t slots = mChildSlots + (mChildrenAreLeaves ? nextTotal : 0);
+    const std::uint64_t next = mChildrenAreLeaves ? 0 : nextTotal;
+    if (slots >= std::numeric_limits<std::uint32_t>::max() ||
+        next >= std::numeric_limits<std::uint32_t>::max()) {
         throw InputError("octree " + mSpec.toString() +
                          ": more than 2^32 object-leaf pairs; raise MIN or M");
     }
-    refuseAbove(nodes.size(), mSlotBase + leafTotal, nextTotal);
-    mTree.mSlots.reserve(mSlotBase + leafTotal);
-    mTree.mSlots.resize(mSlotBase + leafTotal);
-    freshArray(mNext, nextTotal);
+    std::uint64_t leafTotal = 0;
+    for (std::size_t k = 0; k < mWidth; ++k) {
+        placeNode(k, leafTotal);
+    }
+    refuseAbove(nodes.size(), slots, next);
+    mTree.mSlots.reserve(slots);
+    mTree.mSlots.resize(slots);
+    mNext.reset(next);
 }
 
 // Refuses the build (IndexTooLargeError) when the build would hold more than the spec's
@@ -579,15 +607,14 @@ void OctreeBuilder::refuseAbove(std::uint64_t nodes, std::uint64_t slots,
 }
 
 // Node k of the level becomes a leaf with the next run of slots, or an inner node whose eight
-// children are appended, their lists' starts added to mNextStart.
-void OctreeBuilder::placeNode(std::size_t k, std::uint64_t& leafTotal, std::uint64_t& nextTotal) {
+// children are appended (in split rank order, as their lists' starts in mNextStart).
+void OctreeBuilder::placeNode(std::size_t k, std::uint64_t& leafTotal) {
     std::vector<OctreeNode>& nodes = mTree.mNodes;
     const std::uint32_t id = static_cast<std::uint32_t>(mLevelBegin + k);
-    if (!mSplits[k]) {
+    if (mSplitRank[k] == kStaysLeaf) {
         OctreeNode& n = nodes[id];
         n.makeLeaf(static_cast<std::uint32_t>(mSlotBase + leafTotal),
                    static_cast<std::uint32_t>(mStart[k + 1] - mStart[k]));
-        mLeafAt[k] = mSlotBase + leafTotal;
         leafTotal += n.slotCount();
         return;
     }
@@ -595,56 +622,74 @@ void OctreeBuilder::placeNode(std::size_t k, std::uint64_t& leafTotal, std::uint
     nodes[id].makeInner(first);
     const OctreeNode parent = nodes[id];
     mTree.mGroupParent.push_back(id);
+    const std::uint64_t childBase = 8 * std::uint64_t(mSplitRank[k]);
     for (std::uint32_t o = 0; o < 8; ++o) {
         OctreeNode c;
         c.setCell(mLevel + 1, 2 * parent.cell(0) + (o & 1), 2 * parent.cell(1) + ((o >> 1) & 1),
                   2 * parent.cell(2) + ((o >> 2) & 1));
+        if (mChildrenAreLeaves) {
+            const std::uint64_t start = mNextStart[childBase + o];
+            c.makeLeaf(static_cast<std::uint32_t>(mChildSlots + start),
+                       static_cast<std::uint32_t>(mNextStart[childBase + o + 1] - start));
+        }
         nodes.push_back(c);
-        nextTotal += mChildCount[k][o];
-        mNextStart.push_back(nextTotal);
     }
 }
 
 // Step 3, in parallel: copy leaf lists out (back to item ids, ascending), cut children's lists
 // by the masks.
 void OctreeBuilder::fillLists() {
-    std::vector<std::uint64_t> childBase(mWidth, 0);
-    for (std::size_t k = 0, c = 0; k < mWidth; ++k) {
-        if (mSplits[k]) {
-            childBase[k] = c;
-            c += 8;
-        }
-    }
     parallel::forEach(0, mWidth, 16, [&](std::size_t k) {
-        if (mSplits[k]) {
-            cutChildLists(k, childBase[k]);
+        if (mSplitRank[k] != kStaysLeaf) {
+            cutChildLists(k, 8 * std::uint64_t(mSplitRank[k]));
             return;
         }
         const std::uint64_t b = mStart[k], e = mStart[k + 1];
-        const auto out = mTree.mSlots.begin() + static_cast<std::ptrdiff_t>(mLeafAt[k]);
+        const OctreeNode& leaf = mTree.mNodes[mLevelBegin + k];
+        const auto out = mTree.mSlots.begin() + static_cast<std::ptrdiff_t>(leaf.firstSlot());
         std::transform(mEntries.begin() + b, mEntries.begin() + e, out,
                        [&](std::uint32_t local) { return mSlotOf[local]; });
         std::sort(out, out + static_cast<std::ptrdiff_t>(e - b));
     });
 }
 
-// The eight children's lists of node k, each cut from its list by the masks (in order, so each
-// stays sorted by local id).
+// The eight children's lists of node k, cut from its list by the masks (in order, so each stays
+// sorted by local id): a long list one octant a task, a short one in one pass. Children that are
+// leaves get their lists as slots: item ids, each run sorted.
 void OctreeBuilder::cutChildLists(std::size_t k, std::uint64_t childBase) {
-    const std::uint64_t b = mStart[k], e = mStart[k + 1];
-    const auto cut = [&](std::size_t o) {
-        std::uint64_t out = mNextStart[childBase + o];
-        for (std::uint64_t i = b; i < e; ++i) {
-            if ((mMasks[i] >> o) & 1) {
-                mNext[out++] = mEntries[i];
-            }
+    if (mChildrenAreLeaves) {
+        cutInto(k, childBase, mTree.mSlots.data() + mChildSlots,
+                [&](std::uint32_t local) { return mSlotOf[local]; });
+        for (std::uint64_t o = childBase; o < childBase + 8; ++o) {
+            std::sort(mTree.mSlots.begin() + std::ptrdiff_t(mChildSlots + mNextStart[o]),
+                      mTree.mSlots.begin() + std::ptrdiff_t(mChildSlots + mNextStart[o + 1]));
         }
-    };
-    if (e - b > kNestedGrain) {
-        parallel::forEach(0, 8, 1, cut);
     } else {
-        for (std::size_t o = 0; o < 8; ++o) {
-            cut(o);
+        cutInto(k, childBase, mNext.begin(), [](std::uint32_t local) { return local; });
+    }
+}
+
+template <class Value>
+void OctreeBuilder::cutInto(std::size_t k, std::uint64_t childBase, std::uint32_t* to,
+                            const Value& value) {
+    const std::uint64_t b = mStart[k], e = mStart[k + 1];
+    if (e - b > kNestedGrain) {
+        parallel::forEach(0, 8, 1, [&](std::size_t o) {
+            std::uint64_t out = mNextStart[childBase + o];
+            for (std::uint64_t i = b; i < e; ++i) {
+                if ((mMasks[i] >> o) & 1) {
+                    to[out++] = value(mEntries[i]);
+                }
+            }
+        });
+        return;
+    }
+    std::array<std::uint64_t, 8> out;
+    std::copy_n(mNextStart.begin() + childBase, 8, out.begin());
+    for (std::uint64_t i = b; i < e; ++i) {
+        const std::uint32_t v = value(mEntries[i]);
+        for (unsigned m = mMasks[i]; m != 0; m &= m - 1) {
+            to[out[std::countr_zero(m)]++] = v;
         }
     }
 }
