@@ -19,7 +19,8 @@
 // trees: the boxes they return), hits (boxes holding the point), steps (hapto cursor links);
 // and bytes_per_object (hapto: IndexStats bytes / objects; baselines: heap growth around the
 // build, glibc mallinfo2), heap_bytes_per_object (heap growth for all), checked_points.
-// Build benchmarks time one build per iteration (wall clock); hapto builds with TBB on the
+// Build benchmarks time one build per iteration (wall clock), each started from the same
+// trimmed heap, as in a fresh process (buildLoop, HeapUsage.h); hapto builds with TBB on the
 // number of threads in the name.
 //
 // Before timing, each structure is checked once at every check point of its scene: it must
@@ -232,30 +233,6 @@ void baselineQuery(benchmark::State& state, const std::string& name, SceneKind k
     }
 }
 
-/// A build benchmark: one build per iteration; freeing the previous one is not timed. Returns
-/// the last build and sets the heap growth of the first (bytes per object).
-template <class Build>
-auto buildLoop(benchmark::State& state, std::size_t count, double& heapBytesPerObject,
-               Build&& build) {
-    const std::size_t before = heapBytesInUse();
-    bool first = true;
-    decltype(build()) last;
-    for (auto _ : state) {
-        auto built = build();
-        state.PauseTiming();
-        if (first) {
-            const std::size_t after = heapBytesInUse();
-            heapBytesPerObject = after > before ? static_cast<double>(after - before) / count : 0.0;
-            first = false;
-        }
-        last.reset();
-        last = std::move(built);
-        state.ResumeTiming();
-    }
-    state.counters["heap_bytes_per_object"] = heapBytesPerObject;
-    return last;
-}
-
 void haptoBuild(benchmark::State& state, SceneKind kind, std::size_t count, bool grid,
                 int threads) {
     const SceneCase& c = sceneCase(kind, count);
@@ -266,6 +243,7 @@ void haptoBuild(benchmark::State& state, SceneKind kind, std::size_t count, bool
     std::shared_ptr<const SpatialIndex> index = buildLoop(state, count, heap, [&] {
         return std::shared_ptr<const SpatialIndex>(buildIndex(c.scene, spec));
     });
+    state.counters["heap_bytes_per_object"] = heap;
     if (index) {
         state.counters["bytes_per_object"] = index->stats().bytesPerObject;
         keepHaptoIndex(c, std::move(index), heap);
@@ -280,6 +258,7 @@ void baselineBuild(benchmark::State& state, const std::string& key, SceneKind ki
     double heap = 0.0;
     std::shared_ptr<S> last =
         buildLoop(state, count, heap, [&] { return std::make_shared<S>(c.boxes); });
+    state.counters["heap_bytes_per_object"] = heap;
     if (last) {
         Prepared& p = prepared();
         p.key = key;

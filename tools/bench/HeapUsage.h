@@ -1,6 +1,8 @@
 #pragma once
-/// Heap bytes in use, from glibc's mallinfo2(), to measure what a structure's build keeps.
+/// Heap bytes in use, from glibc's mallinfo2(), to measure what a structure's build keeps;
+/// and the build benchmarks' loop, which starts every build from the same heap.
 
+#include <benchmark/benchmark.h>
 #include <malloc.h>
 
 #include <cstddef>
@@ -26,6 +28,40 @@ template <class Make> auto measureHeap(Make&& make, std::size_t& grownBytes) {
     const std::size_t after = heapBytesInUse();
     grownBytes = after > before ? after - before : 0;
     return built;
+}
+
+/// A build benchmark's loop: one build per iteration, each from the same heap (below); freeing
+/// the previous one is not timed. Returns the last build (a smart pointer) and sets
+/// `heapBytesPerItem` to the heap growth of the first over `count` items.
+///
+/// Every build starts as it would in a fresh process: the previous build is freed and the heap
+/// trimmed (malloc_trim returns free pages to the kernel) before the clock starts. A build's
+/// time at 10^6 follows the fresh pages it first writes (about 11 us a page on the VM of
+/// docs/results/index-builds.md), so without this a build that reused pages an earlier
+/// benchmark had freed ran up to 2x faster than the same build in a process of its own, and
+/// which structure got them depended on the order the benchmarks ran in. [control]
+template <class Build>
+auto buildLoop(benchmark::State& state, std::size_t count, double& heapBytesPerItem,
+               Build&& build) {
+    bool first = true;
+    decltype(build()) last;
+    for (auto _ : state) {
+        state.PauseTiming();
+        last.reset();
+        malloc_trim(0);
+        const std::size_t before = heapBytesInUse();
+        state.ResumeTiming();
+        auto built = build();
+        state.PauseTiming();
+        if (first) {
+            const std::size_t after = heapBytesInUse();
+            heapBytesPerItem = after > before ? static_cast<double>(after - before) / count : 0.0;
+            first = false;
+        }
+        last = std::move(built);
+        state.ResumeTiming();
+    }
+    return last;
 }
 
 } // namespace hapto::bench

@@ -13,9 +13,10 @@
 //                fcl-obbrss   fcl::collide of BVHModel<OBBRSS> with a sphere of radius r
 //                             (triangles that really touch the sphere, up to 10^5 contacts).
 //              Counter: candidates per query (what each hands on).
-//   mesh-build one build per iteration (wall clock): hapto's index over the scene's triangle
-//              items (2 TBB threads), Bullet's BVH, FCL's OBBRSS tree; counters
-//              bytes_per_triangle (hapto: IndexStats bytes; the others: heap growth).
+//   mesh-build one build per iteration (wall clock, each from a trimmed heap: buildLoop in
+//              HeapUsage.h): hapto's index over the scene's triangle items (2 TBB threads),
+//              Bullet's BVH, FCL's OBBRSS tree; counters bytes_per_triangle (hapto:
+//              IndexStats bytes; the others: heap growth).
 //   mesh-tick  the servo path's full tick (HapticTick: locate, candidates, god-object render,
 //              safety) along the same loop; manual time per tick; counters p50_ns, p99_ns,
 //              contact (the share of ticks in contact), and per tick: tested (candidate items
@@ -327,25 +328,23 @@ void nearFcl(benchmark::State& state, std::size_t n) {
 void buildMesh(benchmark::State& state, std::size_t n, int which) {
     const Scene& scene = meshScene(n);
     const TriangleMesh& mesh = *scene.object(0).mesh;
-    double bytes = 0;
-    for (auto _ : state) {
-        const std::size_t before = heapBytesInUse();
-        if (which == 0 || which == 1) {
-            const auto index = buildIndex(scene, meshSpec(which == 1));
-            bytes = static_cast<double>(index->stats().bytes);
-            benchmark::DoNotOptimize(index.get());
-        } else if (which == 2) {
-            const auto bullet = std::make_unique<BulletMesh>(mesh);
-            bytes = static_cast<double>(heapBytesInUse() - before);
-            benchmark::DoNotOptimize(bullet.get());
-        } else {
-            const auto fcl = makeFcl(mesh);
-            bytes = static_cast<double>(heapBytesInUse() - before);
-            benchmark::DoNotOptimize(fcl.get());
-        }
+    const std::size_t triangles = scene.triangleCount();
+    double heap = 0.0; // bytes per triangle, the first build's heap growth
+    double bytes = 0.0;
+    if (which == 0 || which == 1) {
+        const auto index = buildLoop(state, triangles, heap, [&] {
+            return std::unique_ptr<const SpatialIndex>(buildIndex(scene, meshSpec(which == 1)));
+        });
+        bytes = index ? static_cast<double>(index->stats().bytes) / triangles : 0.0;
+    } else if (which == 2) {
+        buildLoop(state, triangles, heap, [&] { return std::make_unique<BulletMesh>(mesh); });
+        bytes = heap;
+    } else {
+        buildLoop(state, triangles, heap, [&] { return makeFcl(mesh); });
+        bytes = heap;
     }
-    state.counters["bytes_per_triangle"] = bytes / scene.triangleCount();
-    state.counters["triangles"] = scene.triangleCount();
+    state.counters["bytes_per_triangle"] = bytes;
+    state.counters["triangles"] = static_cast<double>(triangles);
 }
 
 /// The fine sphere's n triangles nearest its pole, as a scene with the sphere's bounds (n = 0:
