@@ -72,11 +72,12 @@ bool GodObjectRenderer::Solve::addPlane(const Plane& plane) noexcept {
 GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const CandidateSet& candidates,
                                                 const Vec3& from, const Vec3& to) const noexcept {
     Hit best;
-    // The segment's bounding box: a box or sphere whose skin's bounding box it misses cannot
-    // be entered (the entry test's surface lies kShrinkM inside that skin, far more than
-    // rounding), so most of a long near list ends at six comparisons.
-    const Vec3 mid = 0.5 * (from + to);
-    const Vec3 half = 0.5 * glm::abs(to - from);
+    // The bounding box of the segment up to the nearest entry found so far: a box or sphere
+    // whose skin's bounding box it misses cannot be entered before that (the entry test's
+    // surface lies kShrinkM inside that skin, far more than rounding), so most of a long near
+    // list ends at six comparisons, and once a hit is found, so do the items beyond it.
+    Vec3 mid = 0.5 * (from + to);
+    Vec3 half = 0.5 * glm::abs(to - from);
     forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t near) {
         SweptEntry e;
         if (near != kNotCached) {
@@ -106,6 +107,9 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
         }
         if (e.found && e.t < best.t) {
             best = {true, e.t, e.tStop, item, e.axis, e.sign, near};
+            const Vec3 end = from + e.t * (to - from);
+            mid = 0.5 * (from + end);
+            half = 0.5 * glm::abs(end - from);
         }
     });
     return best;

@@ -180,6 +180,35 @@ TEST_CASE("a fast stroke through a 2 mm plate never pops through") {
     checkVec(out.force, kK * 0.041 * n, kTol);
 }
 
+TEST_CASE("a jump through a row of plates stops at the first plate in its way, whatever order "
+          "the candidates come in") {
+    // Three 2 mm plates (two of them tilted) and a sphere, 1 cm apart on one line, and one
+    // 5 cm jump through all of them: a pass keeps the nearest entry it has found and skips
+    // what lies beyond it, so every order of the candidates must give the first plate's face.
+    const Quat tilt = someRotation(0.2, Vec3(1.0, 0.0, 1.0));
+    const RenderRig rig(
+        {makeBox(1, Vec3(0.0, 0.00, 0.0), Vec3(0.02, 0.001, 0.02), Quat(1, 0, 0, 0), stiff()),
+         makeBox(2, Vec3(0.0, -0.01, 0.0), Vec3(0.02, 0.001, 0.02), tilt, stiff()),
+         makeSphere(3, Vec3(0.0, -0.02, 0.0), 0.004, stiff()),
+         makeBox(4, Vec3(0.0, -0.03, 0.0), Vec3(0.02, 0.001, 0.02), tilt, stiff())});
+    std::vector<std::uint32_t> order{0, 1, 2, 3};
+    int orders = 0;
+    do {
+        CandidateSet cands;
+        cands.add(order);
+        GodObjectRenderer r;
+        r.reset(Vec3(0.0, 0.01, 0.0));
+        const RenderOutput out = r.update(rig.scene, cands, Vec3(0.0, -0.04, 0.0), Vec3(0.0), 1e-3);
+        INFO("order " << order[0] << order[1] << order[2] << order[3]);
+        CHECK(out.proxy.y == Approx(0.001).margin(kTolM));
+        REQUIRE(out.contactCount == 1);
+        CHECK(out.contacts[0].slot == 0);
+        checkVec(out.force, kK * Vec3(0.0, 0.041, 0.0), kTol);
+        ++orders;
+    } while (std::next_permutation(order.begin(), order.end()));
+    CHECK(orders == 24);
+}
+
 TEST_CASE("sliding across the seam of two boxes side by side has no snag") {
     const RenderRig rig({makeBox(1, Vec3(-0.05, 0.0, 0.0), Vec3(0.05), Quat(1, 0, 0, 0), stiff()),
                          makeBox(2, Vec3(0.05, 0.0, 0.0), Vec3(0.05), Quat(1, 0, 0, 0), stiff())});
