@@ -19,9 +19,9 @@
 // trees: the boxes they return), hits (boxes holding the point), steps (hapto cursor links);
 // and bytes_per_object (hapto: IndexStats bytes / objects; baselines: heap growth around the
 // build, glibc mallinfo2), heap_bytes_per_object (heap growth for all), checked_points.
-// Build benchmarks time one build per iteration (wall clock), each started from the same
-// trimmed heap, as in a fresh process (buildLoop, HeapUsage.h); hapto builds with TBB on the
-// number of threads in the name.
+// Build benchmarks time one build per iteration (wall clock), each run started from a trimmed
+// heap, as in a fresh process (buildLoop, HeapUsage.h); hapto builds with TBB on the number of
+// threads in the name.
 //
 // Before timing, each structure is checked once at every check point of its scene: it must
 // return every object whose solid holds the point and nothing whose AABB misses it (the

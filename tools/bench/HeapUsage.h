@@ -1,6 +1,6 @@
 #pragma once
 /// Heap bytes in use, from glibc's mallinfo2(), to measure what a structure's build keeps;
-/// and the build benchmarks' loop, which starts every build from the same heap.
+/// and the build benchmarks' loop, which starts each run from a trimmed heap.
 
 #include <benchmark/benchmark.h>
 #include <malloc.h>
@@ -30,16 +30,19 @@ template <class Make> auto measureHeap(Make&& make, std::size_t& grownBytes) {
     return built;
 }
 
-/// A build benchmark's loop: one build per iteration, each from the same heap (below); freeing
-/// the previous one is not timed. Returns the last build (a smart pointer) and sets
-/// `heapBytesPerItem` to the heap growth of the first over `count` items.
+/// A build benchmark's loop: one build per iteration; freeing the previous one is not timed.
+/// Returns the last build (a smart pointer) and sets `heapBytesPerItem` to the heap growth of
+/// the first over `count` items.
 ///
-/// Every build starts as it would in a fresh process: the previous build is freed and the heap
-/// trimmed (malloc_trim returns free pages to the kernel) before the clock starts. A build's
-/// time at 10^6 follows the fresh pages it first writes (about 11 us a page on the VM of
-/// docs/results/index-builds.md), so without this a build that reused pages an earlier
-/// benchmark had freed ran up to 2x faster than the same build in a process of its own, and
-/// which structure got them depended on the order the benchmarks ran in. [control]
+/// Each run starts from a trimmed heap, as in a fresh process: the heap is trimmed
+/// (malloc_trim returns free pages to the kernel) before the first build, so that build pays
+/// for every page it first writes whatever ran before it. A build's time at 10^6 follows the
+/// fresh pages it touches (about 11 us a page on the VM of docs/results/index-builds.md);
+/// without the trim a build that got the pages an earlier benchmark had freed ran up to 2x
+/// faster than the same build in a process of its own, and which structure got them depended
+/// on the order the benchmarks ran in. The run's later builds each free the previous one
+/// first and reuse what the allocator kept, as a program that builds again does (at 10^3
+/// items a fresh build is mostly page faults). [control]
 template <class Build>
 auto buildLoop(benchmark::State& state, std::size_t count, double& heapBytesPerItem,
                Build&& build) {
@@ -48,7 +51,9 @@ auto buildLoop(benchmark::State& state, std::size_t count, double& heapBytesPerI
     for (auto _ : state) {
         state.PauseTiming();
         last.reset();
-        malloc_trim(0);
+        if (first) {
+            malloc_trim(0);
+        }
         const std::size_t before = heapBytesInUse();
         state.ResumeTiming();
         auto built = build();

@@ -13,8 +13,8 @@
 //                fcl-obbrss   fcl::collide of BVHModel<OBBRSS> with a sphere of radius r
 //                             (triangles that really touch the sphere, up to 10^5 contacts).
 //              Counter: candidates per query (what each hands on).
-//   mesh-build one build per iteration (wall clock, each from a trimmed heap: buildLoop in
-//              HeapUsage.h): hapto's index over the scene's triangle items (2 TBB threads),
+//   mesh-build one build per iteration (wall clock, each run from a trimmed heap: buildLoop
+//              in HeapUsage.h): hapto's index over the scene's triangle items (2 TBB threads),
 //              Bullet's BVH, FCL's OBBRSS tree; counters bytes_per_triangle (hapto:
 //              IndexStats bytes; the others: heap growth).
 //   mesh-tick  the servo path's full tick (HapticTick: locate, candidates, god-object render,
