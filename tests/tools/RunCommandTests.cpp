@@ -130,11 +130,15 @@ TEST_CASE("hapto run refuses what cannot work before any device starts, and writ
                         std::filesystem::directory_iterator()) == 2);
 }
 
-TEST_CASE("hapto run drives devices at 20 kHz", "[threads]") {
+TEST_CASE("hapto run drives devices at 20 kHz", "[realtime]") {
+    // On the wall clock, alone: under a sanitizer, with other tests keeping both cores busy,
+    // this run once exited 1 (a device faulted and was not recovered within the 0.3 s; most
+    // likely the watchdog, 50 ms without a tick, with the reopen 1 s later).
     TempDir dir;
     const CommandResult r =
         runHapto("run --rate 20000 --duration 0.3 --no-realtime --quiet --report " +
                  (dir / "r.json").string());
+    INFO(r.output);
     REQUIRE(r.exitCode == 0);
     const json j = json::parse(readFile(dir / "r.json"));
     for (const json& d : j["devices"]) {
