@@ -19,8 +19,10 @@
 /// then edges, each when first needed) into mTriangleData, and a second list in the same tick
 /// (the friction solve's) meets them in the same order, so it reads nothing again.
 ///
-/// Cost. One pass over the spans (an item an earlier span holds is skipped by a binary search
-/// of that sorted leaf list); two dot products reject most triangles by their plane; a corner
+/// Cost. One pass over the spans (an item already read is skipped: a table of the items read
+/// since the list was built, open-addressed and keyed by the build's number so a new list
+/// empties it without clearing; past kSeenFull items, a binary search of the earlier, sorted
+/// leaf lists); two dot products reject most triangles by their plane; a corner
 /// well inside the ball spares the closest-point test. A tick solved again over more spans
 /// (extendNextUpdate) reads only the new ones: the spans are read in order, so the list so
 /// extended is the one a build over all of them gives. No allocation.
@@ -177,7 +179,34 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
     mNearTriangles = false;
     mNearSpans = 0;
     mNearTriangleItems = 0;
+    mSeenCount = 0;
+    if (++mSeenBuild == 0) { // a wrap every 2^32 builds: the old numbers must not match
+        mSeen.fill(0);
+        mSeenBuild = 1;
+    }
     addNearSpans(scene, candidates, tested);
+}
+
+bool GodObjectRenderer::seenBefore(const CandidateSet& candidates, std::size_t s,
+                                   std::uint32_t item) noexcept {
+    const std::uint64_t key = (std::uint64_t{mSeenBuild} << 32) | item;
+    // Fibonacci hashing into kSeenSlots (2^8) slots, linear probing.
+    std::size_t slot = (item * 2654435769u) >> 24;
+    for (;; slot = (slot + 1) % kSeenSlots) {
+        const std::uint64_t there = mSeen[slot];
+        if (there == key) {
+            return true;
+        }
+        if ((there >> 32) != mSeenBuild) {
+            break; // an empty slot: not recorded this build
+        }
+    }
+    if (mSeenCount < kSeenFull) {
+        mSeen[slot] = key;
+        ++mSeenCount;
+        return false;
+    }
+    return listedEarlier(candidates, s, item);
 }
 
 bool GodObjectRenderer::extendsNearSpans(const CandidateSet& candidates) const noexcept {
@@ -206,7 +235,7 @@ void GodObjectRenderer::addNearSpans(const Scene& scene, const CandidateSet& can
             if (mNearOverflow) {
                 break;
             }
-            if (listedEarlier(candidates, s, item) || skipItem(scene, item)) {
+            if (seenBefore(candidates, s, item) || skipItem(scene, item)) {
                 continue;
             }
             if (isTriangleItem(item)) {

@@ -64,7 +64,8 @@
 /// per near item (slab clipping in the box frame, a quadratic for a sphere, a plane crossing and
 /// three edge tests for a triangle, after a plane test that rejects most; a box or sphere whose
 /// skin's bounding box the pass's segment misses, up to the nearest entry found so far, ends at
-/// six comparisons; every pose, matrix, radius and triangle plane comes precomputed from the
+/// six comparisons, and a triangle whose skin plane it reaches only beyond that entry ends at
+/// its plane test; every pose, matrix, radius and triangle plane comes precomputed from the
 /// scene's render copy). Worst case per tick: 2 solves x maxIterations x near items; typically
 /// 2-3 passes over 1-5 objects or a handful of triangles. A tick solved again over more spans
 /// (extendNextUpdate) reads only those spans into its near list. No allocation: the near list
@@ -83,7 +84,7 @@ namespace hapto {
 
 using namespace godobject;
 
-static_assert(sizeof(GodObjectRenderer) == 10240, "update the size in GodObjectRenderer.h");
+static_assert(sizeof(GodObjectRenderer) == 12288, "update the size in GodObjectRenderer.h");
 static_assert(alignof(GodObjectRenderer) == 64);
 
 namespace {

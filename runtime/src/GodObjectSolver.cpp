@@ -75,7 +75,9 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
     // The bounding box of the segment up to the nearest entry found so far: a box or sphere
     // whose skin's bounding box it misses cannot be entered before that (the entry test's
     // surface lies kShrinkM inside that skin, far more than rounding), so most of a long near
-    // list ends at six comparisons, and once a hit is found, so do the items beyond it.
+    // list ends at six comparisons, and once a hit is found, so do the items beyond it. A
+    // triangle's test likewise skips its edge tests when its skin plane lies beyond that hit
+    // (an entry is kept only when strictly nearer).
     Vec3 mid = 0.5 * (from + to);
     Vec3 half = 0.5 * glm::abs(to - from);
     forEachNear(scene, candidates, [&](std::uint32_t item, std::uint32_t near) {
@@ -84,13 +86,13 @@ GodObjectRenderer::Hit GodObjectRenderer::sweep(const Scene& scene, const Candid
             const NearTriangle& t = mTriangleData[near];
             e = sweepTriangleFront(
                 t.face.normal, t.face.offset, [&]() -> const NearTriangle& { return t; }, from, to,
-                kSkinM, kShrinkM, kOnM);
+                kSkinM, kShrinkM, kOnM, best.t);
         } else if (isTriangleItem(item)) {
             const WorldFace tp = faceAt(scene, item);
             e = sweepTriangleFront(
                 tp.normal, tp.offset,
                 [&] { return fetchTriangle(cornersAt(scene, item), tp.normal); }, from, to, kSkinM,
-                kShrinkM, kOnM);
+                kShrinkM, kOnM, best.t);
         } else {
             const RenderBody& o = bodyAt(scene, item);
             const Vec3 reach = half + (o.axisAligned ? o.halfExtents : Vec3(o.radius)) + kSkinM;

@@ -585,3 +585,72 @@ TEST_CASE("a tick solved again over more candidate spans gives what a fresh solv
     INFO("candidates read: " << readExtending << " extending, " << readFresh << " afresh");
     CHECK(readExtending < 0.8 * readFresh);
 }
+
+TEST_CASE("the near list reads a candidate once however many spans list it and past its table "
+          "of items read too, and forgets them from tick to tick") {
+    // Neighbouring leaves list the items that straddle them; the renderer reads each item once
+    // per near list (a table of the items read, then a search of the earlier spans once the
+    // table is full) and a new list forgets the last one's. Six sorted spans hold every one of
+    // 480 cubes twice, so each list reads more items than the table holds; every tick must give
+    // what one span listing each cube once, in the order first read, gives.
+    RandomOptions options;
+    options.count = 480;
+    options.seed = 3;
+    options.rotate = true;
+    options.cubeSize = 0.015;
+    const Scene scene = makeRandomScene(options);
+    const std::vector<std::uint32_t> items = test::indexedItems(scene);
+    std::array<std::vector<std::uint32_t>, 6> parts;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        parts[i % 6].push_back(items[i]);
+        parts[(i + 1) % 6].push_back(items[i]);
+    }
+    std::vector<std::uint32_t> once;
+    CandidateSet shared;
+    for (auto& part : parts) {
+        std::sort(part.begin(), part.end());
+        for (const std::uint32_t item : part) {
+            if (std::find(once.begin(), once.end(), item) == once.end()) {
+                once.push_back(item);
+            }
+        }
+        shared.add(part);
+    }
+    REQUIRE(once.size() == items.size());
+    CandidateSet single;
+    single.add(once);
+    GodObjectRenderer got, want;
+    hapto::Random rng(9);
+    Vec3 p(0.0, 0.0, 0.1);
+    Vec3 v(0.0);
+    got.reset(p);
+    want.reset(p);
+    std::uint64_t contactTicks = 0;
+    for (int tick = 0; tick < 3000; ++tick) {
+        v += Vec3(rng.normal(), rng.normal(), rng.normal()) * 0.05;
+        if (glm::length(v) > 1.0) {
+            v = glm::normalize(v); // at most 1 mm per tick
+        }
+        p += v * 1e-3;
+        for (int axis = 0; axis < 3; ++axis) { // bounce off the walls, inside the cubes' reach
+            if (std::abs(p[axis]) > 0.1) {
+                p[axis] = std::clamp(p[axis], -0.1, 0.1);
+                v[axis] = -v[axis];
+            }
+        }
+        const RenderOutput a = got.update(scene, shared, p, v, 1e-3);
+        const RenderOutput b = want.update(scene, single, p, v, 1e-3);
+        INFO("tick " << tick);
+        REQUIRE(a.status == b.status);
+        REQUIRE(a.proxy == b.proxy);
+        REQUIRE(a.force == b.force);
+        REQUIRE(a.contactCount == b.contactCount);
+        for (std::uint32_t c = 0; c < a.contactCount; ++c) {
+            REQUIRE(a.contacts[c].slot == b.contacts[c].slot);
+        }
+        REQUIRE(a.objectsTested == 2 * b.objectsTested); // every list read every span
+        contactTicks += a.contactCount > 0;
+    }
+    INFO("ticks in contact: " << contactTicks);
+    CHECK(contactTicks > 300); // the walk touched things
+}

@@ -45,11 +45,13 @@ SweptEntry sweepSphere(const Vec3& center, double radius, const Vec3& from, cons
 ///
 /// The plane comes first (two dot products reject most triangles); `geometry()` (a
 /// TriangleGeometry, or anything with `corners` and `edges`) is called only for a path that
-/// reaches the skin slab, so a caller may fetch the corners lazily. [servo]
+/// reaches the skin slab before `beforeT`, so a caller may fetch the corners lazily, and a
+/// caller that has already found an entry at t = beforeT on this path (an entry is kept only
+/// when it comes strictly earlier) spares the edge tests of every later one. [servo]
 template <class GeometryFn>
 SweptEntry sweepTriangleFront(const Vec3& normal, double offset, GeometryFn&& geometry,
                               const Vec3& from, const Vec3& to, double skinM, double shrinkM,
-                              double crossMarginM) noexcept {
+                              double crossMarginM, double beforeT = 1.0) noexcept {
     if (normal == Vec3(0.0)) {
         return {};
     }
@@ -66,7 +68,7 @@ SweptEntry sweepTriangleFront(const Vec3& normal, double offset, GeometryFn&& ge
         }
         t = (sf - h) / (sf - st);
     }
-    if (t >= 1.0) {
+    if (t >= std::min(beforeT, 1.0)) {
         return {};
     }
     const Vec3 d = to - from;

@@ -19,10 +19,11 @@ namespace hapto {
 /// Ruspini et al. 1997) and Coulomb friction. One instance per device: it holds that device's
 /// proxy and scratch space, shares nothing, and never allocates after construction.
 ///
-/// Size: 10240 bytes (64-byte aligned; checked by a static_assert in the source file), of which
+/// Size: 12288 bytes (64-byte aligned; checked by a static_assert in the source file), of which
 /// 1280 are the near-object scratch list, 6912 the tick's copy of its first 32 candidate
-/// triangles (plane, corners, edges: 216 bytes each) and 1608 the points the proxy visited
-/// (visitedPath). A tick solved again restores only the 296-byte State.
+/// triangles (plane, corners, edges: 216 bytes each), 2048 the table of the candidates a near
+/// list has read (so an item two leaves list is read once) and 1608 the points the proxy
+/// visited (visitedPath). A tick solved again restores only the 296-byte State.
 class alignas(64) GodObjectRenderer {
 public:
     /// Constraint planes solved at once (a corner needs three).
@@ -168,6 +169,10 @@ private:
         TriangleEdges edges; ///< Its edges in its plane.
     };
     static constexpr std::uint32_t kNotCached = 0xffffffffu;
+    /// Slots of the table of candidates read (mSeen); past kSeenFull items a build looks the
+    /// rest up in the earlier spans instead.
+    static constexpr std::size_t kSeenSlots = 256;
+    static constexpr std::uint32_t kSeenFull = 192;
     /// Where a solve ended.
     struct Solve {
         Vec3 proxy{0.0};
@@ -247,6 +252,9 @@ private:
     /// Lists a box or sphere, or a mesh's triangles, within the ball of `radius` (m).
     void considerObject(const Scene& scene, std::uint32_t item, double radius) noexcept;
     bool addNear(std::uint32_t item) noexcept;
+    /// True when the near list has read `item` since it was built (an earlier span listed it,
+    /// or this one did already), as listedEarlier over span `s` decides; records it otherwise.
+    bool seenBefore(const CandidateSet& candidates, std::size_t s, std::uint32_t item) noexcept;
     /// Distance (m) from p to an item's skin, 0 inside; a cached triangle's (`near` <
     /// kCachedTriangles) from its copy.
     double distanceToSkinOf(const Scene& scene, std::uint32_t item, std::uint32_t near,
@@ -308,6 +316,11 @@ private:
     std::array<std::uint8_t, kMaxNearObjects> mNearCached{};
     std::uint32_t mTriangleCount = 0; ///< mTriangleData entries read this tick.
     std::array<NearTriangle, kCachedTriangles> mTriangleData{};
+    /// The candidates the near list has read since it was built (seenBefore): an open-addressed
+    /// table of (build << 32 | item), so a new build empties it by counting, not by clearing.
+    std::array<std::uint64_t, kSeenSlots> mSeen{};
+    std::uint32_t mSeenBuild = 0; ///< This build's number in mSeen (0: none).
+    std::uint32_t mSeenCount = 0; ///< Items in mSeen this build.
     // Per-tick scratch: where the proxy went (visitedPath).
     std::uint32_t mVisitedCount = 0;
     std::uint32_t mVisitedSecond = 0; ///< Where the friction solve's points begin.
