@@ -58,15 +58,6 @@ bool listedEarlier(const CandidateSet& candidates, std::size_t s, std::uint32_t 
 
 } // namespace
 
-const RenderBody& GodObjectRenderer::bodyAt(const Scene& scene, std::uint32_t slot) const noexcept {
-    if (mDynamic != nullptr && mDynamic->count > 0) {
-        if (const DynamicBodySet::Entry* e = mDynamic->find(slot)) {
-            return e->render;
-        }
-    }
-    return scene.body(slot);
-}
-
 void GodObjectRenderer::poseAt(const Scene& scene, std::uint32_t slot, Vec3& center,
                                Quat& rotation) const noexcept {
     const DynamicBodySet::Entry* e = mDynamic != nullptr ? mDynamic->find(slot) : nullptr;

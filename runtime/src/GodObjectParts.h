@@ -60,6 +60,18 @@ std::uint32_t firstTriangleItem(const Scene& scene, std::uint32_t slot) noexcept
 
 namespace hapto {
 
+/// Defined here, not with the other poses in GodObjectNearList.cpp, so that every pass's loop
+/// over the near list inlines it.
+inline const RenderBody& GodObjectRenderer::bodyAt(const Scene& scene,
+                                                   std::uint32_t slot) const noexcept {
+    if (mDynamic != nullptr && mDynamic->count > 0) {
+        if (const DynamicBodySet::Entry* e = mDynamic->find(slot)) {
+            return e->render;
+        }
+    }
+    return scene.body(slot);
+}
+
 /// The mesh walk: visits (calls fn(item) for) every triangle of the mesh in `slot` within
 /// `radius` + the skin of `center` (m, world), in the mesh's own frame through its local BVH
 /// (TriangleMesh::forEachTriangleNear): one point transformed, no triangle copied, no
