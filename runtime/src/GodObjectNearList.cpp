@@ -180,8 +180,10 @@ void GodObjectRenderer::buildNear(const Scene& scene, const CandidateSet& candid
 
 bool GodObjectRenderer::seenBefore(const CandidateSet& candidates, std::size_t s,
                                    std::uint32_t item) noexcept {
+    // Fibonacci hashing into the 2^8 slots, linear probing; the table never fills (at most
+    // kSeenFull < kSeenSlots entries a build), so every probe ends at an empty slot.
+    static_assert(kSeenSlots == 256 && kSeenFull < kSeenSlots);
     const std::uint64_t key = (std::uint64_t{mSeenBuild} << 32) | item;
-    // Fibonacci hashing into kSeenSlots (2^8) slots, linear probing.
     std::size_t slot = (item * 2654435769u) >> 24;
     for (;; slot = (slot + 1) % kSeenSlots) {
         const std::uint64_t there = mSeen[slot];
