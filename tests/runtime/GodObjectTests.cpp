@@ -562,14 +562,7 @@ TEST_CASE("a tick solved again over more candidate spans gives what a fresh solv
         const RenderOutput got = extending.update(scene, all, p, v, 1e-3);
         const RenderOutput want = fresh.update(scene, all, p, v, 1e-3);
         INFO("tick " << tick << ", first solve over " << k << " spans");
-        REQUIRE(got.status == want.status);
-        REQUIRE(got.proxy == want.proxy);
-        REQUIRE(got.force == want.force);
-        REQUIRE(got.contactCount == want.contactCount);
-        for (std::uint32_t c = 0; c < got.contactCount; ++c) {
-            REQUIRE(got.contacts[c].slot == want.contacts[c].slot);
-            REQUIRE(got.contacts[c].normal == want.contacts[c].normal);
-        }
+        test::requireSameOutput(got, want);
         // It reads the new spans, plus a full list only when the kept one does not cover
         // this solve (the friction solve's tight triangle list, say).
         std::size_t added = 0;
@@ -641,13 +634,7 @@ TEST_CASE("the near list reads a candidate once however many spans list it and p
         const RenderOutput a = got.update(scene, shared, p, v, 1e-3);
         const RenderOutput b = want.update(scene, single, p, v, 1e-3);
         INFO("tick " << tick);
-        REQUIRE(a.status == b.status);
-        REQUIRE(a.proxy == b.proxy);
-        REQUIRE(a.force == b.force);
-        REQUIRE(a.contactCount == b.contactCount);
-        for (std::uint32_t c = 0; c < a.contactCount; ++c) {
-            REQUIRE(a.contacts[c].slot == b.contacts[c].slot);
-        }
+        test::requireSameOutput(a, b);
         REQUIRE(a.objectsTested == 2 * b.objectsTested); // every list read every span
         contactTicks += a.contactCount > 0;
     }

@@ -3,6 +3,8 @@
 
 #include "hapto/runtime/GodObjectRenderer.h"
 
+#include <catch2/catch.hpp>
+
 #include <cstdint>
 #include <numeric>
 #include <vector>
@@ -42,6 +44,19 @@ inline RenderOutput stroke(GodObjectRenderer& r, const RenderRig& rig, const Vec
         out = r.update(rig.scene, c, p, (to - from) * (1000.0 / steps), 1e-3);
     }
     return out;
+}
+
+/// Requires two ticks' outputs to be the same, bit for bit: status, proxy, force, and each
+/// contact's item and normal.
+inline void requireSameOutput(const RenderOutput& got, const RenderOutput& want) {
+    REQUIRE(got.status == want.status);
+    REQUIRE(got.proxy == want.proxy);
+    REQUIRE(got.force == want.force);
+    REQUIRE(got.contactCount == want.contactCount);
+    for (std::uint32_t c = 0; c < got.contactCount; ++c) {
+        REQUIRE(got.contacts[c].slot == want.contacts[c].slot);
+        REQUIRE(got.contacts[c].normal == want.contacts[c].normal);
+    }
 }
 
 /// Resets at `from` and strokes to `to`.
