@@ -647,7 +647,9 @@ TEST_CASE("unplugged and plugged back in, the same device opens again and drives
     emu.setEncoders(a.encoders);
     FalconDevice dev("left", noHoming(), 5.0);
     dev.setTimeouts(testTimeouts());
-    const auto drive = [&](DeviceStatus until) {
+    // Reads and writes 0.5 N every millisecond until `seen` holds, then stops. The force must be
+    // looked for while it is written: 10 ms after the last write the I/O thread sends zero.
+    const auto driveUntil = [&](const auto& seen) {
         std::atomic<bool> stop{false};
         std::atomic<DeviceStatus> last{DeviceStatus::NotOpen};
         std::thread servo([&] {
@@ -658,15 +660,18 @@ TEST_CASE("unplugged and plugged back in, the same device opens again and drives
                 std::this_thread::sleep_for(1ms);
             }
         });
-        const bool seen = eventually([&] { return last.load() == until; });
+        const bool held = eventually([&] { return seen(last.load()); });
         stop = true;
         servo.join();
-        return seen;
+        return held;
+    };
+    const auto reaches = [](DeviceStatus until) {
+        return [until](DeviceStatus last) { return last == until; };
     };
     REQUIRE_OPEN(dev);
-    REQUIRE(drive(DeviceStatus::Ok));
+    REQUIRE(driveUntil(reaches(DeviceStatus::Ok)));
     emu.unplug();
-    REQUIRE(drive(DeviceStatus::Disconnected));
+    REQUIRE(driveUntil(reaches(DeviceStatus::Disconnected)));
     dev.close();
     CHECK(dev.open() != DeviceStatus::Ok); // still away: open says so, and does not hang
     dev.close();
@@ -674,14 +679,14 @@ TEST_CASE("unplugged and plugged back in, the same device opens again and drives
     emu.replug();
     const std::size_t sentBefore = emu.commandCount();
     REQUIRE_OPEN(dev);
-    REQUIRE(drive(DeviceStatus::Ok));
+    CHECK(driveUntil([&](DeviceStatus last) {
+        const auto c = emu.commands();
+        return last == DeviceStatus::Ok && c.size() > sentBefore &&
+               c.back().motor != MotorWords{0, 0, 0};
+    }));
     DeviceState s;
     REQUIRE(dev.read(s) == DeviceStatus::Ok);
     CHECK(glm::length(s.position - (a.mechPosition - kOrigin)) < 1e-9); // the same pose
-    CHECK(eventually([&] {
-        const auto c = emu.commands();
-        return c.size() > sentBefore && c.back().motor != MotorWords{0, 0, 0};
-    }));
     dev.close();
     CHECK(emu.commands().back().motor == MotorWords{0, 0, 0}); // zero at close
 }
