@@ -38,40 +38,42 @@
 //   cell, are left out: fewer items, a lower floor, still a floor. The groups are looked for
 //   only when the ceiling passes the limit (under it the build fits whatever the floor says),
 //   so a build that fits pays nothing for them.
-// - distinct cells: items that do not overlap but sit closer than a level's cells (a lattice
+// - cell counts: items that do not overlap but sit closer than a level's cells (a lattice
 //   with 0.5 mm gaps) split every cell spanning a gap, few per pair, so the largest group says
-//   little. When the floor with it still fits the limit, the search runs again and every
-//   box's best group marks its cells (at most kMarkCells a level) on one bitmap per level
-//   below kMarkLevels, and the level's set bits, distinct split cells, add up: at 10^6 such
-//   cubes the floor is 3.7 x 10^7 nodes where the largest group gave 265. With M > 1 a box
-//   with no group sharing volume marks a near group instead: the following boxes whose gaps
-//   to the group stay under a grid cell, taken greedily, once more than M (a cell spanning
-//   the gaps lists them all: a lattice's corners).
-// - cell counts: each box marks one group, so at M > 1 a lattice's cells spanning its gaps
-//   along the edges (three or four cubes each) are mostly missed, and boxes larger than a
-//   grid cell (five large overlapping boxes) are in no group. When the floor still fits,
-//   every cell of the levels below kCountLevels counts the boxes that touch it (strictly, as
-//   the groups' cells): each box adds +1 and -1 at the eight corners of its cell range in a
-//   difference array, and prefix sums along the three axes give every cell's count, O(1) a
-//   box whatever its size. Cells counted over M are the level's splits, exactly what the
-//   boxes force there; a cell whose parent is counted over M is a node, and its count is a
-//   floor of its list. At 10^6 cubes with 0.5 mm gaps and M = 8 the floor is the real tree's
-//   1 884 745 nodes; at M = 2 it rises from 1.2 x 10^7 to 2.5 x 10^7.
+//   little, and boxes larger than a grid cell (five large overlapping boxes) are in no group.
+//   When the floor with the groups still fits, every cell of the levels below kCountLevels
+//   counts the boxes that touch it (strictly, as the groups' cells), exactly: each level is
+//   swept along z, a plane's 2D difference array holding the (x, y) rectangles of the boxes
+//   whose z range holds the slice (each box added at its first slice and taken out after its
+//   last, O(1) whatever its size), and the plane's prefix sums are the slice's counts. Cells
+//   counted over M are the level's splits, exactly what the boxes force there; a cell whose
+//   parent is counted over M is a node, and its count is a floor of its list. At 10^6 cubes
+//   with 0.5 mm gaps and M = 8 the floor is the real tree's 1 884 745 nodes.
 // - level checks: a tree of few nodes can still be refused for its wide levels, where the
 //   build holds per-node arrays and long lists while it makes the next. The build's check
 //   after it places level l counts octreeBuildBytes of its nodes through level l + 1, the
-//   level's nodes, its lists' entries and the next level's; with a split floor s(l) > 0 (so
-//   the build gets there) these are at least the floor's nodes through l plus 8 s(l),
-//   max(8 s(l - 1), s(l)), the larger of (M + 1) s(l) and the counted lists of level l, and
-//   the counted lists of level l + 1. The floor in bytes is the larger of that, over the
-//   levels, and what the finished tree holds.
+//   level's nodes, its lists' entries, the leaf slots so far and the next level's entries;
+//   with a split floor s(l) > 0 (so the build gets there) these are at least the floor's nodes
+//   through l plus 8 s(l), max(8 s(l - 1), s(l)), and for the lists the larger of two floors:
+//   (M + 1) s(l) or the counted lists of level l, with the counted lists of level l + 1; or
+//   the counted tiles. The counted cells that are nodes but not counted over M (tiles) tile
+//   the bounds with level l's nodes, and the real tree's leaves above l and nodes at l tile
+//   each of them, listing at least its count (a box touching a cell touches one of its
+//   children). A tile above l costs at least a leaf slot per count (8 bytes: a leaf, or level
+//   l's lists and their children's); one at l, at least the smaller of a leaf's slots and
+//   entries (13 bytes a count) and a split node's more than M entries and its children's
+//   lists. At 10^6 cubes with 0.5 mm gaps the tiles are exactly the real leaves and lists
+//   (12 091 904 entries through depth 8), and the floor at M = 4 is 99 % of the build's
+//   check. The floor in bytes is the larger of that, over the levels, and what the finished
+//   tree holds.
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
 // Cost: O(items * levels) time; memory per item (at most kPairItems of them) one inner box
-// and its sort key (32 bytes, 32 MB at 10^6 items), none per node; the second search's
-// bitmaps, 8^l bits at level l, 19 MB for levels 0 to 9; then the cell counts, (2^l + 1)^3
-// bytes a level, 19.6 MB for levels 0 to 8, and 8^l bits for two levels at a time, O(boxes +
-// cells) per level.
+// and its sort key (32 bytes, 32 MB at 10^6 items), none per node; then for the cell counts
+// per box its cell range and its place in two orders by z (20 bytes), a plane of (2^l + 1)^2
+// counters per slab of slices (8 slabs in parallel, 1 MB each at level 9), and 8^l bits of
+// the previous level (2 MB at level 8; the last level's are not kept); O(boxes + cells) per
+// level, 1.5 x 10^8 cells through level 9.
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/SpatialIndex.h"
@@ -82,7 +84,6 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <bit>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -98,9 +99,9 @@ std::uint64_t octreeBuildBytes(const OctreeBuildFigures& f) noexcept {
     constexpr std::uint64_t kPerNode = 2 * sizeof(OctreeNode) + 1; // + 2 * 4 B per 8 siblings
     std::uint64_t b = mulSat(f.items, kPerItem);
     b = addSat(b, mulSat(f.nodes, kPerNode));
-    b = addSat(b, mulSat(addSat(f.slots, 1), 2 * sizeof(std::uint32_t)));
-    b = addSat(b, mulSat(f.levelEntries, sizeof(std::uint32_t) + 1));
-    b = addSat(b, mulSat(f.nextEntries, sizeof(std::uint32_t)));
+    b = addSat(b, mulSat(addSat(f.slots, 1), kSlotBytes));
+    b = addSat(b, mulSat(f.levelEntries, kLevelEntryBytes));
+    b = addSat(b, mulSat(f.nextEntries, kNextEntryBytes));
     b = addSat(b, mulSat(addSat(f.levelNodes, 1), 12 + 8 * sizeof(std::uint64_t)));
     return b;
 }
@@ -412,172 +413,242 @@ float groupGridCell(const Scene& scene, const IndexSpec& spec, const Aabb& b, st
     return std::max(1.25f * sample[sample.size() / 2], std::ldexp(1.0f, -20));
 }
 
-/// Levels whose groups' distinct cells are counted on a bitmap of 8^l bits (16 MB at 9).
-constexpr int kMarkLevels = 10;
-/// Cells of one group's shared box marked per level at most (any subset keeps a floor).
-constexpr std::uint64_t kMarkCells = 64;
+/// Levels whose cells are counted (the note's cell counts): 2^27 cells at level 9, swept one
+/// z slice at a time.
+constexpr int kCountLevels = 10;
 
-/// Sets the bits of up to kMarkCells level-l cells in [first, last] (per axis).
-void markCells(std::span<std::uint64_t> bits, int l, const std::array<std::uint64_t, 3>& first,
-               const std::array<std::uint64_t, 3>& last) {
-    std::uint64_t marked = 0;
-    for (std::uint64_t z = first[2]; z <= last[2]; ++z) {
-        for (std::uint64_t y = first[1]; y <= last[1]; ++y) {
-            for (std::uint64_t x = first[0]; x <= last[0]; ++x) {
-                if (++marked > kMarkCells) {
-                    return;
-                }
-                const std::uint64_t cell = (z << (2 * l)) | (y << l) | x;
-                const std::uint64_t bit = std::uint64_t(1) << (cell & 63);
-                std::atomic_ref<std::uint64_t> word(bits[cell >> 6]);
-                if ((word.load(std::memory_order_relaxed) & bit) == 0) {
-                    word.fetch_or(bit, std::memory_order_relaxed);
-                }
-            }
-        }
+/// A box's cell range at the deepest counted level, per axis [lo, hi] (at most 2^9 cells).
+struct CellRange {
+    std::array<std::uint16_t, 3> lo;
+    std::array<std::uint16_t, 3> hi;
+};
+
+/// One level's counted cells: those over m (splits), the counts of the cells whose parent is
+/// over m (listed: nodes of the real tree), of those of them at m or under (tiles) and the
+/// bytes those tiles' lists cost a check of their own level at least (tileBytes: a leaf's
+/// list is a level's entries and slots, a list that splits is over m level entries and its
+/// children's lists hold the count at least).
+struct SweptLevel {
+    std::uint64_t splits = 0;
+    std::uint64_t listed = 0;
+    std::uint64_t tiles = 0;
+    std::uint64_t tileBytes = 0;
+};
+
+/// The boxes' indices in `ranges` ordered by z0(range), by counting (0 <= z0 < slots), and in
+/// `first` where each slot's run begins (slots + 1 entries).
+template <class Z>
+std::vector<std::uint32_t> orderByZ(std::span<const CellRange> ranges, std::size_t slots,
+                                    std::vector<std::uint32_t>& first, Z z0) {
+    first.assign(slots + 1, 0);
+    for (const CellRange& r : ranges) {
+        ++first[z0(r) + 1];
     }
+    for (std::size_t z = 0; z < slots; ++z) {
+        first[z + 1] += first[z];
+    }
+    std::vector<std::uint32_t> order(ranges.size());
+    std::vector<std::uint32_t> next(first.begin(), first.end() - 1);
+    for (std::uint32_t i = 0; i < ranges.size(); ++i) {
+        order[next[z0(ranges[i])]++] = i;
+    }
+    return order;
 }
 
-/// Per level below min(levels, kMarkLevels), a bitmap of the cells that every box of some
-/// marked group touches. Each is a split cell of the real tree and distinct cells are distinct
-/// nodes, so unlike the largest group's count these add up. Marked with relaxed atomic ORs:
-/// the same bits on any number of threads.
-class CellMarks {
+/// One level's cell counts (the note's cell counts), swept along z: a plane's 2D difference
+/// array holds the (x, y) rectangles of the boxes whose z range holds the slice, each box
+/// added at its first slice and taken out after its last, and the plane's prefix sums are the
+/// slice's counts. O(boxes + cells), (2^l + 1)^2 counters a slab of slices; the slabs run in
+/// parallel and their sums add up, the same on any number of threads.
+class LevelSweep {
 public:
-    explicit CellMarks(int levels) : mLevels(std::min(levels, kMarkLevels)) {
-        for (int l = 0; l < mLevels; ++l) {
-            mBits[l].resize(((std::uint64_t(1) << (3 * l)) + 63) / 64);
+    /// Level l from the boxes' ranges at level `deepest`; `parentOver`: level l - 1's bits of
+    /// cells over m; `over` (when not null) gets level l's.
+    LevelSweep(std::span<const CellRange> ranges, int deepest, int l, std::uint32_t m,
+               const std::vector<std::uint64_t>& parentOver, std::vector<std::uint64_t>* over)
+        : mRanges(ranges), mShift(deepest - l), mLevel(l), mSide(std::size_t(1) << l), mM(m),
+          mParentOver(parentOver), mOver(over) {
+        mStarts = orderByZ(ranges, mSide, mStartAt, [this](const CellRange& r) { return z0(r); });
+        mEnds = orderByZ(ranges, mSide, mEndAt, [this](const CellRange& r) { return z1(r); });
+        if (mOver) {
+            mOver->assign((mSide * mSide * mSide + 63) / 64, 0);
         }
     }
 
-    /// Marks the cells of every level that all boxes sharing [lo, hi] touch (groupRange).
-    void mark(const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
-        std::array<std::uint64_t, 3> first, last;
-        for (int l = 0; l < mLevels; ++l) {
-            if (groupRange(lo, hi, l, first, last)) {
-                markCells(mBits[l], l, first, last);
-            }
-        }
-    }
-
-    /// Per level, the cells marked.
-    LevelCells counts() const {
-        LevelCells cells{};
-        for (int l = 0; l < mLevels; ++l) {
-            for (const std::uint64_t w : mBits[l]) {
-                cells[l] += static_cast<std::uint64_t>(std::popcount(w));
-            }
-        }
-        return cells;
+    SweptLevel run() const {
+        // Slabs of whole slices: a slice is a multiple of 64 cells from level 2 on, so the
+        // slabs set disjoint words of `over`.
+        const std::size_t slabs = mSide >= 64 ? 8 : 1;
+        SweptLevel out;
+        std::mutex merge;
+        parallel::forEach(0, slabs, 1, [&](std::size_t k) {
+            const SweptLevel part = slab(mSide * k / slabs, mSide * (k + 1) / slabs);
+            const std::lock_guard<std::mutex> lock(merge);
+            out.splits += part.splits;
+            out.listed += part.listed;
+            out.tiles += part.tiles;
+            out.tileBytes += part.tileBytes;
+        });
+        return out;
     }
 
 private:
-    int mLevels;
-    std::array<std::vector<std::uint64_t>, kMarkLevels> mBits;
+    std::size_t z0(const CellRange& r) const { return r.lo[2] >> mShift; }
+    std::size_t z1(const CellRange& r) const { return r.hi[2] >> mShift; }
+
+    /// Adds (sign 1) or takes out (-1) a box's (x, y) rectangle.
+    void place(std::vector<std::int32_t>& plane, const CellRange& r, std::int32_t sign) const {
+        const std::size_t n = mSide + 1;
+        const std::size_t x0 = r.lo[0] >> mShift, x1 = (r.hi[0] >> mShift) + 1;
+        const std::size_t y0 = r.lo[1] >> mShift, y1 = (r.hi[1] >> mShift) + 1;
+        plane[y0 * n + x0] += sign;
+        plane[y0 * n + x1] -= sign;
+        plane[y1 * n + x0] -= sign;
+        plane[y1 * n + x1] += sign;
+    }
+
+    /// The counts of slices [first, end).
+    SweptLevel slab(std::size_t first, std::size_t end) const {
+        std::vector<std::int32_t> plane((mSide + 1) * (mSide + 1), 0);
+        for (std::uint32_t i = 0; i < mStartAt[first]; ++i) { // begun before the slab
+            if (z1(mRanges[mStarts[i]]) >= first) {
+                place(plane, mRanges[mStarts[i]], 1);
+            }
+        }
+        SweptLevel out;
+        std::vector<std::int64_t> column(mSide);
+        for (std::size_t z = first; z < end; ++z) {
+            for (std::uint32_t i = mStartAt[z]; i < mStartAt[z + 1]; ++i) {
+                place(plane, mRanges[mStarts[i]], 1);
+            }
+            std::fill(column.begin(), column.end(), 0);
+            for (std::size_t y = 0; y < mSide; ++y) {
+                row(plane.data() + y * (mSide + 1), z, y, column, out);
+            }
+            for (std::uint32_t i = mEndAt[z]; i < mEndAt[z + 1]; ++i) {
+                place(plane, mRanges[mEnds[i]], -1); // out after its last slice
+            }
+        }
+        return out;
+    }
+
+    /// Row y of slice z: `column` holds the sums of the rows before it, per x.
+    void row(const std::int32_t* diff, std::size_t z, std::size_t y,
+             std::vector<std::int64_t>& column, SweptLevel& out) const {
+        constexpr std::uint64_t kLeafBytes = detail::kSlotBytes + detail::kLevelEntryBytes;
+        const std::uint64_t splitBytes = detail::kLevelEntryBytes * (std::uint64_t(mM) + 1);
+        const std::size_t half = mSide / 2;
+        const std::size_t parentRow = ((z / 2) * half + y / 2) * half;
+        std::int64_t run = 0;
+        for (std::size_t x = 0; x < mSide; ++x) {
+            run += diff[x];
+            column[x] += run;
+            const auto count = static_cast<std::uint64_t>(column[x]);
+            const std::size_t parent = parentRow + x / 2;
+            if (mLevel == 0 || ((mParentOver[parent >> 6] >> (parent & 63)) & 1)) {
+                out.listed += count; // a node: it lists at least its count
+                if (count <= mM) {
+                    out.tiles += count;
+                    out.tileBytes +=
+                        std::min(kLeafBytes * count, splitBytes + detail::kNextEntryBytes * count);
+                }
+            }
+            if (count > mM) {
+                ++out.splits;
+                if (mOver) {
+                    const std::size_t cell = (z * mSide + y) * mSide + x;
+                    (*mOver)[cell >> 6] |= std::uint64_t(1) << (cell & 63);
+                }
+            }
+        }
+    }
+
+    std::span<const CellRange> mRanges;
+    int mShift;
+    int mLevel;
+    std::size_t mSide;
+    std::uint32_t mM;
+    const std::vector<std::uint64_t>& mParentOver;
+    std::vector<std::uint64_t>* mOver;
+    std::vector<std::uint32_t> mStarts, mStartAt, mEnds, mEndAt;
 };
 
-/// Levels whose cells are counted (the note's cell counts): 17 MB of counters at level 8.
-constexpr int kCountLevels = 9;
+/// The cell counts' lists (the note's cell counts), per level counted: `nodes`, the counts of
+/// the cells whose parent is counted over M, each a node of the real tree listing at least its
+/// count; `tiles` and `tileBytes`, the part of them counted M or less (SweptLevel). Those
+/// cells above a level and that level's nodes tile the bounds, and the real tree's leaves
+/// above it and nodes at it tile each of them (a cell's boxes each touch one of its children).
+struct CountedLists {
+    LevelCells nodes{};
+    LevelCells tiles{};
+    LevelCells tileBytes{};
+    int levels = 0;
 
-/// row[x] += from[x] (mod 256) for x < n.
-void addRow(std::uint8_t* row, const std::uint8_t* from, std::size_t n) {
-    for (std::size_t x = 0; x < n; ++x) {
-        row[x] = static_cast<std::uint8_t>(row[x] + from[x]);
-    }
-}
-
-/// Turns a difference array of n^3 byte counters into its prefix sums along x, then y, then
-/// z (mod 256): each pass reads rows in memory order.
-void prefixSums(std::uint8_t* d, std::size_t n) {
-    for (std::size_t r = 0; r < n * n; ++r) {
-        std::uint8_t* row = d + r * n;
-        for (std::size_t x = 1; x < n; ++x) {
-            row[x] = static_cast<std::uint8_t>(row[x] + row[x - 1]);
+    /// At least what the leaf slots and the lists cost a build's check after it places level
+    /// l (octreeBuildBytes): a tile above l is covered by leaves (kSlotBytes an entry) or by
+    /// level-l nodes (their entries and their children's, or slots); a tile at l costs its
+    /// tileBytes; a cell at l counted over M splits, and its children are counted below it.
+    std::uint64_t listBytes(int l) const {
+        if (levels == 0) {
+            return 0;
         }
-    }
-    for (std::size_t z = 0; z < n; ++z) {
-        for (std::size_t y = 1; y < n; ++y) {
-            addRow(d + (z * n + y) * n, d + (z * n + y - 1) * n, n);
+        const int last = std::min(l, levels - 1);
+        std::uint64_t above = 0;
+        for (int k = 0; k < last; ++k) {
+            above = addSat(above, tiles[k]);
         }
-    }
-    for (std::size_t z = 1; z < n; ++z) {
-        for (std::size_t y = 0; y < n; ++y) {
-            addRow(d + (z * n + y) * n, d + ((z - 1) * n + y) * n, n);
+        if (l > last) { // not counted at l: the last level's nodes are tiles above l
+            return mulSat(detail::kSlotBytes, addSat(above, nodes[last]));
         }
+        const std::uint64_t next = l + 1 < levels ? nodes[l + 1] : 0;
+        return addSat(addSat(mulSat(detail::kSlotBytes, above), tileBytes[l]),
+                      addSat(mulSat(detail::kLevelEntryBytes, nodes[l] - tiles[l]),
+                             mulSat(detail::kNextEntryBytes, next)));
     }
-}
+};
 
 /// Per level below min(levels, kCountLevels), the cells that more than m boxes touch
-/// (strictly, as groupRange): each lists those items, so it splits, and so did its ancestors.
-/// Each box adds +1 and -1 at the eight corners of its cell range in a difference array of
-/// (2^l + 1)^3 counters, whose prefix sums along x, y and z are then every cell's count: O(1)
-/// per box whatever its size, O(cells) per level, every level's array filled in one pass over
-/// the boxes (19.6 MB for levels 0 to 8, each freed once summed). The counters are bytes and
-/// the sums exact modulo 256, so a cell that 256 boxes or more touch may count as fewer: a
-/// lower floor, still a floor. One thread, the same counts on any machine.
+/// (strictly, as groupRange): each lists those items, so it splits, and so did its ancestors;
+/// the levels' lists go to `lists`. A box's cell range at a level is its range at the deepest
+/// one shifted (floor(lo 2^l) and ceil(hi 2^l) - 1 halve with the cells); each level is swept
+/// along z (LevelSweep). A box with no cell at the deepest level is left out: still a floor.
+/// Exact counts, the same on any number of threads. Before the last level, which has 7/8 of
+/// the cells, `more(splits, lists)` says whether to count it (false: the floor so far is
+/// already past the limit).
+template <class More>
 LevelCells countedSplits(std::span<const CellKey> records, std::uint32_t m, int levels,
-                         LevelCells& entries) {
+                         CountedLists& lists, const More& more) {
     LevelCells splits{};
-    if (m >= 0xff) {
+    const int count = std::min(levels, kCountLevels);
+    if (count == 0) {
         return splits;
     }
-    // One pass over the boxes fills every level's difference array: a box's cell range at a
-    // level is its range at the deepest one shifted (floor(lo 2^l) and ceil(hi 2^l) - 1 halve
-    // with the cells). A box with no cell at the deepest level is left out: still a floor.
-    const int count = std::min(levels, kCountLevels);
-    std::array<std::vector<std::uint8_t>, kCountLevels> diff;
-    for (int l = 0; l < count; ++l) {
-        const std::size_t n = (std::size_t(1) << l) + 1; // counters per axis
-        diff[l].assign(n * n * n, 0);
-    }
+    std::vector<CellRange> ranges;
+    ranges.reserve(records.size());
     std::array<std::uint64_t, 3> lo, hi;
     for (const CellKey& k : records) {
-        if (count == 0 || k.box.empty() || !groupRange(k.box.lo, k.box.hi, count - 1, lo, hi)) {
-            continue;
-        }
-        for (int l = 0; l < count; ++l) {
-            const int shift = count - 1 - l;
-            const std::size_t n = (std::size_t(1) << l) + 1;
-            for (int corner = 0; corner < 8; ++corner) {
-                const std::size_t x = corner & 1 ? (hi[0] >> shift) + 1 : lo[0] >> shift;
-                const std::size_t y = corner & 2 ? (hi[1] >> shift) + 1 : lo[1] >> shift;
-                const std::size_t z = corner & 4 ? (hi[2] >> shift) + 1 : lo[2] >> shift;
-                std::uint8_t& c = diff[l][(z * n + y) * n + x];
-                c = static_cast<std::uint8_t>(std::popcount(unsigned(corner)) % 2 == 0 ? c + 1
-                                                                                       : c - 1);
+        if (!k.box.empty() && groupRange(k.box.lo, k.box.hi, count - 1, lo, hi)) {
+            CellRange r;
+            for (int a = 0; a < 3; ++a) {
+                r.lo[a] = static_cast<std::uint16_t>(lo[a]);
+                r.hi[a] = static_cast<std::uint16_t>(hi[a]);
             }
+            ranges.push_back(r);
         }
     }
     std::vector<std::uint64_t> parentOver, over; // a bit per cell counted over m
     for (int l = 0; l < count; ++l) {
-        const std::size_t n = (std::size_t(1) << l) + 1;
-        std::vector<std::uint8_t>& counts = diff[l];
-        std::uint8_t* const d = counts.data();
-        prefixSums(d, n);
-        // A cell whose parent is counted over m is a node: it lists at least its count.
-        const std::size_t side = n - 1, half = side / 2;
-        over.assign((side * side * side + 63) / 64, 0);
-        std::uint64_t split = 0, listed = 0;
-        for (std::size_t z = 0; z < side; ++z) {
-            for (std::size_t y = 0; y < side; ++y) {
-                const std::uint8_t* row = d + (z * n + y) * n;
-                for (std::size_t x = 0; x < side; ++x) {
-                    const std::size_t parent = ((z / 2) * half + y / 2) * half + x / 2;
-                    if (l == 0 || ((parentOver[parent >> 6] >> (parent & 63)) & 1)) {
-                        listed += row[x];
-                    }
-                    if (row[x] > m) {
-                        const std::size_t cell = (z * side + y) * side + x;
-                        over[cell >> 6] |= std::uint64_t(1) << (cell & 63);
-                        ++split;
-                    }
-                }
-            }
+        if (l > 0 && l + 1 == count && !more(splits, lists)) {
+            break;
         }
-        splits[l] = split;
-        entries[l] = listed;
+        const SweptLevel level =
+            LevelSweep(ranges, count - 1, l, m, parentOver, l + 1 < count ? &over : nullptr).run();
+        splits[l] = level.splits;
+        lists.nodes[l] = level.listed;
+        lists.tiles[l] = level.tiles;
+        lists.tileBytes[l] = level.tileBytes;
         parentOver.swap(over);
-        counts = std::vector<std::uint8_t>(); // its memory back before the next level's sums
+        lists.levels = l + 1;
     }
     return splits;
 }
@@ -590,22 +661,19 @@ constexpr int kRows[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
 /// (the rows' first keys grow with i's key).
 class GroupSearch {
 public:
-    /// With `marks` the search also marks every group it finds (the second pass).
-    GroupSearch(std::span<const CellKey> keys, float cell, std::uint32_t m, CellMarks* marks)
-        : mKeys(keys), mCell(cell), mM(m), mMarks(marks) {}
+    GroupSearch(std::span<const CellKey> keys, float cell, std::uint32_t m)
+        : mKeys(keys), mCell(cell), mM(m) {}
 
-    /// Finds the best group of box i (the most shared volume), keeps it when it is among the
-    /// kKeep best of the search so far, and marks it (with M > 1, when no group shares volume,
-    /// the near group).
+    /// Finds the best group of box i (the most shared volume) and keeps it when it is among
+    /// the kKeep best of the search so far.
     void run(std::size_t i) {
         const std::uint64_t k = mKeys[i].key;
         const std::uint64_t x = k & (kAxisCells - 1), y = (k >> 21) & (kAxisCells - 1);
         const std::uint64_t z = k >> 42;
         mBest = -1.0f;
         mMembers = 1;
-        mNearMembers = 1;
-        mLo = mNearLo = mKeys[i].box.lo;
-        mHi = mNearHi = mKeys[i].box.hi;
+        mLo = mKeys[i].box.lo;
+        mHi = mKeys[i].box.hi;
         mChecks = 0;
         scan(i + 1, packCell(std::min(x + 1, kAxisCells - 1), y, z));
         for (int r = 0; r < 4 && mMembers <= mM; ++r) {
@@ -626,13 +694,7 @@ public:
             }
             scan(j, packCell(std::min(x + 1, kAxisCells - 1), ry, rz));
         }
-        if (mMarks != nullptr && mBest < 0.0f && mNearMembers > mM) {
-            mMarks->mark(mNearLo, mNearHi); // marked, not kept: no shared volume
-        }
         if (mBest >= 0.0f) {
-            if (mMarks != nullptr) {
-                mMarks->mark(mBestLo, mBestHi);
-            }
             Group* worst = &mKept[0];
             for (Group& g : mKept) {
                 worst = g.score < worst->score ? &g : worst;
@@ -655,9 +717,7 @@ public:
 private:
     // Boxes [j, ...) up to key `last`: M = 1 keeps the nearest pair (the most shared volume, a
     // gap under a sixteenth of a cell counting as a thin overlap); M > 1 narrows the shared
-    // box greedily and keeps it once it has more than M members, and beside it a near group:
-    // boxes whose gaps to the group stay under a grid cell (cells spanning the gaps list them
-    // all, a lattice's corners).
+    // box greedily and keeps it once it has more than M members.
     void scan(std::size_t j, std::uint64_t last) {
         for (; j < mKeys.size() && mKeys[j].key <= last && mChecks < kPairChecks; ++j) {
             ++mChecks;
@@ -685,30 +745,12 @@ private:
                     return;
                 }
             }
-            if (mMarks != nullptr && mM > 1 && mNearMembers <= mM) {
-                takeNear(other);
-            }
         }
-    }
-
-    void takeNear(const UnitBox& other) {
-        std::array<float, 3> lo, hi;
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = std::max(mNearLo[a], other.lo[a]);
-            hi[a] = std::min(mNearHi[a], other.hi[a]);
-            if (!(hi[a] - lo[a] > -mCell)) {
-                return;
-            }
-        }
-        mNearLo = lo;
-        mNearHi = hi;
-        ++mNearMembers;
     }
 
     std::span<const CellKey> mKeys;
     float mCell;
     std::uint32_t mM;
-    CellMarks* mMarks;
     // The groups kept: evaluating each box's group at every level would cost more than finding
     // it, and the largest shared volumes give the largest counts where the counts are large.
     static constexpr std::size_t kKeep = 16;
@@ -719,9 +761,9 @@ private:
     std::array<Group, kKeep> mKept{};
     static constexpr std::size_t kUnset = std::numeric_limits<std::size_t>::max();
     std::array<std::size_t, 4> mCursor{kUnset, kUnset, kUnset, kUnset};
-    std::array<float, 3> mLo{}, mHi{}, mBestLo{}, mBestHi{}, mNearLo{}, mNearHi{};
+    std::array<float, 3> mLo{}, mHi{}, mBestLo{}, mBestHi{};
     float mBest = -1.0f;
-    std::uint32_t mMembers = 1, mNearMembers = 1;
+    std::uint32_t mMembers = 1;
     int mChecks = 0;
 };
 
@@ -752,9 +794,8 @@ std::span<const CellKey> sortRecords(std::vector<CellKey>& keys) {
 }
 
 /// Per level, the most cells any kept group of more than M items' inner boxes touches (the
-/// note's groups), over the sorted records; with `marks`, every box's group is marked too.
-LevelCells groupFloor(std::span<const CellKey> sorted, float cell, std::uint32_t m, int levels,
-                      CellMarks* marks) {
+/// note's groups), over the sorted records.
+LevelCells groupFloor(std::span<const CellKey> sorted, float cell, std::uint32_t m, int levels) {
     LevelCells most{};
     std::mutex merge;
     // Fixed blocks of boxes, each keeping its own groups: the same floor on any number of
@@ -763,7 +804,7 @@ LevelCells groupFloor(std::span<const CellKey> sorted, float cell, std::uint32_t
     const std::size_t used = sorted.size();
     parallel::forEach(0, (used + kBlock - 1) / kBlock, 1, [&](std::size_t block) {
         LevelCells part{};
-        GroupSearch search(sorted, cell, m, marks);
+        GroupSearch search(sorted, cell, m);
         for (std::size_t i = block * kBlock; i < std::min(used, (block + 1) * kBlock); ++i) {
             search.run(i);
         }
@@ -804,21 +845,25 @@ std::uint64_t floorBytes(std::uint64_t items, std::uint64_t nodes) {
 /// At least what the build's own check counts after it places a level (the note's level
 /// checks): at level l with a split floor s(l) > 0 (the level is reached) the tree then holds
 /// at least the floor's nodes through l plus 8 s(l) children, the level has at least
-/// max(8 s(l - 1), s(l)) nodes, its lists at least max((M + 1) s(l), listed[l]) entries (each
-/// split node lists more than M items; `listed`: the cell counts' lists, or zeros) and the
-/// next level's at least listed[l + 1].
+/// max(8 s(l - 1), s(l)) nodes, and its lists and slots either at least (M + 1) s(l) and the
+/// counted nodes' lists entries (each split node lists more than M items) and the next
+/// level's the counted nodes' lists of level l + 1, or what CountedLists::listBytes says
+/// (`lists`: the cell counts, or none); each is a floor, so the larger is.
 std::uint64_t levelChecksFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int levels,
-                               const LevelCells& groups, const LevelCells& entries) {
+                               const LevelCells& groups, const CountedLists& lists) {
     std::uint64_t through = 1, width = 1, most = 0;
     for (int l = 0; l < levels; ++l) {
         const std::uint64_t splits = splitsFloor(c, b, m, l, groups);
         const std::uint64_t children = mulSat(8, splits);
         if (splits > 0) {
-            const std::uint64_t next = l + 1 < kLevels ? entries[l + 1] : 0;
-            most =
-                std::max(most, detail::octreeBuildBytes(
-                                   {c.items, addSat(through, children), 0, std::max(width, splits),
-                                    std::max(mulSat(m + 1, splits), entries[l]), next}));
+            const std::uint64_t nodes = addSat(through, children), wide = std::max(width, splits);
+            const std::uint64_t counted = l < lists.levels ? lists.nodes[l] : 0;
+            const std::uint64_t next = l + 1 < lists.levels ? lists.nodes[l + 1] : 0;
+            const std::uint64_t listed = detail::octreeBuildBytes(
+                {c.items, nodes, 0, wide, std::max(mulSat(m + 1, splits), counted), next});
+            const std::uint64_t tiled = addSat(
+                detail::octreeBuildBytes({c.items, nodes, 0, wide, 0, 0}), lists.listBytes(l));
+            most = std::max({most, listed, tiled});
         }
         through = addSat(through, children);
         width = children;
@@ -828,38 +873,37 @@ std::uint64_t levelChecksFloor(const LevelCounts& c, const Aabb& b, std::uint64_
 
 /// The floor in bytes: what the finished tree holds, or the most a level's check counts.
 std::uint64_t bytesFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, int levels,
-                         const LevelCells& groups, const LevelCells& entries = {}) {
+                         const LevelCells& groups, const CountedLists& lists = {}) {
     return std::max(floorBytes(c.items, nodesFloor(c, b, m, levels, groups)),
-                    levelChecksFloor(c, b, m, levels, groups, entries));
+                    levelChecksFloor(c, b, m, levels, groups, lists));
 }
 
-/// The groups' split cells per level below `levels` (the note's groups): the largest kept
-/// group's, and when the floor with them still fits the limit, the groups' distinct cells.
+/// The split cells per level below `levels`: the largest kept group's (the note's groups),
+/// and when the floor with them still fits the limit, the counted cells (the note's cell
+/// counts, whose lists go to `lists`).
 LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
-                       const LevelCounts& c, int levels, LevelCells& entries) {
+                       const LevelCounts& c, int levels, CountedLists& lists) {
     const std::uint64_t m = static_cast<std::uint64_t>(std::max(spec.maxObjects, 1));
     const float cell =
         groupGridCell(scene, spec, b, std::min<std::size_t>(scene.itemCount(), kPairItems));
     std::vector<CellKey> records = groupRecords(scene, spec, b, cell);
     const std::span<const CellKey> sorted = sortRecords(records);
     const auto mm = static_cast<std::uint32_t>(m);
-    LevelCells groups = groupFloor(sorted, cell, mm, levels, nullptr);
+    LevelCells groups = groupFloor(sorted, cell, mm, levels);
     if (bytesFloor(c, b, m, levels, groups) <= spec.maxBytes) {
-        // Not refused yet: search again, marking every box's group, and add the distinct cells.
-        CellMarks marks(levels);
-        (void)groupFloor(sorted, cell, mm, levels, &marks);
-        const LevelCells distinct = marks.counts();
-        for (int l = 0; l < levels; ++l) {
-            groups[l] = std::max(groups[l], distinct[l]);
-        }
-    }
-    if (bytesFloor(c, b, m, levels, groups) <= spec.maxBytes) {
-        // Still not refused: count every shallow cell's boxes (the note's cell counts), down
-        // to the level below the last that splits (its lists are that level's next entries).
-        const LevelCells counted = countedSplits(records, mm, levels + 1, entries);
-        for (int l = 0; l < levels; ++l) {
-            groups[l] = std::max(groups[l], counted[l]);
-        }
+        // Not refused yet: count every shallow cell's boxes (the note's cell counts), down to
+        // the level below the last that splits (its lists are that level's next entries).
+        const auto withCounts = [&](const LevelCells& counted) {
+            LevelCells more = groups;
+            for (int l = 0; l < levels; ++l) {
+                more[l] = std::max(more[l], counted[l]);
+            }
+            return more;
+        };
+        const auto fits = [&](const LevelCells& counted, const CountedLists& sofar) {
+            return bytesFloor(c, b, m, levels, withCounts(counted), sofar) <= spec.maxBytes;
+        };
+        groups = withCounts(countedSplits(records, mm, levels + 1, lists, fits));
     }
     return groups;
 }
@@ -888,7 +932,8 @@ IndexMemoryEstimate estimateOctree(const Scene& scene, const IndexSpec& spec) {
     // under it the build fits whatever the floor says, and pays neither the inner counts nor
     // the group pass.
     const int splitting = std::min(reached, splitLevels);
-    LevelCells groups{}, listed{};
+    LevelCells groups{};
+    CountedLists listed;
     if (e.atMostBytes > spec.maxBytes) {
         c.add(countLevels(scene, spec, b, splitLevels + 1, CountPass::Inner));
         groups = groupSplits(scene, spec, b, c, splitting, listed);

@@ -37,6 +37,12 @@ struct OctreeBuildFigures {
     std::uint64_t nextEntries = 0;  ///< Entries of the next level's lists (0 before known).
 };
 
+/// octreeBuildBytes's bytes per leaf slot (the slots twice: a growing vector copies them), per
+/// entry of the level's lists (its id and mask) and per entry of the next level's (its id).
+inline constexpr std::uint64_t kSlotBytes = 2 * sizeof(std::uint32_t);
+inline constexpr std::uint64_t kLevelEntryBytes = sizeof(std::uint32_t) + 1;
+inline constexpr std::uint64_t kNextEntryBytes = sizeof(std::uint32_t);
+
 /// The most memory an octree build holds at that step (bytes, saturating): per item its id,
 /// outside flag and entry, local id, 192-byte shape, Morton key and flags; every node (40 B)
 /// and its parent share twice, and every slot twice (a vector growing by one level copies the

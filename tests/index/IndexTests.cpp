@@ -453,8 +453,9 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
     }
     // At M = 4 and 6 only cells spanning gaps in all three axes split: few nodes, but the
     // levels the build starts are wide and their lists long. The build's own check as it starts
-    // a level, bounded from the split floor, takes the floor in bytes past half the real peak
-    // (the finished tree's nodes and items alone are about a third of it).
+    // a level, bounded from the split floor and the counted tiles' lists and slots, takes the
+    // floor in bytes to within 5 % of the real peak (99 %; 90 % without the tiles, which leave
+    // the leaf slots out; the finished tree's nodes and items alone are about a third of it).
     for (const int m : {4, 6}) {
         INFO("M = " << m);
         IndexSpec wide = IndexSpec::octree(m, 1e-9);
@@ -464,7 +465,7 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
         wide.maxBytes = estimateIndexMemory(near, wide).atMostBytes - 1;
         const std::uint64_t floor = estimateIndexMemory(near, wide).atLeastBytes;
         CHECK(floor <= peak);
-        CHECK(floor >= peak / 2);
+        CHECK(floor >= peak - peak / 20);
     }
 
     // Against real builds: scenes that overlap densely, here and there, touch or nearly touch,
