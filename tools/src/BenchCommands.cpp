@@ -116,67 +116,36 @@ struct QueryArgs {
     std::uint64_t maxIndexMb = IndexSpec::kDefaultMaxMegabytes;
 };
 
-void runQuery(const QueryArgs& args) {
-    std::vector<std::string> texts = args.indices;
-    if (texts.empty()) {
-        texts = {"brute", "grid:5", std::string(kDefaultIndexSpec)};
-    }
-    std::vector<Target> targets;
-    for (const std::string& t : texts) {
-        targets.push_back(parseTarget(t));
-    }
-    const std::size_t steps = args.steps;
-    const Scene scene = loadSceneOrDefault(args.scene);
-
-    std::vector<std::unique_ptr<Run>> runs;
-    for (const Target& t : targets) {
-        auto run = std::make_unique<Run>();
-        run->target = t;
-        run->index = buildIndex(scene, t.spec.withMaxMegabytes(args.maxIndexMb));
-        run->cursor = Cursor(*run->index, t.strategy);
-        run->nsPerQuery.reserve(steps / args.batch + steps / kBlockSteps + 2);
-        runs.push_back(std::move(run));
-    }
-
-    // The same walk for every index: generated a block at a time, each block run by every
-    // index in turn (starting with a different one each block), each cursor going on from
-    // where its previous block left it.
-    experiments::HandWalk walk(scene.bounds(), args.seed);
-    std::vector<Vec3> block(kBlockSteps);
-    for (std::size_t done = 0, round = 0; done < steps; ++round) {
-        const std::size_t length = std::min(kBlockSteps, steps - done);
-        for (std::size_t k = 0; k < length; ++k) {
-            block[k] = walk.next();
-        }
-        for (std::size_t r = 0; r < runs.size(); ++r) {
-            Run& run = *runs[(r + round) % runs.size()];
-            std::uint64_t locateSteps = 0, candidates = 0, touched = 0;
-            for (std::size_t b = 0; b < length; b += args.batch) {
-                const std::size_t end = std::min(length, b + args.batch);
-                const auto t0 = Clock::now();
-                for (std::size_t k = b; k < end; ++k) {
-                    const LocateResult res = run.cursor.locate(block[k]);
-                    for (const std::uint32_t slot : res.candidates) {
-                        touched += slot;
-                    }
-                    locateSteps += res.steps;
-                    candidates += res.candidates.size();
-                }
-                const auto t1 = Clock::now();
-                keep(touched);
-                const auto batchNs = static_cast<double>(
-                    std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
-                run.nsPerQuery.push_back(batchNs / static_cast<double>(end - b));
-                run.totalNs += batchNs;
+/// Runs `block` through `run`'s cursor in batches of `batch` queries, each batch timed.
+void queryBlock(Run& run, std::span<const Vec3> block, std::size_t batch) {
+    std::uint64_t locateSteps = 0, candidates = 0, touched = 0;
+    for (std::size_t b = 0; b < block.size(); b += batch) {
+        const std::size_t end = std::min(block.size(), b + batch);
+        const auto t0 = Clock::now();
+        for (std::size_t k = b; k < end; ++k) {
+            const LocateResult res = run.cursor.locate(block[k]);
+            for (const std::uint32_t slot : res.candidates) {
+                touched += slot;
             }
-            run.steps += length;
-            run.locateSteps += locateSteps;
-            run.candidates += candidates;
-            run.touched += touched;
+            locateSteps += res.steps;
+            candidates += res.candidates.size();
         }
-        done += length;
+        const auto t1 = Clock::now();
+        keep(touched);
+        const auto batchNs = static_cast<double>(
+            std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
+        run.nsPerQuery.push_back(batchNs / static_cast<double>(end - b));
+        run.totalNs += batchNs;
     }
+    run.steps += block.size();
+    run.locateSteps += locateSteps;
+    run.candidates += candidates;
+    run.touched += touched;
+}
 
+/// Prints (or as JSON) each run's build, per-query time and work.
+void printQueries(const QueryArgs& args, const Scene& scene,
+                  const std::vector<std::unique_ptr<Run>>& runs) {
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
     if (!args.json) {
         std::printf("scene:   %s, %u objects\n",
@@ -184,7 +153,7 @@ void runQuery(const QueryArgs& args) {
                     scene.size());
         std::printf("walk:    %zu steps of 1 ms, seed %llu, <= 0.5 m/s (<= 0.5 mm per step), "
                     "mirrored at the bounds\n",
-                    steps, static_cast<unsigned long long>(args.seed));
+                    args.steps, static_cast<unsigned long long>(args.seed));
         std::printf("timing:  steady_clock around batches of %zu queries (per-query ns = batch "
                     "/ %zu); indices interleaved in blocks of %zu steps; one clock reading "
                     "costs ~%.0f ns\n\n",
@@ -222,6 +191,46 @@ void runQuery(const QueryArgs& args) {
     if (args.json) {
         std::cout << out.dump(2) << "\n";
     }
+}
+
+void runQuery(const QueryArgs& args) {
+    std::vector<std::string> texts = args.indices;
+    if (texts.empty()) {
+        texts = {"brute", "grid:5", std::string(kDefaultIndexSpec)};
+    }
+    std::vector<Target> targets;
+    for (const std::string& t : texts) {
+        targets.push_back(parseTarget(t));
+    }
+    const std::size_t steps = args.steps;
+    const Scene scene = loadSceneOrDefault(args.scene);
+
+    std::vector<std::unique_ptr<Run>> runs;
+    for (const Target& t : targets) {
+        auto run = std::make_unique<Run>();
+        run->target = t;
+        run->index = buildIndex(scene, t.spec.withMaxMegabytes(args.maxIndexMb));
+        run->cursor = Cursor(*run->index, t.strategy);
+        run->nsPerQuery.reserve(steps / args.batch + steps / kBlockSteps + 2);
+        runs.push_back(std::move(run));
+    }
+
+    // The same walk for every index: generated a block at a time, each block run by every
+    // index in turn (starting with a different one each block), each cursor going on from
+    // where its previous block left it.
+    experiments::HandWalk walk(scene.bounds(), args.seed);
+    std::vector<Vec3> block(kBlockSteps);
+    for (std::size_t done = 0, round = 0; done < steps; ++round) {
+        const std::size_t length = std::min(kBlockSteps, steps - done);
+        for (std::size_t k = 0; k < length; ++k) {
+            block[k] = walk.next();
+        }
+        for (std::size_t r = 0; r < runs.size(); ++r) {
+            queryBlock(*runs[(r + round) % runs.size()], {block.data(), length}, args.batch);
+        }
+        done += length;
+    }
+    printQueries(args, scene, runs);
 }
 
 // ---- `hapto bench tick` ----------------------------------------------------------------------
@@ -662,14 +671,8 @@ void runTick(const TickArgs& args) {
     }
 }
 
-} // namespace
-
-void addBenchCommands(CLI::App& app) {
-    CLI::App* bench =
-        app.add_subcommand("bench", "Measure the speed of the spatial indices and the servo tick");
-    bench->require_subcommand(1);
-    setExamples(bench, {"hapto bench query --steps 1e5", "hapto bench tick --ticks 5000"});
-
+/// `hapto bench query`.
+void addQueryCommand(CLI::App* bench) {
     auto args = std::make_shared<QueryArgs>();
     auto* cmd = bench->add_subcommand(
         "query",
@@ -707,7 +710,39 @@ void addBenchCommands(CLI::App& app) {
                       "hapto bench query --scene million.hsb --index octree:2:0.005@climb "
                       "--index grid:20 --json"});
     cmd->callback([args] { runQuery(*args); });
+}
 
+/// `hapto bench tick --motion` and the options that go with it.
+void addMotionOptions(CLI::App* tick, TickArgs& targs) {
+    tick->add_option(
+        "--motion", targs.motions,
+        "Instead of one scene's walk, adversarial hand motions, each over its own "
+        "generated scene, repeatable: rest (the baseline: resting 0.5 mm inside a "
+        "cube's face), walk (the walk held at 2 mm), trapped (the walk deep in "
+        "dense cubes, never held back), sweep (straight lines at 1 m/s through the "
+        "cubes), graze (along cube edges and across vertices), sphere (sliding over "
+        "a fine-faceted sphere), slabs (through 20 thin slabs at 1 m/s), body (resting "
+        "on a dynamic box that swings under the hand), or all. "
+        "Reports per motion the tick's p50, p99, p99.9 and max, p99.9 over rest's, "
+        "and the work that explains them: solves, solver passes, candidates, extra "
+        "leaves, pull-backs, facets entered, the slowest tick's counts. Hot mode "
+        "only unless --mode says otherwise; not with --scene, --walk-edge or "
+        "--push-mm");
+    tick->add_flag("--cpu-time", targs.cpuTime,
+                   "With --motion: also read the thread's CPU clock around each tick and report "
+                   "its quantiles, which leave out the time other processes held the core. A "
+                   "system call per tick: on a VM it makes the ticks after it slower (here the "
+                   "resting tick's p50 0.8 -> 2.5 us), so compare such runs only with each "
+                   "other");
+    tick->add_option("--objects", targs.motionSize.objects,
+                     "With --motion: cubes in the cube scenes (the lattice rounds to K^3) and "
+                     "triangles in the sphere, e.g. 1e6")
+        ->capture_default_str()
+        ->transform(wholeNumber(8, 1e7));
+}
+
+/// `hapto bench tick`.
+void addTickCommand(CLI::App* bench) {
     auto targs = std::make_shared<TickArgs>();
     auto* tick = bench->add_subcommand(
         "tick",
@@ -770,31 +805,7 @@ void addBenchCommands(CLI::App& app) {
                      "device, walk_min, walk_max, stages: {read, ...: {ns_p50, ns_p99, ns_p999, "
                      "ns_mean}}, tick: "
                      "{...}, locate_steps_mean, candidates_mean, contact_fraction} to this file");
-    tick->add_option(
-        "--motion", targs->motions,
-        "Instead of one scene's walk, adversarial hand motions, each over its own "
-        "generated scene, repeatable: rest (the baseline: resting 0.5 mm inside a "
-        "cube's face), walk (the walk held at 2 mm), trapped (the walk deep in "
-        "dense cubes, never held back), sweep (straight lines at 1 m/s through the "
-        "cubes), graze (along cube edges and across vertices), sphere (sliding over "
-        "a fine-faceted sphere), slabs (through 20 thin slabs at 1 m/s), body (resting "
-        "on a dynamic box that swings under the hand), or all. "
-        "Reports per motion the tick's p50, p99, p99.9 and max, p99.9 over rest's, "
-        "and the work that explains them: solves, solver passes, candidates, extra "
-        "leaves, pull-backs, facets entered, the slowest tick's counts. Hot mode "
-        "only unless --mode says otherwise; not with --scene, --walk-edge or "
-        "--push-mm");
-    tick->add_flag("--cpu-time", targs->cpuTime,
-                   "With --motion: also read the thread's CPU clock around each tick and report "
-                   "its quantiles, which leave out the time other processes held the core. A "
-                   "system call per tick: on a VM it makes the ticks after it slower (here the "
-                   "resting tick's p50 0.8 -> 2.5 us), so compare such runs only with each "
-                   "other");
-    tick->add_option("--objects", targs->motionSize.objects,
-                     "With --motion: cubes in the cube scenes (the lattice rounds to K^3) and "
-                     "triangles in the sphere, e.g. 1e6")
-        ->capture_default_str()
-        ->transform(wholeNumber(8, 1e7));
+    addMotionOptions(tick, *targs);
     tick->add_option("--mode", targs->modes,
                      "Modes to run, repeatable: hot, sleep, sleep+warm (default: all three; "
                      "with --motion: hot)")
@@ -806,6 +817,17 @@ void addBenchCommands(CLI::App& app) {
         targs->pushMmGiven = tick->count("--push-mm") > 0;
         runTick(*targs);
     });
+}
+
+} // namespace
+
+void addBenchCommands(CLI::App& app) {
+    CLI::App* bench =
+        app.add_subcommand("bench", "Measure the speed of the spatial indices and the servo tick");
+    bench->require_subcommand(1);
+    setExamples(bench, {"hapto bench query --steps 1e5", "hapto bench tick --ticks 5000"});
+    addQueryCommand(bench);
+    addTickCommand(bench);
 }
 
 } // namespace hapto::cli

@@ -538,29 +538,15 @@ int runDemo(const DemoArgs& a) {
     }
     signals.endStartUp(); // a signal from now on stops the demo in order
     Recorders recorders;
-    if (!a.record.empty()) {
-        std::filesystem::create_directories(a.record);
-    }
-    std::vector<RuntimeDevice> devices;
+    std::vector<RuntimeDevice> devices = recordedDevices(file, scene, a.record, recorders);
     std::vector<SimDevice*> sims;
-    for (std::size_t i = 0; i < configs.size(); ++i) {
-        const DeviceConfig& c = configs[i];
-        RuntimeDevice rd{makeDevice(c, scene), c, nullptr, file.renderingOf(i)};
-        if (!a.record.empty()) {
-            recorders.devices.push_back(recorderFor(c, a.record));
-            rd.recorder = recorders.devices.back().get();
-        }
+    for (const RuntimeDevice& rd : devices) {
         sims.push_back(dynamic_cast<SimDevice*>(rd.device.get()));
-        devices.push_back(std::move(rd));
     }
     RuntimeOptions options;
     options.realtime = a.realtime;
     Runtime runtime(world, std::move(devices), options);
-    if (!a.record.empty() && runtime.hasDynamics()) {
-        recorders.bodies = std::make_unique<BodyTraceRecorder>(
-            std::filesystem::path(a.record) / kBodyTraceFileName, runtime.bodyIds(),
-            runtime.dynamicsRateHz());
-    }
+    recordBodies(runtime, a.record, recorders);
     std::optional<GraspController> grasp;
     if (a.kinematic) {
         grasp.emplace(world, runtime, 0, 1);
@@ -583,10 +569,7 @@ int runDemo(const DemoArgs& a) {
     control.controlPeriodNs = 1'000'000;
     control.steppedClock = a.stepped ? &clock : nullptr;
     control.stopRequested = [&signals] { return signals.requested(); };
-    for (const auto& rec : recorders.devices) {
-        control.recorders.push_back(rec.get());
-    }
-    control.bodyRecorder = recorders.bodies.get();
+    recorders.addTo(control);
     Session session(runtime, std::move(control));
     if (session.start() != 2) {
         if (recorders.bodies) {

@@ -203,6 +203,31 @@ RuntimeOptions runtimeOptionsFor(const RunArgs& a) {
     return opt;
 }
 
+/// After the session stopped: writes --report, prints the summary, each device that faulted
+/// and was not driven again (which makes the run a failure: 1) and a stop by signal.
+int finishRun(const RunArgs& a, const RunReport& r, const StopSignals& signals) {
+    if (!a.report.empty()) {
+        writeFileAtomically(a.report, reportToJson(r));
+    }
+    printSummary(r);
+    if (!a.report.empty()) {
+        std::fprintf(stderr, "report written to %s\n", a.report.c_str());
+    }
+    int down = 0;
+    for (const DeviceReport& d : r.devices) {
+        if (!d.fault.empty()) {
+            std::fprintf(stderr, "hapto run: %s faulted and was not recovered: %s\n",
+                         d.name.c_str(), d.fault.c_str());
+            ++down;
+        }
+    }
+    if (signals.requested()) {
+        std::fprintf(stderr, "hapto run: stopped by signal %d; zero force on every device\n",
+                     signals.signalNumber());
+    }
+    return down > 0 ? 1 : 0;
+}
+
 int runSession(const RunArgs& a) {
     // First, before any thread starts (the index build's TBB workers included), so that every
     // thread inherits the blocked stop signals and only the signal thread takes them.
@@ -229,25 +254,8 @@ int runSession(const RunArgs& a) {
     signals.endStartUp();
 
     Recorders recorders;
-    if (!a.record.empty()) {
-        std::filesystem::create_directories(a.record);
-    }
-    std::vector<RuntimeDevice> devices;
-    for (std::size_t i = 0; i < configs.size(); ++i) {
-        const DeviceConfig& c = configs[i];
-        RuntimeDevice rd{makeDevice(c, scene), c, nullptr, file.renderingOf(i)};
-        if (!a.record.empty()) {
-            recorders.devices.push_back(recorderFor(c, a.record));
-            rd.recorder = recorders.devices.back().get();
-        }
-        devices.push_back(std::move(rd));
-    }
-    Runtime runtime(world, std::move(devices), runtimeOptionsFor(a));
-    if (!a.record.empty() && runtime.hasDynamics()) {
-        recorders.bodies = std::make_unique<BodyTraceRecorder>(
-            std::filesystem::path(a.record) / kBodyTraceFileName, runtime.bodyIds(),
-            runtime.dynamicsRateHz());
-    }
+    Runtime runtime(world, recordedDevices(file, scene, a.record, recorders), runtimeOptionsFor(a));
+    recordBodies(runtime, a.record, recorders);
     // A second signal while the orderly stop below is under way (or blocked): zero force
     // now, from the signal thread, and exit. Stepped, this thread never blocks: it sees the
     // first signal, and the step mode's emergency stop belongs to it.
@@ -268,10 +276,7 @@ int runSession(const RunArgs& a) {
     options.durationS = a.durationS;
     options.steppedClock = a.stepped ? &clock : nullptr;
     options.stopRequested = [&signals] { return signals.requested(); };
-    for (const auto& rec : recorders.devices) {
-        options.recorders.push_back(rec.get());
-    }
-    options.bodyRecorder = recorders.bodies.get();
+    recorders.addTo(options);
     Session session(runtime, std::move(options));
     RunReport r;
     {
@@ -299,27 +304,7 @@ int runSession(const RunArgs& a) {
         r = session.stop(); // zero force on every device before anything else
         view.stop();
     }
-    if (!a.report.empty()) {
-        writeFileAtomically(a.report, reportToJson(r));
-    }
-    printSummary(r);
-    if (!a.report.empty()) {
-        std::fprintf(stderr, "report written to %s\n", a.report.c_str());
-    }
-    // A device that faulted and was not driven again by the end makes the run a failure.
-    int down = 0;
-    for (const DeviceReport& d : r.devices) {
-        if (!d.fault.empty()) {
-            std::fprintf(stderr, "hapto run: %s faulted and was not recovered: %s\n",
-                         d.name.c_str(), d.fault.c_str());
-            ++down;
-        }
-    }
-    if (signals.requested()) {
-        std::fprintf(stderr, "hapto run: stopped by signal %d; zero force on every device\n",
-                     signals.signalNumber());
-    }
-    return down > 0 ? 1 : 0;
+    return finishRun(a, r, signals);
 }
 
 } // namespace

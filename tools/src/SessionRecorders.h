@@ -6,6 +6,9 @@
 #include "hapto/devices/DeviceConfig.h"
 #include "hapto/devices/TraceRecorder.h"
 #include "hapto/runtime/BodyTrace.h"
+#include "hapto/runtime/DeviceFile.h"
+#include "hapto/runtime/Runtime.h"
+#include "hapto/runtime/Session.h"
 
 #include <memory>
 #include <string>
@@ -22,6 +25,19 @@ std::unique_ptr<TraceRecorder> recorderFor(const DeviceConfig& c, const std::str
 struct Recorders {
     std::vector<std::unique_ptr<TraceRecorder>> devices; ///< One per device, in device order.
     std::unique_ptr<BodyTraceRecorder> bodies;           ///< Null without dynamics.
+
+    /// The session's recorders in `options` (they are flushed by the session). [control]
+    void addTo(SessionOptions& options) const;
 };
+
+/// The runtime's devices of `file` over `scene` (DeviceFactory's makeDevice, not opened), each
+/// with its `<folder>/<name>.trace` in `recorders` when `folder` is not empty (the folder is
+/// created). [control]
+std::vector<RuntimeDevice> recordedDevices(const DeviceFile& file, const Scene& scene,
+                                           const std::string& folder, Recorders& recorders);
+
+/// `<folder>/bodies.trace` in `recorders` when `folder` is not empty and `runtime` has dynamic
+/// bodies. [control]
+void recordBodies(const Runtime& runtime, const std::string& folder, Recorders& recorders);
 
 } // namespace hapto::cli

@@ -116,12 +116,82 @@ double seconds(const TraceSample& s) {
     return static_cast<double>(s.timeNs) * 1e-9;
 }
 
+/// The spans of time a device was in contact (contact count > 0: version 2 traces), each from
+/// its first sample in contact to its last.
+std::vector<std::pair<double, double>> contactSpans(const std::vector<TraceSample>& samples) {
+    std::vector<std::pair<double, double>> contact;
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+        if (samples[k].contactCount == 0) {
+            continue;
+        }
+        // Extend the last span when this sample follows it, else start one.
+        const double x = seconds(samples[k]);
+        const double step = k > 0 ? x - seconds(samples[k - 1]) : 0.0;
+        if (!contact.empty() && k > 0 && samples[k - 1].contactCount > 0 &&
+            x >= contact.back().first && x - contact.back().second <= step) {
+            contact.back().second = std::max(contact.back().second, x);
+        } else {
+            contact.emplace_back(x, x);
+        }
+    }
+    return contact;
+}
+
+/// One trace's series for tracePlot: position, proxy (version 2 traces) and force per axis,
+/// |F| and tick time, drawn from at most kMaxPlotPoints samples, in device colour `style`:
+/// x, y and z told apart by dash type, |F| solid.
+struct TraceSeries {
+    experiments::PlotSeries position[3], proxy[3], force[4], tick;
+
+    TraceSeries(const std::vector<TraceSample>& samples, const TraceHeader& h,
+                const std::string& device, int style) {
+        const char* axes[3] = {"x", "y", "z"};
+        for (int a = 0; a < 3; ++a) {
+            position[a].title = proxy[a].title = device + " " + axes[a];
+            force[a].title = device + " F" + axes[a];
+            for (experiments::PlotSeries* series : {&position[a], &proxy[a], &force[a]}) {
+                series->linesOnly = true;
+                series->style = style;
+                series->dash = a + 2;
+            }
+            position[a].dash = proxy[a].dash = a + 1;
+        }
+        force[3].title = device + " |F|";
+        tick.title = device;
+        for (experiments::PlotSeries* series : {&force[3], &tick}) {
+            series->linesOnly = true;
+            series->style = style;
+        }
+        const std::size_t stride =
+            std::max<std::size_t>(1, (samples.size() + kMaxPlotPoints - 1) / kMaxPlotPoints);
+        for (std::size_t k = 0; k < samples.size(); k += stride) {
+            add(samples[k], h.version);
+        }
+        if (!samples.empty() && (samples.size() - 1) % stride != 0) {
+            add(samples.back(), h.version); // the last sample always
+        }
+    }
+
+private:
+    void add(const TraceSample& s, int version) {
+        const double x = seconds(s);
+        for (int a = 0; a < 3; ++a) {
+            position[a].points.emplace_back(x, s.positionM[a]);
+            if (version >= 2) {
+                proxy[a].points.emplace_back(x, s.proxyM[a]);
+            }
+            force[a].points.emplace_back(x, s.forceN[a]);
+        }
+        force[3].points.emplace_back(x, glm::length(s.forceN));
+        tick.points.emplace_back(x, static_cast<double>(s.computeNs) * 1e-3);
+    }
+};
+
 /// A figure of traces: position, proxy, force and tick time against time, one colour per
 /// device, shaded where a device was in contact (version 2 traces: contact count > 0).
 experiments::PlotSpec tracePlot(const std::vector<std::string>& paths) {
     using experiments::panel;
     using experiments::PlotPanel;
-    using experiments::PlotSeries;
     experiments::PlotSpec spec;
     spec.name = "trace";
     spec.title = "hapto trace";
@@ -137,10 +207,8 @@ experiments::PlotSpec tracePlot(const std::vector<std::string>& paths) {
     std::vector<int> spanStyles;                  // the device (style) of each
     std::vector<std::string> spanTitles;          // per device: its key text
     double endS = 0;
-    const char* axes[3] = {"x", "y", "z"};
     int style = 0;
     for (const std::string& path : paths) {
-        std::vector<std::pair<double, double>> contact;
         TraceHeader h;
         const std::vector<TraceSample> samples = TraceReader::load(path, &h);
         const std::string device = h.name.empty() ? path : h.name;
@@ -149,70 +217,23 @@ experiments::PlotSpec tracePlot(const std::vector<std::string>& paths) {
         } else if (paths.size() == 1) {
             spec.title = "hapto trace: " + device + " (" + h.kind + ", " + path + ")";
         }
-        const std::size_t stride =
-            std::max<std::size_t>(1, (samples.size() + kMaxPlotPoints - 1) / kMaxPlotPoints);
-        PlotSeries pos[3], prox[3], f[4], t;
-        for (int a = 0; a < 3; ++a) {
-            pos[a].title = device + " " + axes[a];
-            prox[a].title = device + " " + axes[a];
-            f[a].title = device + " F" + axes[a];
-            f[a].dashed = true;
-        }
-        f[3].title = device + " |F|";
-        t.title = device;
-        for (std::size_t k = 0; k < samples.size(); ++k) {
-            const TraceSample& s = samples[k];
-            const double x = seconds(s);
-            if (s.contactCount > 0) {
-                // Extend the last span when this sample follows it, else start one.
-                const double step = k > 0 ? x - seconds(samples[k - 1]) : 0.0;
-                if (!contact.empty() && k > 0 && samples[k - 1].contactCount > 0 &&
-                    x >= contact.back().first && x - contact.back().second <= step) {
-                    contact.back().second = std::max(contact.back().second, x);
-                } else {
-                    contact.emplace_back(x, x);
-                }
-            }
-            if (k % stride != 0 && k + 1 != samples.size()) {
-                continue;
-            }
-            for (int a = 0; a < 3; ++a) {
-                pos[a].points.emplace_back(x, s.positionM[a]);
-                if (h.version >= 2) {
-                    prox[a].points.emplace_back(x, s.proxyM[a]);
-                }
-                f[a].points.emplace_back(x, s.forceN[a]);
-            }
-            f[3].points.emplace_back(x, glm::length(s.forceN));
-            t.points.emplace_back(x, static_cast<double>(s.computeNs) * 1e-3);
-        }
-        // One colour per device (plotColour): x, y and z told apart by dash type, |F| solid.
-        ++style;
+        ++style; // one colour per device (plotColour)
         if (!samples.empty()) {
             endS = std::max(endS, seconds(samples.back()));
         }
-        for (const auto& span : contact) {
+        for (const auto& span : contactSpans(samples)) {
             spans.push_back(span);
             spanStyles.push_back(style);
         }
         spanTitles.push_back(device + " in contact");
+        const TraceSeries series(samples, h, device, style);
         for (int a = 0; a < 3; ++a) {
-            for (PlotSeries* series : {&pos[a], &prox[a], &f[a]}) {
-                series->linesOnly = true;
-                series->style = style;
-                series->dash = a + 2;
-            }
-            pos[a].dash = prox[a].dash = a + 1;
-            position.series.push_back(pos[a]);
-            proxy.series.push_back(prox[a]);
-            force.series.push_back(f[a]);
+            position.series.push_back(series.position[a]);
+            proxy.series.push_back(series.proxy[a]);
+            force.series.push_back(series.force[a]);
         }
-        f[3].linesOnly = true;
-        f[3].style = style;
-        force.series.push_back(f[3]);
-        t.linesOnly = true;
-        t.style = style;
-        tick.series.push_back(t);
+        force.series.push_back(series.force[3]);
+        tick.series.push_back(series.tick);
     }
     char caption[160];
     std::snprintf(caption, sizeof caption,
