@@ -17,7 +17,10 @@
 using namespace hapto::test;
 using nlohmann::json;
 
-TEST_CASE("hapto run writes a report with every field for both default hands", "[threads]") {
+// The cases tagged [realtime] run sessions on the wall clock (the warm-up, the servo threads'
+// groups and the wake-latency request exist only there) and require exit 0, so they run alone:
+// with other tests keeping both cores busy, a stall past the 50 ms watchdog faults a hand.
+TEST_CASE("hapto run writes a report with every field for both default hands", "[realtime]") {
     TempDir dir;
     const CommandResult r =
         runHapto("run --duration 0.5 --no-realtime --quiet --report " + (dir / "r.json").string());
@@ -45,7 +48,7 @@ TEST_CASE("hapto run writes a report with every field for both default hands", "
 }
 
 TEST_CASE("hapto run --warm-us sets the warm-up, 0 turns it off, and the report says so",
-          "[threads]") {
+          "[realtime]") {
     TempDir dir;
     for (const char* us : {"0", "7.5"}) {
         INFO(us);
@@ -132,9 +135,9 @@ TEST_CASE("hapto run refuses what cannot work before any device starts, and writ
 }
 
 TEST_CASE("hapto run drives devices at 20 kHz", "[realtime]") {
-    // On the wall clock, alone: under a sanitizer, with other tests keeping both cores busy,
-    // this run once exited 1 (a device faulted and was not recovered within the 0.3 s; most
-    // likely the watchdog, 50 ms without a tick, with the reopen 1 s later).
+    // Under a sanitizer, with other tests keeping both cores busy, this run once exited 1 (a
+    // device faulted and was not recovered within the 0.3 s; most likely the watchdog, 50 ms
+    // without a tick, with the reopen 1 s later).
     TempDir dir;
     const CommandResult r =
         runHapto("run --rate 20000 --duration 0.3 --no-realtime --quiet --report " +
@@ -149,7 +152,7 @@ TEST_CASE("hapto run drives devices at 20 kHz", "[realtime]") {
 }
 
 TEST_CASE("hapto run --devices-per-thread drives simulated hands in groups, each reported",
-          "[threads]") {
+          "[realtime]") {
     TempDir dir;
     json devices{{"format", "hapto-devices"}, {"version", 1}, {"devices", json::array()}};
     for (int i = 0; i < 5; ++i) {
@@ -196,7 +199,7 @@ TEST_CASE("hapto run refuses bad input with exit code 2 and says where", "[threa
 }
 
 TEST_CASE("hapto run --wake-latency-us holds the request while the hands run, or says why not",
-          "[threads]") {
+          "[realtime]") {
     TempDir dir;
     const CommandResult r = runHapto("run --duration 0.3 --no-realtime --quiet --wake-latency-us 0 "
                                      "--report " +
