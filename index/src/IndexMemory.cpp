@@ -38,6 +38,16 @@
 //   cell, are left out: fewer items, a lower floor, still a floor. The groups are looked for
 //   only when the ceiling passes the limit (under it the build fits whatever the floor says),
 //   so a build that fits pays nothing for them.
+// - shared vertices: a triangle has no inner box, so over a mesh none of the above counts
+//   anything. But a cell that holds a mesh vertex (strictly inside) meets every triangle
+//   around it, so where more than M triangles share the vertex the cell lists them all and
+//   splits, and so did its ancestors, which hold the vertex too: every level's distinct cells
+//   holding such a vertex are splits of the real tree, down to the minimum size. The vertices'
+//   deepest cells as interleaved keys, sorted: two neighbours in key order are in different
+//   cells from the level of their highest differing bit on, so one pass counts every level's
+//   distinct cells. A vertex within 1/1024 of a deepest cell's side of a boundary is left out
+//   (a lower floor, still a floor). Over a 10^6-triangle sphere at M = 4 and MIN 1e-9 the
+//   floor is 4.4 x 10^7 nodes; the build was refused at depth 11 by its own check.
 // - cell counts: items that do not overlap but sit closer than a level's cells (a lattice
 //   with 0.5 mm gaps) split every cell spanning a gap, few per pair, so the largest group says
 //   little, and boxes larger than a grid cell (five large overlapping boxes) are in no group.
@@ -68,7 +78,8 @@
 //   tree holds.
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
-// Cost: O(items * levels) time; memory per item (at most kPairItems of them) one inner box
+// Cost: O(items * levels) time; per mesh vertex shared by more than M triangles 8 bytes and a
+// sort; memory per item (at most kPairItems of them) one inner box
 // and its sort key (32 bytes, 32 MB at 10^6 items), none per node; then for the cell counts
 // per box its cell range and its place in two orders by z (20 bytes), a plane of (2^l + 1)^2
 // counters per slab of slices (8 slabs in parallel, 1 MB each at level 9), and 8^l bits of
@@ -77,6 +88,7 @@
 
 #include "hapto/index/Octree.h"
 #include "hapto/index/SpatialIndex.h"
+#include "hapto/scenes/TriangleMesh.h"
 
 #include "IndexMemory.h"
 #include "Parallel.h"
@@ -84,6 +96,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -878,18 +891,98 @@ std::uint64_t bytesFloor(const LevelCounts& c, const Aabb& b, std::uint64_t m, i
                     levelChecksFloor(c, b, m, levels, groups, lists));
 }
 
-/// The split cells per level below `levels`: the largest kept group's (the note's groups),
-/// and when the floor with them still fits the limit, the counted cells (the note's cell
-/// counts, whose lists go to `lists`).
+/// A point's cell at level kMaxDepth as a key of its three coordinates' bits interleaved, the
+/// coarsest first (a level-l cell is the key's top 3 l bits); false for a point outside the
+/// bounds or within 1/1024 of a deepest cell's side of a cell boundary (so it lies strictly
+/// inside its cell at every level, whatever the build's rounding).
+bool deepCellKey(const Vec3& p, const Aabb& b, std::uint64_t& key) {
+    constexpr double kCells = double(std::uint64_t(1) << Octree::kMaxDepth);
+    std::array<std::uint64_t, 3> q{};
+    for (int a = 0; a < 3; ++a) {
+        const double u = (p[a] - b.min[a]) / (b.max[a] - b.min[a]) * kCells;
+        if (!(u > 0.0 && u < kCells)) {
+            return false;
+        }
+        const double frac = u - std::floor(u);
+        if (frac < 1.0 / 1024 || frac > 1.0 - 1.0 / 1024) {
+            return false;
+        }
+        q[a] = static_cast<std::uint64_t>(u);
+    }
+    key = 0;
+    for (int bit = Octree::kMaxDepth - 1; bit >= 0; --bit) {
+        for (int a = 2; a >= 0; --a) {
+            key = (key << 1) | ((q[a] >> bit) & 1);
+        }
+    }
+    return true;
+}
+
+/// Per level below `levels`, the distinct cells that hold a mesh vertex shared by more than m
+/// of its mesh's triangles (the note's shared vertices): such a cell lists those triangles,
+/// so it splits, and so did its ancestors, which hold the vertex too. O(triangles + vertices
+/// log vertices), 8 bytes per such vertex.
+LevelCells sharedVertexSplits(const Scene& scene, const Aabb& b, std::uint64_t m, int levels) {
+    std::vector<std::uint64_t> keys;
+    std::vector<std::uint32_t> valence;
+    for (std::uint32_t slot = 0; slot < scene.size(); ++slot) {
+        const SceneObject& o = scene.object(slot);
+        if (o.shape != Shape::Mesh || !o.mesh) {
+            continue;
+        }
+        valence.assign(o.mesh->vertices().size(), 0);
+        for (const TriangleIndices& t : o.mesh->triangles()) {
+            for (const std::uint32_t v : t) {
+                ++valence[v];
+            }
+        }
+        std::uint64_t key = 0;
+        for (std::size_t v = 0; v < valence.size(); ++v) {
+            if (valence[v] > m &&
+                deepCellKey(scene.body(slot).toWorld(o.mesh->vertices()[v]), b, key)) {
+                keys.push_back(key);
+            }
+        }
+    }
+    LevelCells cells{};
+    if (keys.empty()) {
+        return cells;
+    }
+    parallel::sort(keys.begin(), keys.end());
+    // Two neighbours in key order first differ at the level of their top differing bit.
+    std::array<std::uint64_t, kLevels + 1> firstApart{};
+    for (std::size_t i = 1; i < keys.size(); ++i) {
+        if (const std::uint64_t diff = keys[i] ^ keys[i - 1]; diff != 0) {
+            ++firstApart[Octree::kMaxDepth - (63 - std::countl_zero(diff)) / 3];
+        }
+    }
+    std::uint64_t distinct = 1;
+    for (int l = 0; l < levels; ++l) {
+        distinct += firstApart[l];
+        cells[l] = distinct;
+    }
+    return cells;
+}
+
+/// The split cells per level below `levels`: those around shared mesh vertices, the largest
+/// kept group's (the note's groups), and when the floor with them still fits the limit, the
+/// counted cells (the note's cell counts, whose lists go to `lists`).
 LevelCells groupSplits(const Scene& scene, const IndexSpec& spec, const Aabb& b,
                        const LevelCounts& c, int levels, CountedLists& lists) {
     const std::uint64_t m = static_cast<std::uint64_t>(std::max(spec.maxObjects, 1));
+    LevelCells shared = sharedVertexSplits(scene, b, m, levels);
+    if (bytesFloor(c, b, m, levels, shared) > spec.maxBytes) {
+        return shared;
+    }
     const float cell =
         groupGridCell(scene, spec, b, std::min<std::size_t>(scene.itemCount(), kPairItems));
     std::vector<CellKey> records = groupRecords(scene, spec, b, cell);
     const std::span<const CellKey> sorted = sortRecords(records);
     const auto mm = static_cast<std::uint32_t>(m);
     LevelCells groups = groupFloor(sorted, cell, mm, levels);
+    for (int l = 0; l < levels; ++l) {
+        groups[l] = std::max(groups[l], shared[l]);
+    }
     if (bytesFloor(c, b, m, levels, groups) <= spec.maxBytes) {
         // Not refused yet: count every shallow cell's boxes (the note's cell counts), down to
         // the level below the last that splits (its lists are that level's next entries).

@@ -5,6 +5,7 @@
 #include "hapto/index/Cursor.h"
 #include "hapto/index/Octree.h"
 #include "hapto/index/UniformGrid.h"
+#include "hapto/scenes/MeshGenerators.h"
 
 #include <catch2/catch.hpp>
 
@@ -508,6 +509,41 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
             }
             CHECK(all.nodesAtLeast <= index->stats().nodes);
             CHECK(all.atLeastBytes <= index->stats().buildPeakBytes);
+        }
+    }
+}
+
+TEST_CASE("a mesh vertex shared by more than M triangles splits every cell around it: the "
+          "octree floor counts those cells and stays a floor") {
+    hapto::test::buildOnOneThread();
+    MeshOptions sphere;
+    sphere.triangles = 2000; // a geodesic sphere: five or six triangles at every vertex
+    const Scene scene = makeMeshScene(sphere);
+    // Down to 1e-9 every cell around a vertex splits to the deepest level: refused by the
+    // floor, before anything is built, not by the build's check some levels down.
+    IndexSpec deep = IndexSpec::octree(4, 1e-9);
+    deep.maxBytes = 8ull << 20;
+    CHECK_THROWS_WITH(buildIndex(scene, deep),
+                      Catch::Contains("at least ") && Catch::Contains("nodes over"));
+    // Against real builds: the floor stays at or under the nodes and the peak accounting; at
+    // M = 4 the shared vertices give over half the real tree (its deep levels are the cells
+    // around the vertices; 77 %), at M = 2 a quarter (cells along the edges split too; 34 %),
+    // at M = 8 none (no vertex has more than six triangles).
+    for (const IndexSpec& spec :
+         {IndexSpec::octree(2, 0.0002), IndexSpec::octree(4, 0.0002),
+          IndexSpec::octree(4, 0.0002, OverlapMode::Aabb), IndexSpec::octree(8, 0.0002)}) {
+        INFO(spec.toString());
+        IndexSpec roomy = spec;
+        roomy.maxBytes = 4ull << 30;
+        const auto index = buildIndex(scene, roomy);
+        IndexSpec tight = spec;
+        tight.maxBytes = 1;
+        tight.maxBytes = estimateIndexMemory(scene, tight).atMostBytes - 1; // every stage runs
+        const IndexMemoryEstimate e = estimateIndexMemory(scene, tight);
+        CHECK(e.nodesAtLeast <= index->stats().nodes);
+        CHECK(e.atLeastBytes <= index->stats().buildPeakBytes);
+        if (spec.maxObjects < 8) {
+            CHECK(e.nodesAtLeast >= index->stats().nodes / (spec.maxObjects == 2 ? 4 : 2));
         }
     }
 }
