@@ -78,10 +78,11 @@ namespace detail {
 
 namespace {
 
-std::string megabytes(std::uint64_t bytes) {
+/// Bytes in MB: one decimal under 10 MB, none above, or `places` decimals when >= 0.
+std::string megabytes(std::uint64_t bytes, int places = -1) {
     const double mb = static_cast<double>(bytes) / (1 << 20);
-    char buf[32];
-    std::snprintf(buf, sizeof buf, mb < 10.0 ? "%.1f" : "%.0f", mb);
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.*f", places >= 0 ? places : mb < 10.0 ? 1 : 0, mb);
     return buf;
 }
 
@@ -89,12 +90,19 @@ std::string megabytes(std::uint64_t bytes) {
 
 void refuseIndexMemory(const IndexSpec& spec, std::uint64_t bytes, const std::string& detail,
                        bool atLeast) {
+    // Just over the limit, the figures get the decimals that tell them apart ("1024.43 MB ...
+    // the 1024.00 MB limit", not "1024 MB ... the 1024 MB limit").
+    int places = -1;
+    while (places < 6 && megabytes(bytes, places) == megabytes(spec.maxBytes, places)) {
+        places = places < 2 ? 2 : places + 2;
+    }
     // A saturated count (IndexMemory.h) means "more than 2^64 bytes".
-    const std::string need = bytes == std::numeric_limits<std::uint64_t>::max()
-                                 ? "more than 2^64 bytes"
-                                 : (atLeast ? "more than " : "about ") + megabytes(bytes) + " MB";
+    const std::string need =
+        bytes == std::numeric_limits<std::uint64_t>::max()
+            ? "more than 2^64 bytes"
+            : (atLeast ? "more than " : "about ") + megabytes(bytes, places) + " MB";
     throw IndexTooLargeError("index " + spec.toString() + " would need " + need + " of memory (" +
-                             detail + "), more than the " + megabytes(spec.maxBytes) +
+                             detail + "), more than the " + megabytes(spec.maxBytes, places) +
                              " MB limit; choose a coarser index (fewer grid cells, a "
                              "larger octree MIN or M) or raise the limit with --max-index-mb");
 }

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <numbers>
 #include <numeric>
+#include <regex>
 
 using namespace hapto;
 using namespace hapto::test;
@@ -525,6 +526,18 @@ TEST_CASE("a mesh vertex shared by more than M triangles splits every cell aroun
     deep.maxBytes = 8ull << 20;
     CHECK_THROWS_WITH(buildIndex(scene, deep),
                       Catch::Contains("at least ") && Catch::Contains("nodes over"));
+    // Just over the limit, the message tells the need from the limit.
+    deep.maxBytes = estimateIndexMemory(scene, deep).atLeastBytes - 1024;
+    try {
+        (void)buildIndex(scene, deep);
+        FAIL("not refused");
+    } catch (const IndexTooLargeError& e) {
+        const std::string what = e.what();
+        std::smatch m;
+        REQUIRE(std::regex_search(what, m,
+                                  std::regex("more than ([0-9.]+) MB .* the ([0-9.]+) MB limit")));
+        CHECK(m[1].str() != m[2].str());
+    }
     // Against real builds: the floor stays at or under the nodes and the peak accounting; at
     // M = 4 the shared vertices give over half the real tree (its deep levels are the cells
     // around the vertices; 77 %), at M = 2 a quarter (cells along the edges split too; 34 %),
