@@ -79,8 +79,8 @@
 // Invariant: atLeastBytes <= the build's peak accounting <= atMostBytes (tests/index), every
 // sum saturating at 2^64 - 1 ("more than any limit").
 // Cost: O(items * levels) time; per mesh vertex shared by more than M triangles 8 bytes and a
-// sort; memory per item (at most kPairItems of them) one inner box
-// and its sort key (32 bytes, 32 MB at 10^6 items), none per node; then for the cell counts
+// sort; memory per item (at most kPairItems of them) one inner box and its sort key (32
+// bytes, 32 MB at 10^6 items), none per node; then for the cell counts
 // per box its cell range and its place in two orders by z (20 bytes), a plane of (2^l + 1)^2
 // counters per slab of slices (8 slabs in parallel, 1 MB each at level 9), and 8^l bits of
 // the previous level (2 MB at level 8; the last level's are not kept); O(boxes + cells) per
