@@ -489,8 +489,8 @@ public:
     }
 
     SweptLevel run() const {
-        // Slabs of whole slices: a slice is a multiple of 64 cells from level 2 on, so the
-        // slabs set disjoint words of `over`.
+        // Slabs of whole slices, only from 64 cells a side: a slice is then a multiple of 64
+        // cells, so the slabs set disjoint words of `over`.
         const std::size_t slabs = mSide >= 64 ? 8 : 1;
         SweptLevel out;
         std::mutex merge;
