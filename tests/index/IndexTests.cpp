@@ -514,7 +514,7 @@ TEST_CASE("the octree floor counts cells shared by overlapping items and stays a
     }
 }
 
-TEST_CASE("a mesh vertex shared by more than M triangles splits every cell around it: the "
+TEST_CASE("a mesh vertex shared by more than M triangles splits every cell around it - the "
           "octree floor counts those cells and stays a floor") {
     hapto::test::buildOnOneThread();
     MeshOptions sphere;

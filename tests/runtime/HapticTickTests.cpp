@@ -222,7 +222,7 @@ double nearestFacetPlane(const TriangleMesh& mesh, double r) {
 } // namespace
 
 TEST_CASE("a hand sliding over a fine mesh whose leaves are smaller than one tick's motion stays "
-          "on the surface: the leaves the proxy slides over are rendered too") {
+          "on the surface - the leaves the proxy slides over are rendered too") {
     hapto::test::buildOnOneThread();
     // An icosphere of 327 680 triangles (edges about 0.45 mm) in an octree of 0.5 mm leaves,
     // and a device 1 mm inside it sliding 0.5 mm per tick over its top: every few ticks the
@@ -316,8 +316,8 @@ DeepPress pressDeepAndFast(double stepM, const char* spec) {
 
 } // namespace
 
-TEST_CASE("a hand pressing deep and fast over a fine mesh is held on every tick under every index: "
-          "the leaves of the proxy's whole path are rendered") {
+TEST_CASE("a hand pressing deep and fast over a fine mesh is held on every tick under every "
+          "index - the leaves of the proxy's whole path are rendered") {
     hapto::test::buildOnOneThread();
     // Up to 2 mm per tick: the solver's passes slide the proxy sideways over several small
     // leaves before it settles, so walking only the straight ways from its start missed some,
@@ -332,7 +332,7 @@ TEST_CASE("a hand pressing deep and fast over a fine mesh is held on every tick 
     CHECK(got.pullBacks == 0);
 }
 
-TEST_CASE("a hand faster than its leaves can be listed has its goal pulled back: the proxy moves "
+TEST_CASE("a hand faster than its leaves can be listed has its goal pulled back - the proxy moves "
           "less, never through the surface, and the hand is held") {
     hapto::test::buildOnOneThread();
     // Up to 6 mm per tick over 0.2 mm leaves: more leaves than a tick can list

@@ -114,7 +114,7 @@ struct GraspRig {
 
 } // namespace
 
-TEST_CASE("two hands squeezing with mu_s (F1 + F2) = 2.4 m g hold a 100 g cube for 5 s: slip "
+TEST_CASE("two hands squeezing with mu_s (F1 + F2) = 2.4 m g hold a 100 g cube for 5 s - slip "
           "under 1 mm, and their vertical forces sum to its weight") {
     const double depth = 2.0 / kStiffness; // F = 2 N a hand: mu_s (F1 + F2) = 2.4 N > 0.98 N
     GraspRig rig([depth](double) { return depth; });
@@ -158,7 +158,7 @@ TEST_CASE("two hands squeezing with mu_s (F1 + F2) = 2.4 m g hold a 100 g cube f
     CHECK(squeeze / samples == Approx(2.0).epsilon(0.02));
 }
 
-TEST_CASE("two hands squeezing with mu_s (F1 + F2) = 0.6 m g cannot lift the cube: it stays on "
+TEST_CASE("two hands squeezing with mu_s (F1 + F2) = 0.6 m g cannot lift the cube - it stays on "
           "the floor while the hands slide up its sides") {
     const double depth = 0.5 / kStiffness; // F = 0.5 N a hand: mu_s (F1 + F2) = 0.6 N < 0.98 N
     GraspRig rig([depth](double) { return depth; });

@@ -166,7 +166,7 @@ TEST_CASE("hapto demo grasp refuses what cannot work, with exit code 2 and the o
 }
 
 TEST_CASE("hapto demo grasp --stepped with hands squeezing 0.3 N each (mu_s (F1 + F2) = 0.37 m g) "
-          "does not lift the box: not held, and it stays on the floor",
+          "does not lift the box - not held, and it stays on the floor",
           "[threads]") {
     TempDir dir;
     const auto hand = [](const char* name, const char* script, double x, int seed) {
