@@ -119,9 +119,20 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
     const LocateResult atDevice = mDeviceCursor.locate(p);
     const LocateResult atProxy = mProxyCursor.locate(mRenderer.proxy());
     stamp(0);
+    // A proxy that the last tick left behind its device point (on a surface, or held back)
+    // solves toward a goal at most kMaxProxyStepM from where it starts: the device point, or
+    // the point that far along the way to it. A proxy that was at its device point follows
+    // the device freely (a jump in free space). The device's leaf is listed only when the goal
+    // is the device point; otherwise the leaves of the proxy's way are walked as always.
+    const Vec3 from = mRenderer.proxy();
+    const double lag = glm::length(p - from);
+    const bool stepped = mLeftBehind && lag > kMaxProxyStepM;
+    const Vec3 goal = stepped ? from + (kMaxProxyStepM / lag) * (p - from) : p;
     mCandidates.clear();
-    mCandidates.add(atDevice.candidates);
-    if (atProxy.leaf != atDevice.leaf || atProxy.outside != atDevice.outside) {
+    if (!stepped) {
+        mCandidates.add(atDevice.candidates);
+    }
+    if (stepped || atProxy.leaf != atDevice.leaf || atProxy.outside != atDevice.outside) {
         mCandidates.add(atProxy.candidates);
     }
     mCandidates.add(snapshot.movingSlots());
@@ -133,13 +144,12 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
 
     // 3. Render, over every leaf the proxy's way crosses (see render()).
     ListedLeaves listed;
-    listed.leaves[0] = atDevice.leaf;
+    listed.leaves[0] = stepped ? atProxy.leaf : atDevice.leaf;
     listed.leaves[1] = atProxy.leaf;
     listed.count = 2;
-    const Vec3 from = mRenderer.proxy();
-    listSlide(p, from, listed, out);
+    listSlide(goal, from, listed, out);
     stamp(1);
-    render(*snapshot.scene, p, v, dtS, from, listed, out);
+    render(*snapshot.scene, p, goal, v, dtS, from, listed, out);
     stamp(2);
 
     // 4. Force effects at the device point, then the hook, and the external force. A hook
@@ -188,20 +198,21 @@ void BasicHapticTick<Algorithm>::bind(const WorldSnapshot& snapshot, const Vec3&
     }
     if (mFresh) {
         mRenderer.reset(p);
+        mLeftBehind = false;
         mFresh = false;
     }
 }
 
 template <ForceAlgorithm Algorithm>
-void BasicHapticTick<Algorithm>::listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed,
+void BasicHapticTick<Algorithm>::listSlide(const Vec3& goal, const Vec3& from, ListedLeaves& listed,
                                            TickOutput& out) noexcept {
-    // The likely slide (from the start along last tick's contact plane to the device point's
+    // The likely slide (from the start along last tick's contact plane to the goal's
     // projection on it) is known before solving, so its first kSlideLeaves leaves are listed
     // first: a slide over small leaves usually solves once. Not more: a proxy trapped far
     // behind the hand has a slide centimetres long that it will not go far along, and its
     // leaves would cost their walks and items and take the room the solved way needs.
     const Vec3 slide =
-        mRenderer.inContact() ? p - glm::dot(p - from, mSlideNormal) * mSlideNormal : from;
+        mRenderer.inContact() ? goal - glm::dot(goal - from, mSlideNormal) * mSlideNormal : from;
     while (listed.count < listed.leaves.size() && listed.count < 2 + kSlideLeaves &&
            mRenderer.inContact()) {
         const SegmentWalk missed = mProxyCursor.firstLeafNotIn(from, slide, listed.known());
@@ -235,9 +246,9 @@ std::size_t BasicHapticTick<Algorithm>::listPaths(ListedLeaves& listed, bool& co
 }
 
 template <ForceAlgorithm Algorithm>
-void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const Vec3& v,
-                                        double dtS, const Vec3& from, ListedLeaves& listed,
-                                        TickOutput& out) noexcept {
+void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const Vec3& goal,
+                                        const Vec3& v, double dtS, const Vec3& from,
+                                        ListedLeaves& listed, TickOutput& out) noexcept {
     // The candidates cover where the device and the proxy are, not every place the proxy
     // visits this tick: a proxy sliding over fine triangles (a mesh whose leaves are smaller
     // than one tick's motion, with the device in an empty leaf under the surface) can slide
@@ -248,7 +259,7 @@ void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const
     // keeps its near list and reads only theirs), up to kExtraLeaves leaves in all; then, if
     // the way still leaves the listed leaves, the goal is pulled back.
     const typename Algorithm::State start = mRenderer.state(); // a plain copy: no allocation
-    out.render = mRenderer.update(scene, mCandidates, p, v, dtS);
+    out.render = mRenderer.update(scene, mCandidates, p, goal, v, dtS);
     out.solves = 1;
     std::uint32_t tested = out.render.objectsTested;
     for (;;) {
@@ -258,13 +269,13 @@ void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const
         bool covered = true;
         if (listPaths(listed, covered, out) == 0) {
             if (!covered) {
-                pullBack(scene, p, v, dtS, from, start, listed.known(), tested, out);
+                pullBack(scene, p, goal, v, dtS, from, start, listed.known(), tested, out);
             }
             break;
         }
         mRenderer.restore(start);
         solveAgainNext(mRenderer);
-        out.render = mRenderer.update(scene, mCandidates, p, v, dtS);
+        out.render = mRenderer.update(scene, mCandidates, p, goal, v, dtS);
         tested += out.render.objectsTested;
         ++out.solves;
     }
@@ -272,30 +283,31 @@ void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const
     if (out.render.contactCount > 0) {
         mSlideNormal = out.render.contacts[0].normal;
     }
+    mLeftBehind = out.render.proxy != p;
 }
 
 template <ForceAlgorithm Algorithm>
-void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, const Vec3& v,
-                                          double dtS, const Vec3& from,
+void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, const Vec3& aim,
+                                          const Vec3& v, double dtS, const Vec3& from,
                                           const typename Algorithm::State& start,
                                           std::span<const std::uint32_t> known,
                                           std::uint32_t& tested, TickOutput& out) noexcept {
     // Out of room while the path still crosses a leaf no span lists (a very fast hand over
-    // very small leaves, or a proxy trapped far behind a hand that pushed through), or a walk
-    // that could not finish: the proxy must not move through space whose items the renderer
-    // has not seen. Solve again with the proxy's motion held to a goal pulled back from the
-    // device point toward the start, halving, then a nudge of kNudgeM, until the path stays in
-    // listed leaves; the last try is the start itself (the proxy stays, no contact, no force).
-    // The contacts and the force are the device point's: the hand pushing in feels the surface
-    // as hard as ever, and the proxy never falls through it. The first goal is halfway to where
-    // the straight way from the start to the device point leaves the listed leaves (halfway to
-    // the device point when it does not): a proxy trapped centimetres behind then moves up to
-    // half a leaf in one more solve, where halving from the device point would try goals
-    // centimetres away, each crossing unlisted leaves again, and end on the nudge.
-    const double away = glm::length(p - from);
-    const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (p - from) : p;
-    Vec3 goal = p;
-    const double firstHalf = 0.5 * mProxyCursor.firstLeafNotIn(from, p, known).t;
+    // very small leaves, or a proxy trapped behind a hand that pushed through), or a walk that
+    // could not finish: the proxy must not move through space whose items the renderer has not
+    // seen. Solve again with the proxy's motion held to a goal pulled back from the tick's aim
+    // (the device point, or the step toward it) toward the start, halving, then a nudge of
+    // kNudgeM, until the path stays in listed leaves; the last try is the start itself (the
+    // proxy stays, no contact, no force). The contacts and the force are the device point's:
+    // the hand pushing in feels the surface as hard as ever, and the proxy never falls through
+    // it. The first goal is halfway to where the straight way from the start to the aim leaves
+    // the listed leaves (halfway to the aim when it does not): the proxy then moves up to half
+    // a leaf in one more solve, where halving from the aim would try goals that each cross
+    // unlisted leaves again, and end on the nudge.
+    const double away = glm::length(aim - from);
+    const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (aim - from) : aim;
+    Vec3 goal = aim;
+    const double firstHalf = 0.5 * mProxyCursor.firstLeafNotIn(from, aim, known).t;
     bool covered = false;
     for (int k = 0; !covered && k < kPullBacks; ++k) {
         const double keep = k == 0 ? firstHalf : 0.5;

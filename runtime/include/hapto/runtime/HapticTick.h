@@ -69,6 +69,12 @@ inline constexpr int kTickPullBacks = 5;
 /// surfaces it rests on that the device point is behind, so the tick keeps their contact and
 /// force; 1 µm is inside the proxy's leaf unless it sits on the leaf's face.
 inline constexpr double kTickNudgeM = 1e-6;
+/// The farthest the proxy moves toward the device point in one tick (m): its goal is the
+/// device point, or the point this far along the way to it. 5 mm a tick is 5 m/s at 1 kHz,
+/// faster than a hand moves a grip; it bounds the space one tick's solve can reach, so a proxy
+/// trapped centimetres behind a hand that pushed through reads the leaves around it, not
+/// every leaf on the way to the hand. The force is always k (proxy - device point).
+inline constexpr double kTickMaxProxyStepM = 0.005;
 
 /// The leaves a tick's candidate spans list (N at most): the device's, the proxy's, then the
 /// extra ones, in the order their spans were added.
@@ -94,10 +100,13 @@ using TickStageStamps = std::array<std::uint64_t, 5>;
 /// experiments run; and `hapto render`) lives here and nowhere else:
 ///   1. locate: the device point's cursor and the proxy's cursor each find their leaf (they
 ///      differ while the tool presses into a surface, the proxy resting on it);
-///   2. candidates: the two leaves' object slots (the proxy's only when its leaf differs) and
-///      the snapshot's moving objects, as spans (no copy);
-///   3. render: the force algorithm (the god-object renderer) moves the proxy and computes
-///      k (proxy - device), solved again with each leaf the proxy's way crossed unlisted;
+///   2. candidates: the two leaves' object slots (the proxy's only when its leaf differs; the
+///      device's only when the goal is the device point) and the snapshot's moving objects, as
+///      spans (no copy);
+///   3. render: the force algorithm (the god-object renderer) moves the proxy toward the goal
+///      (the device point, or kMaxProxyStepM toward it for a proxy the last tick left behind)
+///      and computes k (proxy - device), solved again with each leaf the proxy's way crossed
+///      unlisted;
 ///   4. force effects and the hook: the device's EffectSet (springs, dampers, constant forces)
 ///      at the device point, then the application's per-tick hook, if any, are added to the
 ///      render force and the external force;
@@ -119,6 +128,7 @@ public:
     static constexpr std::size_t kSlideLeaves = detail::kTickSlideLeaves; ///< See there.
     static constexpr int kPullBacks = detail::kTickPullBacks;             ///< See there.
     static constexpr double kNudgeM = detail::kTickNudgeM;                ///< See there (m).
+    static constexpr double kMaxProxyStepM = detail::kTickMaxProxyStepM;  ///< See there (m).
 
     /// Checks both configurations; throws std::invalid_argument when one is invalid. [control]
     explicit BasicHapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
@@ -186,17 +196,21 @@ private:
     void stamp(std::size_t i) noexcept;
     /// Binds the cursors to a new snapshot's index, and the proxy to `p` on a fresh start.
     void bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& out) noexcept;
-    /// Lists the leaves of the likely slide (`from` along the last contact plane) first.
-    void listSlide(const Vec3& p, const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept;
+    /// Lists the leaves of the likely slide (`from` along the last contact plane toward the
+    /// goal's projection) first.
+    void listSlide(const Vec3& goal, const Vec3& from, ListedLeaves& listed,
+                   TickOutput& out) noexcept;
     /// Lists the unlisted leaves the last paths cross (room allowing): how many; `covered`.
     std::size_t listPaths(ListedLeaves& listed, bool& covered, TickOutput& out) noexcept;
-    /// Solves again with the unlisted leaves the proxy's way crosses; then pulls back.
-    void render(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
-                ListedLeaves& listed, TickOutput& out) noexcept;
-    /// Solves toward goals pulled back from `p` toward `from` (TickOutput::pullBacks).
-    void pullBack(const Scene& scene, const Vec3& p, const Vec3& v, double dtS, const Vec3& from,
-                  const typename Algorithm::State& start, std::span<const std::uint32_t> known,
-                  std::uint32_t& tested, TickOutput& out) noexcept;
+    /// Solves toward `goal` (the force from the device point `p`), again with the unlisted
+    /// leaves the proxy's way crosses; then pulls back.
+    void render(const Scene& scene, const Vec3& p, const Vec3& goal, const Vec3& v, double dtS,
+                const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept;
+    /// Solves toward goals pulled back from `aim` toward `from` (TickOutput::pullBacks).
+    void pullBack(const Scene& scene, const Vec3& p, const Vec3& aim, const Vec3& v, double dtS,
+                  const Vec3& from, const typename Algorithm::State& start,
+                  std::span<const std::uint32_t> known, std::uint32_t& tested,
+                  TickOutput& out) noexcept;
     /// Places the dynamic bodies near `p` and the proxy for the renderer and the candidates.
     void placeDynamic(const WorldSnapshot& snapshot, const Vec3& p, double dtS) noexcept;
 
@@ -212,6 +226,7 @@ private:
     std::uint64_t mBoundVersion = 0; ///< The snapshot version they were bound for.
     StageStamps* mStamps = nullptr;  ///< Where tick() writes its stage ends, or none.
     bool mFresh = true;              ///< The next tick starts afresh (reset()).
+    bool mLeftBehind = false;        ///< The last tick ended with the proxy off its device point.
     BodyCoupling mCoupling;          ///< The dynamic bodies placed, and their reaction.
 };
 
