@@ -86,7 +86,13 @@ template <ForceAlgorithm Algorithm> void solveAgainNext(Algorithm& renderer) noe
 template <ForceAlgorithm Algorithm>
 BasicHapticTick<Algorithm>::BasicHapticTick(const RendererConfig& renderer,
                                             const SafetyConfig& safety)
-    : mRenderer(renderer), mSafety(safety), mCoupling(renderer.torsionRadiusM) {}
+    : mRenderer(renderer), mSafety(safety), mMaxStepM(renderer.maxProxyStepM),
+      mCoupling(renderer.torsionRadiusM) {
+    if (!(std::isfinite(mMaxStepM) && mMaxStepM > 0.0)) {
+        throw std::invalid_argument("HapticTick: maxProxyStepM must be a finite value > 0 m (got " +
+                                    std::to_string(mMaxStepM) + ")");
+    }
+}
 
 template <ForceAlgorithm Algorithm> void BasicHapticTick<Algorithm>::stamp(std::size_t i) noexcept {
     if (mStamps != nullptr) {
@@ -120,14 +126,14 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
     const LocateResult atProxy = mProxyCursor.locate(mRenderer.proxy());
     stamp(0);
     // A proxy that the last tick left behind its device point (on a surface, or held back)
-    // solves toward a goal at most kMaxProxyStepM from where it starts: the device point, or
+    // solves toward a goal at most mMaxStepM from where it starts: the device point, or
     // the point that far along the way to it. A proxy that was at its device point follows
     // the device freely (a jump in free space). The device's leaf is listed only when the goal
     // is the device point; otherwise the leaves of the proxy's way are walked as always.
     const Vec3 from = mRenderer.proxy();
     const double lag = glm::length(p - from);
-    const bool stepped = mLeftBehind && lag > kMaxProxyStepM;
-    const Vec3 goal = stepped ? from + (kMaxProxyStepM / lag) * (p - from) : p;
+    const bool stepped = mLeftBehind && lag > mMaxStepM;
+    const Vec3 goal = stepped ? from + (mMaxStepM / lag) * (p - from) : p;
     mCandidates.clear();
     if (!stepped) {
         mCandidates.add(atDevice.candidates);

@@ -41,7 +41,8 @@ EffectSet effectsFor(const RuntimeDevice& device) {
 } // namespace
 
 Runtime::Channel::Channel(RuntimeDevice d, const RuntimeOptions& o)
-    : servo(withDeviceSettings(o.renderer, d.rendering.renderer), safetyFor(d.config.maxForceN)) {
+    : servo(withDeviceSettings(o.renderer, d.rendering.renderer, d.config.transform.scale),
+            safetyFor(d.config.maxForceN)) {
     record.effects = effectsFor(d);
     servo.haptic.setEffects(record.effects); // before any thread: no publish needed
     const std::uint64_t period = static_cast<std::uint64_t>(std::llround(1e9 / d.config.rateHz));

@@ -6,10 +6,12 @@
 #include "hapto/index/DefaultIndex.h"
 #include "hapto/runtime/HapticTick.h"
 #include "hapto/runtime/Realtime.h"
+#include "hapto/runtime/RendererSettings.h"
 #include "hapto/scenes/Generators.h"
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -385,43 +387,64 @@ TEST_CASE("timing a tick's stages changes none of its results, and the stamps ar
     CHECK(solvedAgain > 0); // the path did make the tick solve again
 }
 
-TEST_CASE("a proxy left behind its hand moves at most kMaxProxyStepM a tick toward it, pushing "
+TEST_CASE("a proxy left behind its hand moves at most maxProxyStepM a tick toward it, pushing "
           "k (proxy - device point) all the while, and one at its hand follows a jump") {
     World world(boxScene(800.0), IndexSpec::parse(kDefaultIndexSpec));
-    HapticTick tick;
-    // 2 cm into the box's top face (y = 0.025), then the hand jumps 3 cm along it in one tick.
-    TickOutput out = pressTo(tick, world.current(), 0.02, -0.015);
-    REQUIRE(out.render.contactCount == 1);
-    const Vec3 p(0.015, 0.005, 0.0);
-    Vec3 last = out.render.proxy;
-    double firstStep = 0.0;
-    for (int i = 0; i < 100; ++i) {
-        out = tick.tick(world.current(), p, Vec3(0.0), 1e-3, Vec3(0.0));
-        const RenderOutput& r = out.render;
-        INFO("tick " << i << " proxy x " << r.proxy.x);
-        const double step = glm::length(r.proxy - last);
-        CHECK(step <= HapticTick::kMaxProxyStepM * (1.0 + 1e-12));
-        CHECK(r.proxy.x >= last.x); // toward the hand's projection, never back
-        REQUIRE(r.contactCount == 1);
-        CHECK(r.contacts[0].normal == Vec3(0, 1, 0));
-        CHECK(r.proxy.y == Approx(last.y).margin(1e-12)); // on the face
-        CHECK(glm::length(r.force - 800.0 * (r.proxy - p)) <= 1e-9);
-        firstStep = i == 0 ? step : firstStep;
-        last = r.proxy;
-    }
-    // The first step: 5 mm toward the hand, projected on the face (3 cm along, 2 cm below).
-    CHECK(firstStep == Approx(0.005 * 0.03 / std::sqrt(0.03 * 0.03 + 0.02 * 0.02)).epsilon(1e-6));
-    // Then ever shorter steps, ending over the hand.
-    CHECK(last.x == Approx(0.015).margin(1e-9));
-    // Back out above the face, a proxy at its hand follows a jump of any length in free space.
-    for (const Vec3& q : {Vec3(0.015, 0.04, 0.0), Vec3(-0.09, 0.1, 0.05)}) {
-        for (int i = 0; i < 3; ++i) {
-            out = tick.tick(world.current(), q, Vec3(0.0), 1e-3, Vec3(0.0));
+    for (const double stepM : {RendererConfig{}.maxProxyStepM, 0.002}) {
+        INFO("step " << stepM << " m");
+        RendererConfig config;
+        config.maxProxyStepM = stepM;
+        HapticTick tick(config);
+        // 2 cm into the box's top face (y = 0.025), then the hand jumps 3 cm along it at once.
+        TickOutput out = pressTo(tick, world.current(), 0.02, -0.015);
+        REQUIRE(out.render.contactCount == 1);
+        const Vec3 p(0.015, 0.005, 0.0);
+        Vec3 last = out.render.proxy;
+        double firstStep = 0.0;
+        for (int i = 0; i < 200; ++i) {
+            out = tick.tick(world.current(), p, Vec3(0.0), 1e-3, Vec3(0.0));
+            const RenderOutput& r = out.render;
+            INFO("tick " << i << " proxy x " << r.proxy.x);
+            const double step = glm::length(r.proxy - last);
+            CHECK(step <= stepM * (1.0 + 1e-12));
+            CHECK(r.proxy.x >= last.x); // toward the hand's projection, never back
+            REQUIRE(r.contactCount == 1);
+            CHECK(r.contacts[0].normal == Vec3(0, 1, 0));
+            CHECK(r.proxy.y == Approx(last.y).margin(1e-12)); // on the face
+            CHECK(glm::length(r.force - 800.0 * (r.proxy - p)) <= 1e-9);
+            firstStep = i == 0 ? step : firstStep;
+            last = r.proxy;
         }
-        CHECK(out.render.proxy == q);
+        // The first step: stepM toward the hand, on the face (3 cm along, 2 cm below it).
+        CHECK(firstStep == Approx(stepM * 0.03 / std::sqrt(0.03 * 0.03 + 0.02 * 0.02)));
+        // Then ever shorter steps, ending over the hand.
+        CHECK(last.x == Approx(0.015).margin(1e-9));
+        // Back out above the face: the proxy steps up to it, then follows any jump in free
+        // space at once.
+        const Vec3 above(0.015, 0.04, 0.0);
+        for (int i = 0; i < 10; ++i) {
+            out = tick.tick(world.current(), above, Vec3(0.0), 1e-3, Vec3(0.0));
+        }
+        CHECK(out.render.proxy == above);
+        for (const Vec3& q : {Vec3(-0.09, 0.1, 0.05), Vec3(0.09, 0.1, -0.05)}) {
+            out = tick.tick(world.current(), q, Vec3(0.0), 1e-3, Vec3(0.0));
+            CHECK(out.render.proxy == q);
+        }
     }
-    out = tick.tick(world.current(), Vec3(0.09, 0.1, -0.05), Vec3(0.0), 1e-3, Vec3(0.0));
-    CHECK(out.render.proxy == Vec3(0.09, 0.1, -0.05));
+}
+
+TEST_CASE("the proxy's step is checked, and a device scaled into the world steps as far in its "
+          "own motion") {
+    for (const double bad : {0.0, -0.001, std::nan(""), HUGE_VAL}) {
+        RendererConfig config;
+        config.maxProxyStepM = bad;
+        CHECK_THROWS_WITH(HapticTick(config),
+                          Catch::Contains("maxProxyStepM must be a finite value > 0 m"));
+    }
+    CHECK(withDeviceSettings(RendererConfig{}, RendererSettings{}).maxProxyStepM ==
+          RendererConfig{}.maxProxyStepM);
+    CHECK(withDeviceSettings(RendererConfig{}, RendererSettings{}, 10.0).maxProxyStepM ==
+          Approx(10.0 * RendererConfig{}.maxProxyStepM));
 }
 
 TEST_CASE("a proxy trapped far behind a hand that pushed through keeps its contacts and the "
@@ -430,7 +453,7 @@ TEST_CASE("a proxy trapped far behind a hand that pushed through keeps its conta
     // 10^3 cubes of 0.5 mm filling half of a 6.25 mm cube, and the benchmarks' hand walk (up
     // to 0.5 mm per tick) through them, ignoring the force: the proxy is caught in the pockets
     // between cubes, millimetres behind, and its way toward the hand (at most
-    // HapticTick::kMaxProxyStepM a tick) can cross more 0.25 mm leaves than one tick can list
+    // RendererConfig::maxProxyStepM a tick) can cross more 0.25 mm leaves than one tick can list
     // (HapticTick::kExtraLeaves), so its goal is pulled back.
     RandomOptions options;
     options.count = 1000;

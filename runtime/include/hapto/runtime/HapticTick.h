@@ -69,12 +69,6 @@ inline constexpr int kTickPullBacks = 5;
 /// surfaces it rests on that the device point is behind, so the tick keeps their contact and
 /// force; 1 µm is inside the proxy's leaf unless it sits on the leaf's face.
 inline constexpr double kTickNudgeM = 1e-6;
-/// The farthest the proxy moves toward the device point in one tick (m): its goal is the
-/// device point, or the point this far along the way to it. 5 mm a tick is 5 m/s at 1 kHz,
-/// faster than a hand moves a grip; it bounds the space one tick's solve can reach, so a proxy
-/// trapped centimetres behind a hand that pushed through reads the leaves around it, not
-/// every leaf on the way to the hand. The force is always k (proxy - device point).
-inline constexpr double kTickMaxProxyStepM = 0.005;
 
 /// The leaves a tick's candidate spans list (N at most): the device's, the proxy's, then the
 /// extra ones, in the order their spans were added.
@@ -104,7 +98,9 @@ using TickStageStamps = std::array<std::uint64_t, 5>;
 ///      device's only when the goal is the device point) and the snapshot's moving objects, as
 ///      spans (no copy);
 ///   3. render: the force algorithm (the god-object renderer) moves the proxy toward the goal
-///      (the device point, or kMaxProxyStepM toward it for a proxy the last tick left behind)
+///      (the device point, or RendererConfig::maxProxyStepM toward it for a proxy the last
+///      tick left behind: a proxy trapped centimetres behind a hand that pushed through reads
+///      the leaves around it, not every leaf on the way to the hand)
 ///      and computes k (proxy - device), solved again with each leaf the proxy's way crossed
 ///      unlisted;
 ///   4. force effects and the hook: the device's EffectSet (springs, dampers, constant forces)
@@ -128,9 +124,9 @@ public:
     static constexpr std::size_t kSlideLeaves = detail::kTickSlideLeaves; ///< See there.
     static constexpr int kPullBacks = detail::kTickPullBacks;             ///< See there.
     static constexpr double kNudgeM = detail::kTickNudgeM;                ///< See there (m).
-    static constexpr double kMaxProxyStepM = detail::kTickMaxProxyStepM;  ///< See there (m).
 
-    /// Checks both configurations; throws std::invalid_argument when one is invalid. [control]
+    /// Checks both configurations (the renderer's maxProxyStepM here: finite, > 0); throws
+    /// std::invalid_argument when one is invalid. [control]
     explicit BasicHapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
 
     /// The next tick starts afresh: the proxy is put on that tick's device point with no
@@ -227,6 +223,7 @@ private:
     StageStamps* mStamps = nullptr;  ///< Where tick() writes its stage ends, or none.
     bool mFresh = true;              ///< The next tick starts afresh (reset()).
     bool mLeftBehind = false;        ///< The last tick ended with the proxy off its device point.
+    double mMaxStepM = 0.005;        ///< RendererConfig::maxProxyStepM (m, world).
     BodyCoupling mCoupling;          ///< The dynamic bodies placed, and their reaction.
 };
 

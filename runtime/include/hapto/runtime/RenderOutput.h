@@ -24,6 +24,12 @@ struct RendererConfig {
     /// spin about the contact normal up to mu |Fn| r (BodyCoupling.h). 3 mm by default: a few
     /// millimetres, a choice (a fingertip-sized patch), not a measured fact.
     double torsionRadiusM = 0.003;
+    /// The farthest a proxy that the last tick left behind its device point moves toward it in
+    /// one tick (m, world; finite, > 0): its goal is the device point, or the point this far
+    /// along the way to it (HapticTick.h). 5 mm by default, 5 m/s at 1 kHz, faster than a hand
+    /// moves a grip; it bounds the space one tick's solve can reach. The runtime gives each
+    /// device this much of its own motion: times its transform's scale (withDeviceSettings).
+    double maxProxyStepM = 0.005;
 };
 
 /// What happened in a tick besides the force.

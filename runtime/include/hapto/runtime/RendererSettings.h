@@ -20,11 +20,15 @@ struct RendererSettings {
     std::optional<double> torsionRadiusM;
 };
 
-/// `runtime` (the settings every device gets) with one device's own `settings` applied.
-/// [control]
+/// `runtime` (the settings every device gets) with one device's own `settings` applied, for a
+/// device whose transform scales its motion into the world by `worldScale` (world metres per
+/// device metre): the proxy's step is that many times `runtime`'s, the same motion of the
+/// hand. [control]
 inline RendererConfig withDeviceSettings(const RendererConfig& runtime,
-                                         const RendererSettings& settings) {
+                                         const RendererSettings& settings,
+                                         double worldScale = 1.0) {
     RendererConfig c = runtime;
+    c.maxProxyStepM *= worldScale;
     if (settings.contactDampingNsPerM) {
         c.damping = *settings.contactDampingNsPerM;
     }
