@@ -127,8 +127,7 @@ RunReport Runtime::report() const {
         } else if (down) {
             d.fault = c.lastFault;
         } else if (f != FaultKind::None) { // faulted, not yet taken by the supervisor
-            d.fault = std::string(faultName(f)) + ": " +
-                      std::string(statusName(static_cast<DeviceStatus>(m.faultStatus.load())));
+            d.fault = faultText(ch);
         }
         d.faults = c.faults + (f != FaultKind::None && f != FaultKind::OpenFailed && !down);
         d.reopens = c.reopens;

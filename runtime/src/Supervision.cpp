@@ -147,7 +147,6 @@ void becomeNormalThread() {
 
 void Runtime::closeFaulted(Channel& ch) {
     ChannelRecord& c = ch.record;
-    const FaultKind f = ch.metrics.fault.load(std::memory_order_acquire);
     if (!c.closed.exchange(true)) {
         c.rd.device->close();
     }
@@ -156,14 +155,19 @@ void Runtime::closeFaulted(Channel& ch) {
     const std::uint64_t at = ch.metrics.faultNs.load();
     c.downSinceNs = at != 0 && at <= t ? at : t; // down since the fault itself
     ++c.faults;
+    c.lastFault = faultText(ch);
+    const std::string detail = c.rd.device->errorMessage();
+    addEvent(ch, t, c.lastFault + (detail.empty() ? "" : " (" + detail + ")") + "; force zeroed");
+    c.down.store(true, std::memory_order_release);
+}
+
+std::string Runtime::faultText(const Channel& ch) const {
+    const FaultKind f = ch.metrics.fault.load(std::memory_order_acquire);
     const std::string status =
         f == FaultKind::Watchdog
             ? "no tick for " + std::to_string(mOptions.stallTimeoutNs / 1'000'000) + " ms"
             : std::string(statusName(static_cast<DeviceStatus>(ch.metrics.faultStatus.load())));
-    c.lastFault = std::string(faultName(f)) + ": " + status;
-    const std::string detail = c.rd.device->errorMessage();
-    addEvent(ch, t, c.lastFault + (detail.empty() ? "" : " (" + detail + ")") + "; force zeroed");
-    c.down.store(true, std::memory_order_release);
+    return std::string(faultName(f)) + ": " + status;
 }
 
 bool Runtime::openAgain(Channel& ch, std::uint64_t& backNs) {

@@ -403,6 +403,9 @@ TEST_CASE("step mode: a wake-up K periods late commands zero for that tick, a la
         REQUIRE_FALSE(rig.runtime->step(0, rig.t0 + 160 * kMs));
         CHECK(m.fault.load() == FaultKind::Watchdog);
         CHECK(rig.devices[0]->lastForce() == Vec3(0.0));
+        // Reported as the supervisor will name it, before it has taken it.
+        CHECK(rig.report(0).fault == "watchdog: no tick for 50 ms");
+        CHECK(rig.report(0).faults == 1);
         rig.runtime->supervise(rig.t0 + 160 * kMs);
         CHECK(rig.devices[0]->closed());
         CHECK(rig.report(0).events ==

@@ -352,6 +352,9 @@ private:
     void superviseDynamics(std::uint64_t nowNs) noexcept;
     void recoverMain(Channel& channel);
     void closeFaulted(Channel& channel);
+    /// The channel's current fault as a report and its events say it: "watchdog: no tick for
+    /// 50 ms", "read-failed: disconnected", ...
+    std::string faultText(const Channel& channel) const;
     bool openAgain(Channel& channel, std::uint64_t& backNs);
     void markReopened(Channel& channel, std::uint64_t backNs);
     void reopenStepped(Channel& channel, std::uint64_t nowNs);
