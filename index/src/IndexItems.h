@@ -26,4 +26,13 @@ inline std::vector<std::uint32_t> indexedItems(const Scene& scene) {
     return items;
 }
 
+/// How many items indexedItems() gives: the boxes, spheres and triangles, O(objects). [control]
+inline std::uint64_t indexedItemCount(const Scene& scene) {
+    std::uint64_t meshes = 0;
+    for (const SceneObject& o : scene.objects()) {
+        meshes += o.shape == Shape::Mesh ? 1 : 0;
+    }
+    return scene.itemCount() - meshes;
+}
+
 } // namespace hapto::detail

@@ -112,7 +112,7 @@ void refuseIndexMemory(const IndexSpec& spec, std::uint64_t bytes, const std::st
 std::unique_ptr<SpatialIndex> buildIndex(const Scene& scene, const IndexSpec& spec) {
     const IndexMemoryEstimate need = estimateIndexMemory(scene, spec);
     if (need.atLeastBytes > spec.maxBytes) {
-        const std::string items = std::to_string(scene.itemCount()) + " items";
+        const std::string items = std::to_string(detail::indexedItemCount(scene)) + " items";
         const std::string detail =
             spec.kind == IndexSpec::Kind::Grid
                 ? std::to_string(std::uint64_t(spec.gridCells) * spec.gridCells * spec.gridCells) +
