@@ -169,6 +169,7 @@ void Runtime::startDynamics(std::uint64_t nowNs) {
 void Runtime::dynamicsMain() {
     // Set-up: may allocate (the grant's note); nothing below the loop's entry does.
     DynamicsChannel& dc = *mDynamics;
+    rt::nameCurrentThread("hapto-dynamics");
     if (mOptions.realtime) {
         // Below the servo threads: a servo tick preempts a dynamics step, never the reverse.
         dc.grant = rt::makeCurrentThreadRealtime(std::max(1, mOptions.fifoPriority - 1), -1);

@@ -104,6 +104,7 @@ void Runtime::tickDue(Group& g) noexcept {
 void Runtime::groupMain(Group& g) {
     // Set-up: may allocate (the real-time grant's note), nothing below the loop entry does.
     rt::RealtimeGrant grant;
+    rt::nameCurrentThread("hapto-group");
     if (mOptions.realtime) {
         grant = rt::makeCurrentThreadRealtime(mOptions.fifoPriority, g.cpu);
     } else {

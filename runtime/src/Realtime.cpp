@@ -42,6 +42,12 @@ void tightenTimerSlack() noexcept {
     prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
 }
 
+void nameCurrentThread(const char* name) noexcept {
+    char shortName[16] = {};
+    std::strncpy(shortName, name, sizeof shortName - 1); // the kernel's limit, with the NUL
+    (void)pthread_setname_np(pthread_self(), shortName);
+}
+
 RealtimeGrant makeCurrentThreadRealtime(int priority, int cpu) {
     RealtimeGrant g;
     tightenTimerSlack();

@@ -106,6 +106,7 @@ void Runtime::startThread(Channel& ch) {
 void Runtime::servoMain(Channel& ch) {
     // Set-up: may allocate (the real-time grant's note), nothing below the loop entry does.
     ChannelRecord& c = ch.record;
+    rt::nameCurrentThread("hapto-servo");
     if (mOptions.realtime) {
         c.grant = rt::makeCurrentThreadRealtime(mOptions.fifoPriority, c.cpu);
     } else {

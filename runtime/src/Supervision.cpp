@@ -29,6 +29,7 @@ bool Runtime::waitUnlessStopping(std::uint64_t ns) {
 void Runtime::superviseMain() {
     // Above the servo threads, so a stalled or starved core never keeps the watchdog from
     // running (it sleeps between passes and its pass is a few atomic loads).
+    rt::nameCurrentThread("hapto-watchdog");
     if (mOptions.realtime) {
         (void)rt::makeCurrentThreadRealtime(std::min(99, mOptions.fifoPriority + 1), -1);
     }
@@ -203,6 +204,7 @@ void Runtime::markReopened(Channel& ch, std::uint64_t backNs) {
 }
 
 void Runtime::recoverMain(Channel& ch) {
+    rt::nameCurrentThread("hapto-reopen");
     becomeNormalThread();
     ChannelRecord& c = ch.record;
     if (c.thread.joinable()) {

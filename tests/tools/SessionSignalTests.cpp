@@ -12,6 +12,7 @@
 #include <chrono>
 #include <csignal>
 #include <fcntl.h>
+#include <filesystem>
 #include <fstream>
 #include <poll.h>
 #include <pty.h>
@@ -95,6 +96,19 @@ struct Session {
         return -1;
     }
 };
+
+/// How many of process `pid`'s threads are named `name` (/proc/PID/task/TID/comm).
+std::size_t threadsNamed(pid_t pid, const std::string& name) {
+    std::size_t n = 0;
+    std::error_code ec;
+    for (const auto& task :
+         std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) {
+        std::ifstream comm(task.path() / "comm");
+        std::string line;
+        n += std::getline(comm, line) && line == name ? 1 : 0;
+    }
+    return n;
+}
 
 /// True once process `pid` catches all four stop signals (/proc/PID/status, SigCgt): its
 /// StopSignals is installed, and the command's start-up under way. (StopSignals installs them
@@ -183,6 +197,12 @@ TEST_CASE("a host stall (the process stopped 200 ms and then continued) is a fau
     Session s({"--duration", "2", "--no-realtime", "--reopen-ms", "20", "--report",
                (dir / "r.json").string()});
     REQUIRE(s.waitForOutput("hapto run:"));
+    // Both hands' servo threads and the watchdog (named by the runtime) are running: the stall
+    // lands in the session, not in its start-up (which the header line comes before).
+    REQUIRE(eventually([&] {
+        return threadsNamed(s.pid, "hapto-servo") == 2 &&
+               threadsNamed(s.pid, "hapto-watchdog") == 1;
+    }));
     REQUIRE(kill(s.pid, SIGSTOP) == 0);
     // The stimulus is wall time itself: four watchdog timeouts with the whole process stopped.
     std::this_thread::sleep_for(std::chrono::milliseconds(200));

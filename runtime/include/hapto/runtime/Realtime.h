@@ -18,6 +18,11 @@ void sleepUntilNs(std::uint64_t deadlineNs, std::uint64_t spinNs) noexcept;
 /// (Linux's default slack for normal threads is 50 us). [control]
 void tightenTimerSlack() noexcept;
 
+/// Names the calling thread (at most 15 characters are kept), as `top -H`, `gdb` and
+/// /proc/PID/task/TID/comm show it: the runtime's threads are hapto-servo, hapto-group,
+/// hapto-dynamics, hapto-watchdog and hapto-reopen. [control]
+void nameCurrentThread(const char* name) noexcept;
+
 /// What the current thread got when it asked for real-time scheduling.
 struct RealtimeGrant {
     bool fifo = false;   ///< SCHED_FIFO granted.
