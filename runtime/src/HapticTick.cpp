@@ -153,9 +153,10 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
     listed.leaves[0] = stepped ? atProxy.leaf : atDevice.leaf;
     listed.leaves[1] = atProxy.leaf;
     listed.count = 2;
-    listSlide(goal, from, listed, out);
+    const detail::TickAim aim{p, goal, v, dtS, from};
+    listSlide(aim, listed, out);
     stamp(1);
-    render(*snapshot.scene, p, goal, v, dtS, from, listed, out);
+    render(*snapshot.scene, aim, listed, out);
     stamp(2);
 
     // 4. Force effects at the device point, then the hook, and the external force. A hook
@@ -210,15 +211,17 @@ void BasicHapticTick<Algorithm>::bind(const WorldSnapshot& snapshot, const Vec3&
 }
 
 template <ForceAlgorithm Algorithm>
-void BasicHapticTick<Algorithm>::listSlide(const Vec3& goal, const Vec3& from, ListedLeaves& listed,
+void BasicHapticTick<Algorithm>::listSlide(const detail::TickAim& aim, ListedLeaves& listed,
                                            TickOutput& out) noexcept {
+    const Vec3& from = aim.from;
     // The likely slide (from the start along last tick's contact plane to the goal's
     // projection on it) is known before solving, so its first kSlideLeaves leaves are listed
     // first: a slide over small leaves usually solves once. Not more: a proxy trapped far
     // behind the hand has a slide centimetres long that it will not go far along, and its
     // leaves would cost their walks and items and take the room the solved way needs.
-    const Vec3 slide =
-        mRenderer.inContact() ? goal - glm::dot(goal - from, mSlideNormal) * mSlideNormal : from;
+    const Vec3 slide = mRenderer.inContact()
+                           ? aim.goal - glm::dot(aim.goal - from, mSlideNormal) * mSlideNormal
+                           : from;
     while (listed.count < listed.leaves.size() && listed.count < 2 + kSlideLeaves &&
            mRenderer.inContact()) {
         const SegmentWalk missed = mProxyCursor.firstLeafNotIn(from, slide, listed.known());
@@ -252,9 +255,9 @@ std::size_t BasicHapticTick<Algorithm>::listPaths(ListedLeaves& listed, bool& co
 }
 
 template <ForceAlgorithm Algorithm>
-void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const Vec3& goal,
-                                        const Vec3& v, double dtS, const Vec3& from,
+void BasicHapticTick<Algorithm>::render(const Scene& scene, const detail::TickAim& aim,
                                         ListedLeaves& listed, TickOutput& out) noexcept {
+    const auto& [p, goal, v, dtS, from] = aim;
     // The candidates cover where the device and the proxy are, not every place the proxy
     // visits this tick: a proxy sliding over fine triangles (a mesh whose leaves are smaller
     // than one tick's motion, with the device in an empty leaf under the surface) can slide
@@ -275,7 +278,7 @@ void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const
         bool covered = true;
         if (listPaths(listed, covered, out) == 0) {
             if (!covered) {
-                pullBack(scene, p, goal, v, dtS, from, start, listed.known(), tested, out);
+                pullBack(scene, aim, start, listed.known(), tested, out);
             }
             break;
         }
@@ -293,11 +296,11 @@ void BasicHapticTick<Algorithm>::render(const Scene& scene, const Vec3& p, const
 }
 
 template <ForceAlgorithm Algorithm>
-void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, const Vec3& aim,
-                                          const Vec3& v, double dtS, const Vec3& from,
+void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const detail::TickAim& aim,
                                           const typename Algorithm::State& start,
                                           std::span<const std::uint32_t> known,
                                           std::uint32_t& tested, TickOutput& out) noexcept {
+    const auto& [p, target, v, dtS, from] = aim;
     // Out of room while the path still crosses a leaf no span lists (a very fast hand over
     // very small leaves, or a proxy trapped behind a hand that pushed through), or a walk that
     // could not finish: the proxy must not move through space whose items the renderer has not
@@ -310,10 +313,10 @@ void BasicHapticTick<Algorithm>::pullBack(const Scene& scene, const Vec3& p, con
     // the listed leaves (halfway to the aim when it does not): the proxy then moves up to half
     // a leaf in one more solve, where halving from the aim would try goals that each cross
     // unlisted leaves again, and end on the nudge.
-    const double away = glm::length(aim - from);
-    const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (aim - from) : aim;
-    Vec3 goal = aim;
-    const double firstHalf = 0.5 * mProxyCursor.firstLeafNotIn(from, aim, known).t;
+    const double away = glm::length(target - from);
+    const Vec3 nudge = away > kNudgeM ? from + (kNudgeM / away) * (target - from) : target;
+    Vec3 goal = target;
+    const double firstHalf = 0.5 * mProxyCursor.firstLeafNotIn(from, target, known).t;
     bool covered = false;
     for (int k = 0; !covered && k < kPullBacks; ++k) {
         const double keep = k == 0 ? firstHalf : 0.5;

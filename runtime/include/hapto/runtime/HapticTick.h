@@ -70,6 +70,16 @@ inline constexpr int kTickPullBacks = 5;
 /// force; 1 µm is inside the proxy's leaf unless it sits on the leaf's face.
 inline constexpr double kTickNudgeM = 1e-6;
 
+/// Where a tick's proxy starts and aims (m, m/s, s, world): the force is the device point's,
+/// the solve goes toward `goal` (the device point, or the proxy's step toward it).
+struct TickAim {
+    Vec3 device{0.0};   ///< The device point.
+    Vec3 goal{0.0};     ///< What the proxy solves toward.
+    Vec3 velocity{0.0}; ///< The device point's velocity.
+    double dtS = 0.0;   ///< Since the last tick.
+    Vec3 from{0.0};     ///< The proxy at the tick's start.
+};
+
 /// The leaves a tick's candidate spans list (N at most): the device's, the proxy's, then the
 /// extra ones, in the order their spans were added.
 template <std::size_t N> struct ListedLeaves {
@@ -125,8 +135,7 @@ public:
     static constexpr int kPullBacks = detail::kTickPullBacks;             ///< See there.
     static constexpr double kNudgeM = detail::kTickNudgeM;                ///< See there (m).
 
-    /// Checks both configurations (the renderer's maxProxyStepM here: finite, > 0); throws
-    /// std::invalid_argument when one is invalid. [control]
+    /// Checks both configurations (maxProxyStepM: finite, > 0), else invalid_argument. [control]
     explicit BasicHapticTick(const RendererConfig& renderer = {}, const SafetyConfig& safety = {});
 
     /// The next tick starts afresh: the proxy is put on that tick's device point with no
@@ -148,10 +157,8 @@ public:
                     const Vec3& velocityWorld, double dtS, const Vec3& externalForceN) noexcept;
 
     /// The dynamic bodies for the next tick(): their poses come from `table` (null: none),
-    /// extrapolated to `nowNs` (the table's clock) (BodyCoupling). [servo]
-    void placeBodies(BodyPoseTable* table, std::uint64_t nowNs) noexcept {
-        mCoupling.use(table, nowNs);
-    }
+    /// extrapolated to `t` (ns, the table's clock) (BodyCoupling). [servo]
+    void placeBodies(BodyPoseTable* table, std::uint64_t t) noexcept { mCoupling.use(table, t); }
     /// The dynamic bodies the last tick placed. [servo]
     const DynamicBodySet& dynamicBodies() const noexcept { return mCoupling.bodies(); }
     /// The last tick's force was sent as computed: hands the touched dynamic bodies its
@@ -192,21 +199,17 @@ private:
     void stamp(std::size_t i) noexcept;
     /// Binds the cursors to a new snapshot's index, and the proxy to `p` on a fresh start.
     void bind(const WorldSnapshot& snapshot, const Vec3& p, TickOutput& out) noexcept;
-    /// Lists the leaves of the likely slide (`from` along the last contact plane toward the
-    /// goal's projection) first.
-    void listSlide(const Vec3& goal, const Vec3& from, ListedLeaves& listed,
-                   TickOutput& out) noexcept;
+    /// Lists the leaves of the likely slide (along the last contact plane) first.
+    void listSlide(const detail::TickAim& aim, ListedLeaves& listed, TickOutput& out) noexcept;
     /// Lists the unlisted leaves the last paths cross (room allowing): how many; `covered`.
     std::size_t listPaths(ListedLeaves& listed, bool& covered, TickOutput& out) noexcept;
-    /// Solves toward `goal` (the force from the device point `p`), again with the unlisted
-    /// leaves the proxy's way crosses; then pulls back.
-    void render(const Scene& scene, const Vec3& p, const Vec3& goal, const Vec3& v, double dtS,
-                const Vec3& from, ListedLeaves& listed, TickOutput& out) noexcept;
-    /// Solves toward goals pulled back from `aim` toward `from` (TickOutput::pullBacks).
-    void pullBack(const Scene& scene, const Vec3& p, const Vec3& aim, const Vec3& v, double dtS,
-                  const Vec3& from, const typename Algorithm::State& start,
-                  std::span<const std::uint32_t> known, std::uint32_t& tested,
-                  TickOutput& out) noexcept;
+    /// Solves toward the goal, again with the unlisted leaves the way crosses; pulls back.
+    void render(const Scene& scene, const detail::TickAim& aim, ListedLeaves& listed,
+                TickOutput& out) noexcept;
+    /// Solves toward goals pulled back from the goal toward the start (TickOutput::pullBacks).
+    void pullBack(const Scene& scene, const detail::TickAim& aim,
+                  const typename Algorithm::State& start, std::span<const std::uint32_t> known,
+                  std::uint32_t& tested, TickOutput& out) noexcept;
     /// Places the dynamic bodies near `p` and the proxy for the renderer and the candidates.
     void placeDynamic(const WorldSnapshot& snapshot, const Vec3& p, double dtS) noexcept;
 
