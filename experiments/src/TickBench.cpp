@@ -186,6 +186,18 @@ void driveTicks(TickRun& run, std::size_t at, std::size_t count, const TickBench
     }
 }
 
+/// Runs every run in `order` for s.ticks ticks, in turns of kTickBlock ticks, each block
+/// starting with the next run.
+void driveInTurns(const std::vector<TickRun*>& order, const TickBenchSettings& s) {
+    for (std::size_t done = 0, round = 0; done < s.ticks; ++round) {
+        const std::size_t length = std::min(kTickBlock, s.ticks - done);
+        for (std::size_t r = 0; r < order.size(); ++r) {
+            driveTicks(*order[(r + round) % order.size()], done, length, s);
+        }
+        done += length;
+    }
+}
+
 } // namespace
 
 WalkDevice::WalkDevice(const Aabb& bounds, std::uint64_t seed, std::unique_ptr<Device> inner,
@@ -251,7 +263,17 @@ const char* modeName(const TickRun& run) {
     return run.holdLatency ? kHeldModeNames[m] : kModeNames[m];
 }
 
+void foldRepeat(TickRun& first, const TickRun& again) {
+    for (std::size_t k = 0; k < first.ownNs.size(); ++k) {
+        first.ownNs[k] = std::min(first.ownNs[k], again.tickNs[k]);
+        first.workDiffered += first.counts[k] == again.counts[k] ? 0 : 1;
+    }
+}
+
 std::vector<TickTarget> runTickBench(const Scene& scene, const TickBenchSettings& s) {
+    if (s.repeats == 0) {
+        throw std::invalid_argument("bench tick: repeats must be at least 1");
+    }
     std::vector<std::pair<TickMode, bool>> modes;
     for (const TickMode m : s.modes) {
         modes.emplace_back(m, false);
@@ -281,12 +303,30 @@ std::vector<TickTarget> runTickBench(const Scene& scene, const TickBenchSettings
             order.push_back(r.get());
         }
     }
-    for (std::size_t done = 0, round = 0; done < s.ticks; ++round) {
-        const std::size_t length = std::min(kTickBlock, s.ticks - done);
-        for (std::size_t r = 0; r < order.size(); ++r) {
-            driveTicks(*order[(r + round) % order.size()], done, length, s);
+    driveInTurns(order, s);
+    if (s.repeats > 1) {
+        for (TickRun* run : order) {
+            run->ownNs = run->tickNs;
         }
-        done += length;
+    }
+    for (std::size_t repeat = 1; repeat < s.repeats; ++repeat) {
+        // Fresh devices and steps over the same worlds, in the same order: the same ticks.
+        std::vector<std::unique_ptr<TickRun>> again;
+        std::vector<TickRun*> againOrder;
+        std::vector<World*> worlds;
+        for (TickTarget& t : targets) {
+            for (const auto& [mode, held] : modes) {
+                again.push_back(makeRun(*t.world, scene, s, mode, held));
+                againOrder.push_back(again.back().get());
+                worlds.push_back(t.world.get());
+            }
+        }
+        driveInTurns(againOrder, s);
+        for (std::size_t r = 0; r < order.size(); ++r) {
+            foldRepeat(*order[r], *again[r]);
+            order[r]->kept += again[r]->kept;
+            worlds[r]->unregisterReader(again[r]->step->reader);
+        }
     }
     return targets;
 }

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 using namespace hapto;
@@ -115,6 +116,64 @@ TEST_CASE("bench tick stamps every stage of the step in order", "[threads]") {
         REQUIRE(sum == run.tickNs[k]); // the stages tile the tick, wake-up to the metrics' end
     }
     CHECK(run.shared->metrics.ticks.load() == s.ticks);
+}
+
+TEST_CASE("bench tick's repeats do the same ticks again and keep each tick's least time",
+          "[threads]") {
+    const Scene scene = cubeGrid();
+    TickBenchSettings s;
+    s.indices = {IndexSpec::parse("octree:2:0.005"), IndexSpec::parse("grid:4")};
+    s.ticks = 700; // past two blocks of kTickBlock, so the runs take turns
+    s.seed = 5;
+    s.modes = {TickMode::Hot};
+    s.walkIn = walkBox(scene.bounds(), 0.0);
+    s.pushMm = 2.0; // the hand is held back from the proxy: each repeat follows its own forces
+
+    SECTION("one run: no own times") {
+        const std::vector<TickTarget> bench = runTickBench(scene, s);
+        CHECK(bench[0].runs[0]->ownNs.empty());
+        CHECK(bench[0].runs[0]->workDiffered == 0);
+    }
+    SECTION("three repeats: the same work every time, each tick's own time the least") {
+        s.repeats = 3;
+        const std::vector<TickTarget> bench = runTickBench(scene, s);
+        for (const TickTarget& target : bench) {
+            const TickRun& run = *target.runs[0];
+            REQUIRE(run.ownNs.size() == s.ticks);
+            CHECK(run.ticks == s.ticks); // the samples and sums are the first repeat's
+            // The step is deterministic: the same walk does the same work on every repeat.
+            CHECK(run.workDiffered == 0);
+            std::size_t touching = 0;
+            for (std::size_t k = 0; k < s.ticks; ++k) {
+                REQUIRE(run.ownNs[k] <= run.tickNs[k]);
+                touching += run.counts[k].contacts > 0 ? 1 : 0;
+            }
+            CHECK(touching > 20); // the work compared is not all free space
+        }
+    }
+    SECTION("no repeat at all is refused") {
+        s.repeats = 0;
+        CHECK_THROWS_AS(runTickBench(scene, s), std::invalid_argument);
+    }
+}
+
+TEST_CASE("a repeat folds in as each tick's least time, and work that differs is counted") {
+    TickRun first, again;
+    first.tickNs = {500, 900, 700, 300};
+    first.ownNs = first.tickNs;
+    first.counts.assign(4, TickCounts{});
+    again.tickNs = {600, 400, 700, 100};
+    again.counts = first.counts;
+    foldRepeat(first, again);
+    CHECK(first.ownNs == std::vector<double>{500, 400, 700, 100});
+    CHECK(first.tickNs == std::vector<double>{500, 900, 700, 300}); // the first repeat's samples
+    CHECK(first.workDiffered == 0);
+    again.tickNs = {450, 450, 450, 450};
+    again.counts[1].candidates = 3;
+    again.counts[3].solves = 2;
+    foldRepeat(first, again);
+    CHECK(first.ownNs == std::vector<double>{450, 400, 450, 100});
+    CHECK(first.workDiffered == 2);
 }
 
 TEST_CASE("a warmed simulated hand is primed by the servo's step and starts on the surface",

@@ -435,7 +435,9 @@ struct MotionWork {
     double solves = 0, candidates = 0, passes = 0, extraLeaves = 0, pullBacks = 0,
            facetsEntered = 0, contact = 0, multiContact = 0;
     std::uint32_t maxSolves = 0, maxCandidates = 0;
-    experiments::TickCounts worst; ///< The slowest tick's (by CPU time when it was read).
+    /// The slowest tick's: by its own time with --repeats, else by CPU time when it was read,
+    /// else on the wall.
+    experiments::TickCounts worst;
 };
 
 MotionWork workOf(const TickRun& run) {
@@ -453,7 +455,9 @@ MotionWork workOf(const TickRun& run) {
         w.maxSolves = std::max<std::uint32_t>(w.maxSolves, c.solves);
         w.maxCandidates = std::max(w.maxCandidates, c.candidates);
     }
-    const std::vector<double>& ns = run.cpuNs.empty() ? run.tickNs : run.cpuNs;
+    const std::vector<double>& ns = !run.ownNs.empty()   ? run.ownNs
+                                    : !run.cpuNs.empty() ? run.cpuNs
+                                                         : run.tickNs;
     const auto slowest = std::max_element(ns.begin(), ns.end());
     w.worst = run.counts[static_cast<std::size_t>(slowest - ns.begin())];
     return w;
@@ -469,13 +473,13 @@ nlohmann::ordered_json countsJson(const experiments::TickCounts& c) {
 /// One motion run's tick times: on the wall (wake-up to the end of the metrics) and on the
 /// thread's CPU clock, and each p99.9 over rest's (0: no rest run to compare with).
 struct MotionTimes {
-    Quantiles wall, cpu;
-    double wallOverRest = 0, cpuOverRest = 0;
+    Quantiles wall, cpu, own; ///< own: each tick's least wall time over --repeats (TickRun::ownNs)
+    double wallOverRest = 0, cpuOverRest = 0, ownOverRest = 0;
 };
 
 /// One motion run's JSON entry.
 nlohmann::ordered_json motionJson(const experiments::MotionCase& c, const TickTarget& target,
-                                  const TickRun& run, const MotionTimes& t) {
+                                  const TickRun& run, const MotionTimes& t, std::size_t repeats) {
     const MotionWork w = workOf(run);
     nlohmann::ordered_json stages = nlohmann::ordered_json::object();
     for (std::size_t st = 0; st < kStageCount; ++st) {
@@ -490,8 +494,12 @@ nlohmann::ordered_json motionJson(const experiments::MotionCase& c, const TickTa
             {"ticks", run.ticks},
             {"tick", toJson(t.wall)},
             {"tick_cpu", run.cpuNs.empty() ? nlohmann::ordered_json() : toJson(t.cpu)},
+            {"tick_own", run.ownNs.empty() ? nlohmann::ordered_json() : toJson(t.own)},
+            {"repeats", repeats},
+            {"work_differed", run.workDiffered},
             {"p999_over_rest", t.wallOverRest},
             {"cpu_p999_over_rest", t.cpuOverRest},
+            {"own_p999_over_rest", t.ownOverRest},
             {"stages", stages},
             {"contact_fraction", w.contact},
             {"multi_contact_fraction", w.multiContact},
@@ -515,17 +523,22 @@ std::string ratioText(double r) {
 
 std::string motionTimesRow(const experiments::MotionCase& c, const TickTarget& target,
                            const TickRun& run, const MotionTimes& t) {
-    char cpu[64] = "      -       -        -        -";
-    if (!run.cpuNs.empty()) {
-        std::snprintf(cpu, sizeof cpu, "%7.0f %7.0f %8.0f %8.0f", t.cpu.p50, t.cpu.p99, t.cpu.p999,
-                      t.cpu.max);
-    }
-    char row[256];
-    std::snprintf(row, sizeof row, "%-8s %-15s %-10s | %7.0f %7.0f %8.0f %9.0f | %s | %8s %8s\n",
+    const auto columns = [](const std::vector<double>& samples, const Quantiles& q) {
+        char text[64] = "      -       -        -        -";
+        if (!samples.empty()) {
+            std::snprintf(text, sizeof text, "%7.0f %7.0f %8.0f %8.0f", q.p50, q.p99, q.p999,
+                          q.max);
+        }
+        return std::string(text);
+    };
+    char row[320];
+    std::snprintf(row, sizeof row,
+                  "%-8s %-15s %-10s | %7.0f %7.0f %8.0f %9.0f | %s | %s | %8s %8s %8s\n",
                   std::string(experiments::tickMotionName(c.motion)).c_str(),
                   target.spec.toString().c_str(), modeName(run), t.wall.p50, t.wall.p99,
-                  t.wall.p999, t.wall.max, cpu, ratioText(t.wallOverRest).c_str(),
-                  ratioText(t.cpuOverRest).c_str());
+                  t.wall.p999, t.wall.max, columns(run.cpuNs, t.cpu).c_str(),
+                  columns(run.ownNs, t.own).c_str(), ratioText(t.wallOverRest).c_str(),
+                  ratioText(t.cpuOverRest).c_str(), ratioText(t.ownOverRest).c_str());
     return row;
 }
 
@@ -556,11 +569,46 @@ void printMotionHeader(const experiments::TickBenchSettings& common,
                 "cpu (--cpu-time; - without): this thread's CPU clock around the step (without "
                 "the time other processes held the core; a system call per tick, which slows "
                 "the ticks after it); nearest-rank quantiles over every tick (ns); "
-                "/rest: p99.9 over rest's\n");
+                "own (--repeats > 1; - without): each tick's least wall time over the repeats of "
+                "the same ticks, the host's interruptions taken out; /rest: p99.9 over rest's\n");
     std::printf("counts:  per tick, means: solves, passes (solver passes of the last solve), "
                 "candidates, extra leaves, pull-backs, facets entered; max: the largest solves "
-                "and candidates of any tick; slowest (by cpu): that tick's solves, candidates, "
-                "passes, extra leaves, pull-backs\n");
+                "and candidates of any tick; slowest (by own time, else cpu, else wall): that "
+                "tick's solves, candidates, passes, extra leaves, pull-backs\n");
+}
+
+/// The motions' two tables (times, work), the motions whose work differed between repeats,
+/// and what each motion is.
+void printMotionTables(const std::vector<std::string>& timeRows,
+                       const std::vector<std::string>& workRows,
+                       const std::vector<std::string>& differed,
+                       const std::vector<std::string>& described) {
+    std::printf("\n%-8s %-15s %-10s | %7s %7s %8s %9s | %7s %7s %8s %8s | %7s %7s %8s %8s | "
+                "%8s %8s %8s\n",
+                "motion", "index", "mode", "p50", "p99", "p99.9", "max", "cpu p50", "p99", "p99.9",
+                "max", "own p50", "p99", "p99.9", "max", "/rest", "cpu/rest", "own/rest");
+    for (const std::string& row : timeRows) {
+        std::printf("%s", row.c_str());
+    }
+    std::printf("\n%-8s %-15s %-10s | %6s %6s %6s %6s %7s %6s %5s %6s | %10s | %s\n", "motion",
+                "index", "mode", "contact", "2+", "solves", "passes", "cand.", "extra", "pull",
+                "facets", "max s/cand", "slowest s cand pa ex pb");
+    for (const std::string& row : workRows) {
+        std::printf("%s", row.c_str());
+    }
+    if (!differed.empty()) {
+        // A deterministic step does the same work on every repeat; say so when it did not.
+        std::printf("\nticks whose work differed between repeats (their own times mix "
+                    "different work):");
+        for (const std::string& d : differed) {
+            std::printf(" %s", d.c_str());
+        }
+        std::printf("\n");
+    }
+    std::printf("\n");
+    for (const std::string& d : described) {
+        std::printf("%s\n", d.c_str());
+    }
 }
 
 void runMotions(const TickArgs& args) {
@@ -583,9 +631,9 @@ void runMotions(const TickArgs& args) {
 
     // Each motion's scene (10^6 objects) and index go before the next is built; only the
     // rows and the JSON are kept.
-    std::vector<std::string> timeRows, workRows, described;
+    std::vector<std::string> timeRows, workRows, described, differed;
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
-    std::map<std::string, std::pair<double, double>> rest; // wall, cpu p99.9 by index and mode
+    std::map<std::string, MotionTimes> rest; // rest's times by index and mode
     for (const experiments::TickMotion m : motions) {
         const experiments::MotionCase c = experiments::makeMotionCase(m, size);
         experiments::TickBenchSettings s = common;
@@ -600,39 +648,31 @@ void runMotions(const TickArgs& args) {
         const std::vector<TickTarget> targets = experiments::runTickBench(c.scene, s);
         for (const TickTarget& target : targets) {
             for (const auto& run : target.runs) {
-                MotionTimes t{quantilesOf(run->tickNs), quantilesOf(run->cpuNs)};
+                MotionTimes t{quantilesOf(run->tickNs), quantilesOf(run->cpuNs),
+                              quantilesOf(run->ownNs)};
                 const std::string key = target.spec.toString() + " " + modeName(*run);
                 if (m == experiments::TickMotion::Rest) {
-                    rest[key] = {t.wall.p999, t.cpu.p999};
+                    rest[key] = t;
                 } else if (rest.count(key) != 0) {
-                    t.wallOverRest = t.wall.p999 / rest[key].first;
-                    t.cpuOverRest = args.cpuTime ? t.cpu.p999 / rest[key].second : 0.0;
+                    const MotionTimes& r = rest[key];
+                    t.wallOverRest = t.wall.p999 / r.wall.p999;
+                    t.cpuOverRest = args.cpuTime ? t.cpu.p999 / r.cpu.p999 : 0.0;
+                    t.ownOverRest = run->ownNs.empty() ? 0.0 : t.own.p999 / r.own.p999;
                 }
                 timeRows.push_back(motionTimesRow(c, target, *run, t));
                 workRows.push_back(motionWorkRow(c, target, *run));
-                out.push_back(motionJson(c, target, *run, t));
+                out.push_back(motionJson(c, target, *run, t, s.repeats));
+                if (run->workDiffered > 0) {
+                    differed.push_back(std::string(experiments::tickMotionName(m)) + ": " +
+                                       std::to_string(run->workDiffered));
+                }
                 keep(run->kept);
             }
         }
         described.push_back(std::string(experiments::tickMotionName(m)) + ": " + c.sceneText +
                             "; " + c.pathText);
     }
-    std::printf("\n%-8s %-15s %-10s | %7s %7s %8s %9s | %7s %7s %8s %8s | %8s %8s\n", "motion",
-                "index", "mode", "p50", "p99", "p99.9", "max", "cpu p50", "p99", "p99.9", "max",
-                "/rest", "cpu/rest");
-    for (const std::string& row : timeRows) {
-        std::printf("%s", row.c_str());
-    }
-    std::printf("\n%-8s %-15s %-10s | %6s %6s %6s %6s %7s %6s %5s %6s | %10s | %s\n", "motion",
-                "index", "mode", "contact", "2+", "solves", "passes", "cand.", "extra", "pull",
-                "facets", "max s/cand", "slowest s cand pa ex pb");
-    for (const std::string& row : workRows) {
-        std::printf("%s", row.c_str());
-    }
-    std::printf("\n");
-    for (const std::string& d : described) {
-        std::printf("%s\n", d.c_str());
-    }
+    printMotionTables(timeRows, workRows, differed, described);
     if (!args.json.empty()) {
         writeFileAtomically(args.json, out.dump(2) + "\n");
         std::printf("\nwrote %s\n", args.json.c_str());
@@ -643,6 +683,9 @@ void runTick(const TickArgs& args) {
     if (!args.motions.empty()) {
         runMotions(args);
         return;
+    }
+    if (args.settings.repeats > 1) {
+        throw InputError("--repeats: only with --motion (each motion's own times)");
     }
     experiments::TickBenchSettings s = tickSettings(args);
     const Scene scene = loadSceneOrDefault(args.scene);
@@ -734,6 +777,13 @@ void addMotionOptions(CLI::App* tick, TickArgs& targs) {
                    "system call per tick: on a VM it makes the ticks after it slower (here the "
                    "resting tick's p50 0.8 -> 2.5 us), so compare such runs only with each "
                    "other");
+    tick->add_option("--repeats", targs.settings.repeats,
+                     "With --motion: run each motion this many times over the same ticks (the "
+                     "same work) and also report each tick's least wall time over the repeats "
+                     "(own): its cost with the host's interruptions taken out, since one that "
+                     "lands on a tick in one repeat rarely lands on it in every one")
+        ->capture_default_str()
+        ->transform(wholeNumber(1, 100));
     tick->add_option("--objects", targs.motionSize.objects,
                      "With --motion: cubes in the cube scenes (the lattice rounds to K^3) and "
                      "triangles in the sphere, e.g. 1e6")

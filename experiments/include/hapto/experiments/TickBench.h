@@ -108,6 +108,12 @@ struct TickBenchSettings {
     /// time without the time other processes held the core. Two clock_gettime calls per tick,
     /// outside the stages' stamps.
     bool cpuTime = false;
+    /// Runs every (index, mode) this many times over the same ticks (the same seed, path and
+    /// poses: the same work), each time with a fresh device and step over the same index, and
+    /// keeps in TickRun::ownNs each tick's least wall time: its own cost, with the host's
+    /// interruptions taken out (one that lands on a tick in one repeat rarely lands on it in
+    /// every one). The other samples are the first repeat's. At least 1.
+    std::size_t repeats = 1;
 };
 
 /// What one tick did, the work that explains its time.
@@ -122,6 +128,8 @@ struct TickCounts {
     /// Facets entered: the tick's contact planes (item and normal) that the previous tick's
     /// contacts did not hold: the faces, edges' sides and triangles the proxy moved onto.
     std::uint8_t facetsEntered = 0;
+
+    bool operator==(const TickCounts&) const = default; ///< Every count the same.
 };
 
 /// One (index, mode) being driven: its device, its step and its per-tick samples.
@@ -160,6 +168,12 @@ struct TickRun {
     /// Per tick after a sleep: how long after its deadline it started (ns; 0 if on time): the
     /// wake-up's lateness, plus a warm-up's overrun. A servo reads its device this late.
     std::vector<double> startLateNs;
+    /// Per tick with TickBenchSettings::repeats > 1: its least wall time over the repeats
+    /// (ns); empty otherwise.
+    std::vector<double> ownNs;
+    /// Ticks whose work (TickCounts) differed between repeats: 0 when every repeat did the
+    /// same work, as a deterministic step does; otherwise ownNs mixes different work.
+    std::uint64_t workDiffered = 0;
 };
 
 /// One index: its world (scene copy, index, snapshots) and its runs.
@@ -174,9 +188,16 @@ const char* modeName(const TickRun& run);
 
 /// Builds every target over `scene` and runs every (index, mode) for settings.ticks ticks, the
 /// runs taking turns in blocks of kTickBlock ticks (each block starting with another run), so
-/// a slow spell of the machine falls on all of them alike. Throws std::runtime_error when a
-/// device does not open, a wake-latency request cannot be held, or a step faults. [control]
+/// a slow spell of the machine falls on all of them alike; then again settings.repeats - 1
+/// times, folding each tick's least time into TickRun::ownNs. Throws std::invalid_argument for
+/// 0 repeats, std::runtime_error when a device does not open, a wake-latency request cannot
+/// be held, or a step faults. [control]
 std::vector<TickTarget> runTickBench(const Scene& scene, const TickBenchSettings& settings);
+/// Folds `again`, a repeat of `first`'s ticks, into `first`: each tick's TickRun::ownNs
+/// becomes the least of it and `again`'s wall time, and TickRun::workDiffered counts the ticks
+/// whose TickCounts differ. `first.ownNs` must already hold a time per tick (the first
+/// repeat's, to begin with); `again` must have as many ticks. [control]
+void foldRepeat(TickRun& first, const TickRun& again);
 /// Ticks a run takes in one turn.
 inline constexpr std::size_t kTickBlock = 256;
 
