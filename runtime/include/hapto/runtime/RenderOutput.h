@@ -26,10 +26,12 @@ struct RendererConfig {
     double torsionRadiusM = 0.003;
     /// The farthest a proxy that the last tick left behind its device point moves toward it in
     /// one tick (m, world; finite, > 0): its goal is the device point, or the point this far
-    /// along the way to it (HapticTick.h). 5 mm by default, 5 m/s at 1 kHz, faster than a hand
-    /// moves a grip; it bounds the space one tick's solve can reach. The runtime gives each
-    /// device this much of its own motion: times its transform's scale (withDeviceSettings).
-    double maxProxyStepM = 0.005;
+    /// along the way to it (HapticTick.h). 3 mm by default, 3 m/s at 1 kHz, faster than a hand
+    /// slides while it presses; it bounds the space one tick's solve can reach, and so the
+    /// worst tick of a hand that pushed through a dense scene (docs/results/tick-motions.md,
+    /// "The proxy's step: 3 mm"). The runtime gives each device this much of its own motion:
+    /// times its transform's scale (withDeviceSettings).
+    double maxProxyStepM = 0.003;
 };
 
 /// What happened in a tick besides the force.
