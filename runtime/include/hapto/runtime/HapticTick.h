@@ -226,7 +226,7 @@ private:
     StageStamps* mStamps = nullptr;  ///< Where tick() writes its stage ends, or none.
     bool mFresh = true;              ///< The next tick starts afresh (reset()).
     bool mLeftBehind = false;        ///< The last tick ended with the proxy off its device point.
-    double mMaxStepM = 0.003;        ///< RendererConfig::maxProxyStepM (m, world).
+    double mMaxStepM;                ///< RendererConfig::maxProxyStepM (m, world), as given.
     BodyCoupling mCoupling;          ///< The dynamic bodies placed, and their reaction.
 };
 
