@@ -60,6 +60,12 @@ LocateResult Cursor::locate(const Vec3& p) noexcept {
 SegmentWalk Cursor::firstLeafNotIn(const Vec3& a, const Vec3& b,
                                    std::span<const std::uint32_t> listed) const noexcept {
     Cursor walker = *this;
+    return walker.walkToFirstLeafNotIn(a, b, listed);
+}
+
+SegmentWalk Cursor::walkToFirstLeafNotIn(const Vec3& a, const Vec3& b,
+                                         std::span<const std::uint32_t> listed) noexcept {
+    Cursor& walker = *this;
     const Vec3 d = b - a;
     const double length = glm::length(d);
     double t = 0.0;

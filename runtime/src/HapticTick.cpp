@@ -40,12 +40,13 @@ namespace hapto {
 namespace {
 
 /// Walks every segment of the renderer's visited paths (where the proxy went in its last
-/// update) leaf by leaf, from the proxy's cursor `walker`. At each leaf not in `listed()` it
+/// update) leaf by leaf, with `walker` (a copy of the proxy's cursor, moved along the way, so
+/// every leaf on it is located once). At each leaf not in `listed()` it
 /// calls `onMissed(missed)`, which lists that leaf and returns true to walk on from where the
 /// segment enters it, or returns false to stop there. Returns true when every leaf on the way
 /// was listed, false when it stopped. [servo]
 template <ForceAlgorithm Algorithm, class Listed, class OnMissed>
-bool walkPaths(const Cursor& walker, const Algorithm& renderer, Listed&& listed,
+bool walkPaths(Cursor walker, const Algorithm& renderer, Listed&& listed,
                OnMissed&& onMissed) noexcept {
     for (int which = 0; which < 2; ++which) {
         const std::span<const Vec3> path = renderer.visitedPath(which);
@@ -58,7 +59,7 @@ bool walkPaths(const Cursor& walker, const Algorithm& renderer, Listed&& listed,
             }
             Vec3 a = path[i - 1];
             for (;;) {
-                const SegmentWalk missed = walker.firstLeafNotIn(a, path[i], listed());
+                const SegmentWalk missed = walker.walkToFirstLeafNotIn(a, path[i], listed());
                 box = missed.endBox;
                 if (missed.covered()) {
                     break;
@@ -222,14 +223,19 @@ void BasicHapticTick<Algorithm>::listSlide(const detail::TickAim& aim, ListedLea
     const Vec3 slide = mRenderer.inContact()
                            ? aim.goal - glm::dot(aim.goal - from, mSlideNormal) * mSlideNormal
                            : from;
+    // One walker along the slide: after a leaf is listed it walks on from where the slide
+    // enters that leaf, so each leaf is located once.
+    Cursor walker = mProxyCursor;
+    Vec3 a = from;
     while (listed.count < listed.leaves.size() && listed.count < 2 + kSlideLeaves &&
            mRenderer.inContact()) {
-        const SegmentWalk missed = mProxyCursor.firstLeafNotIn(from, slide, listed.known());
+        const SegmentWalk missed = walker.walkToFirstLeafNotIn(a, slide, listed.known());
         if (missed.at.leaf == kNoLeaf || !mCandidates.add(missed.at.candidates)) {
             break;
         }
         listed.leaves[listed.count++] = missed.at.leaf;
         ++out.extraLeaves;
+        a += missed.t * (slide - a); // inside the leaf just listed
     }
 }
 

@@ -42,6 +42,29 @@ std::vector<Vec3> randomWalk(const Aabb& b, std::uint64_t seed, int steps, doubl
     return walk;
 }
 
+/// Calls fn(index, a, e, n) for 200 seeded segments a -> e inside each test scene's bounds,
+/// under an octree and a grid (n: the segment's number).
+template <class Fn> void forSegmentsInScenes(std::uint64_t seed, Fn&& fn) {
+    for (const auto& [name, scene] : testScenes()) {
+        for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::grid(7)}) {
+            INFO(name << " " << spec.toString());
+            const auto index = buildIndex(scene, spec);
+            const Aabb b = scene.bounds();
+            Random rng(seed);
+            const auto inBounds = [&] {
+                return b.center() +
+                       0.45 * b.size() *
+                           Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+            };
+            for (int n = 0; n < 200; ++n) {
+                const Vec3 a = inBounds();
+                const Vec3 e = inBounds();
+                fn(*index, a, e, n);
+            }
+        }
+    }
+}
+
 } // namespace
 
 TEST_CASE("a cursor on a long hand-speed walk lands where a fresh locate does, links never "
@@ -135,48 +158,64 @@ TEST_CASE("cursor: unbound, outside and back, reset to another index, FromRoot s
 TEST_CASE("cursor walk: the first unlisted leaf along a segment, every leaf a sampled point is "
           "in found, the cursor itself unmoved",
           "[threads]") {
-    for (const auto& [name, scene] : testScenes()) {
-        for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::grid(7)}) {
-            INFO(name << " " << spec.toString());
-            const auto index = buildIndex(scene, spec);
-            const Aabb b = scene.bounds();
-            Random rng(23);
-            for (int n = 0; n < 200; ++n) {
-                const Vec3 a = b.center() +
-                               0.45 * b.size() *
-                                   Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
-                const Vec3 e = b.center() +
-                               0.45 * b.size() *
-                                   Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
-                Cursor cursor(*index);
-                const std::uint32_t startLeaf = cursor.locate(a).leaf;
-                // List the leaves one walk at a time: each is found where the segment enters
-                // it, and the first is a's own.
-                std::vector<std::uint32_t> listed;
-                SegmentWalk walk;
-                for (int k = 0; k < 200; ++k) {
-                    walk = cursor.firstLeafNotIn(a, e, listed);
-                    if (walk.at.leaf == kNoLeaf || walk.unknown) {
-                        break;
-                    }
-                    INFO("segment " << n << ", walk " << k << " at t = " << walk.t);
-                    REQUIRE(walk.t >= 0.0);
-                    REQUIRE(walk.t <= 1.0);
-                    REQUIRE(index->locate(a + walk.t * (e - a)).leaf == walk.at.leaf);
-                    REQUIRE((k > 0 || (walk.t == 0.0 && walk.at.leaf == startLeaf)));
-                    listed.push_back(walk.at.leaf);
-                }
-                REQUIRE(walk.covered());
-                REQUIRE(cursor.leaf() == startLeaf);
-                // The walk saw every leaf a point of the segment lies in, and ended in e's.
-                for (int k = 0; k <= 400; ++k) {
-                    const std::uint32_t leaf = index->locate(a + (k / 400.0) * (e - a)).leaf;
-                    REQUIRE(std::find(listed.begin(), listed.end(), leaf) != listed.end());
-                }
-                REQUIRE((walk.endBox.isEmpty() || walk.endBox.contains(e)));
+    forSegmentsInScenes(23, [](const SpatialIndex& index, const Vec3& a, const Vec3& e, int n) {
+        Cursor cursor(index);
+        const std::uint32_t startLeaf = cursor.locate(a).leaf;
+        // List the leaves one walk at a time: each is found where the segment enters it, and
+        // the first is a's own.
+        std::vector<std::uint32_t> listed;
+        SegmentWalk walk;
+        for (int k = 0; k < 200; ++k) {
+            walk = cursor.firstLeafNotIn(a, e, listed);
+            if (walk.at.leaf == kNoLeaf || walk.unknown) {
+                break;
             }
+            INFO("segment " << n << ", walk " << k << " at t = " << walk.t);
+            REQUIRE(walk.t >= 0.0);
+            REQUIRE(walk.t <= 1.0);
+            REQUIRE(index.locate(a + walk.t * (e - a)).leaf == walk.at.leaf);
+            REQUIRE((k > 0 || (walk.t == 0.0 && walk.at.leaf == startLeaf)));
+            listed.push_back(walk.at.leaf);
         }
-    }
+        REQUIRE(walk.covered());
+        REQUIRE(cursor.leaf() == startLeaf);
+        // The walk saw every leaf a point of the segment lies in, and ended in e's.
+        for (int k = 0; k <= 400; ++k) {
+            const std::uint32_t leaf = index.locate(a + (k / 400.0) * (e - a)).leaf;
+            REQUIRE(std::find(listed.begin(), listed.end(), leaf) != listed.end());
+        }
+        REQUIRE((walk.endBox.isEmpty() || walk.endBox.contains(e)));
+    });
+}
+
+TEST_CASE("cursor walk: one walker that walks on from where the segment enters each leaf it "
+          "found lists the leaves fresh walks from the start list, in the same order, and ends "
+          "in the last leaf it located",
+          "[threads]") {
+    forSegmentsInScenes(29, [](const SpatialIndex& index, const Vec3& a, const Vec3& e, int n) {
+        Cursor cursor(index);
+        cursor.locate(a);
+        std::vector<std::uint32_t> fresh;
+        for (SegmentWalk w = cursor.firstLeafNotIn(a, e, fresh); w.at.leaf != kNoLeaf && !w.unknown;
+             w = cursor.firstLeafNotIn(a, e, fresh)) {
+            fresh.push_back(w.at.leaf);
+        }
+        Cursor walker = cursor;
+        std::vector<std::uint32_t> walked;
+        Vec3 from = a;
+        SegmentWalk w = walker.walkToFirstLeafNotIn(from, e, walked);
+        for (; w.at.leaf != kNoLeaf && !w.unknown;
+             w = walker.walkToFirstLeafNotIn(from, e, walked)) {
+            INFO("segment " << n << ", leaf " << walked.size());
+            REQUIRE(walker.leaf() == w.at.leaf);
+            walked.push_back(w.at.leaf);
+            from += w.t * (e - from);
+        }
+        INFO("segment " << n);
+        REQUIRE(w.covered());
+        REQUIRE(walked == fresh);
+        REQUIRE(walker.leaf() == index.locate(e).leaf);
+    });
 }
 
 TEST_CASE("cursor walk: outside the bounds, zero length, and an unbound cursor find nothing",
