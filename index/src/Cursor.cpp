@@ -65,12 +65,11 @@ SegmentWalk Cursor::firstLeafNotIn(const Vec3& a, const Vec3& b,
 
 SegmentWalk Cursor::walkToFirstLeafNotIn(const Vec3& a, const Vec3& b,
                                          std::span<const std::uint32_t> listed) noexcept {
-    Cursor& walker = *this;
     const Vec3 d = b - a;
     const double length = glm::length(d);
     double t = 0.0;
     for (int walked = 0; walked < kMaxWalkLeaves; ++walked) {
-        const LocateResult at = walker.locate(a + t * d);
+        const LocateResult at = locate(a + t * d);
         if (at.outside) {
             return {};
         }

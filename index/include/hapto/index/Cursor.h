@@ -77,10 +77,10 @@ public:
     /// not from the root; this cursor is unchanged. No allocation. [servo]
     SegmentWalk firstLeafNotIn(const Vec3& a, const Vec3& b,
                                std::span<const std::uint32_t> listed) const noexcept;
-    /// The same walk with this cursor as the walker: it ends at the last leaf it located (the
-    /// leaf found, or the one holding b). A caller that lists each leaf found and walks on
-    /// from where the segment enters it (`a + t (b - a)`) with the same walker locates every
-    /// leaf of the way once. No allocation. [servo]
+    /// The same walk with this cursor as the walker: it is left at the last leaf it located
+    /// (the leaf found, or the way's last inside the bounds). A caller that lists each leaf found
+    /// and walks on from where the segment enters it (`a + t (b - a)`) with the same walker locates
+    /// every leaf of the way once. No allocation. [servo]
     SegmentWalk walkToFirstLeafNotIn(const Vec3& a, const Vec3& b,
                                      std::span<const std::uint32_t> listed) noexcept;
 
