@@ -63,54 +63,57 @@ fs::path folderOf(const fs::path& path) {
     return path.has_parent_path() ? path.parent_path() : fs::path(".");
 }
 
-/// A streambuf writing to a file descriptor through a buffer; errors make the stream bad.
-class FdBuf final : public std::streambuf {
-public:
-    explicit FdBuf(int fd) : mFd(fd), mBuffer(1 << 16) {
-        setp(mBuffer.data(), mBuffer.data() + mBuffer.size());
-    }
-    bool failed() const { return mFailed; }
-    int error() const { return mErrno; }
-
-protected:
-    int_type overflow(int_type c) override {
-        if (sync() != 0) {
-            return traits_type::eof();
-        }
-        if (!traits_type::eq_int_type(c, traits_type::eof())) {
-            *pptr() = traits_type::to_char_type(c);
-            pbump(1);
-        }
-        return traits_type::not_eof(c);
-    }
-    int sync() override {
-        const char* p = pbase();
-        while (p < pptr() && !mFailed) {
-            const ssize_t n = ::write(mFd, p, static_cast<std::size_t>(pptr() - p));
-            if (n < 0 && errno == EINTR) {
-                continue;
-            }
-            if (n <= 0) {
-                mFailed = true;
-                mErrno = n < 0 ? errno : EIO;
-                break;
-            }
-            p += n;
-        }
-        setp(mBuffer.data(), mBuffer.data() + mBuffer.size());
-        return mFailed ? -1 : 0;
-    }
-
-private:
-    int mFd;
-    std::vector<char> mBuffer;
-    bool mFailed = false;
-    int mErrno = 0;
-};
-
 } // namespace
 
+// FdBuf is Impl's own, not the anonymous namespace's: Impl is declared in the header, and a
+// member whose type has internal linkage makes GCC warn (-Wsubobject-linkage) when the unity
+// build includes this file into its unit.
 struct AtomicOutputFile::Impl {
+    /// A streambuf writing to a file descriptor through a buffer; errors make the stream bad.
+    class FdBuf final : public std::streambuf {
+    public:
+        explicit FdBuf(int fd) : mFd(fd), mBuffer(1 << 16) {
+            setp(mBuffer.data(), mBuffer.data() + mBuffer.size());
+        }
+        bool failed() const { return mFailed; }
+        int error() const { return mErrno; }
+
+    protected:
+        int_type overflow(int_type c) override {
+            if (sync() != 0) {
+                return traits_type::eof();
+            }
+            if (!traits_type::eq_int_type(c, traits_type::eof())) {
+                *pptr() = traits_type::to_char_type(c);
+                pbump(1);
+            }
+            return traits_type::not_eof(c);
+        }
+        int sync() override {
+            const char* p = pbase();
+            while (p < pptr() && !mFailed) {
+                const ssize_t n = ::write(mFd, p, static_cast<std::size_t>(pptr() - p));
+                if (n < 0 && errno == EINTR) {
+                    continue;
+                }
+                if (n <= 0) {
+                    mFailed = true;
+                    mErrno = n < 0 ? errno : EIO;
+                    break;
+                }
+                p += n;
+            }
+            setp(mBuffer.data(), mBuffer.data() + mBuffer.size());
+            return mFailed ? -1 : 0;
+        }
+
+    private:
+        int mFd;
+        std::vector<char> mBuffer;
+        bool mFailed = false;
+        int mErrno = 0;
+    };
+
     fs::path target;    // where the contents end up (a symlink resolved)
     fs::path temporary; // beside the target, renamed onto it by commit()
     int fd = -1;
@@ -150,7 +153,7 @@ AtomicOutputFile::AtomicOutputFile(const fs::path& path)
     if (exists && S_ISREG(st.st_mode)) {
         (void)::fchmod(m.fd, st.st_mode & 07777); // a replaced file keeps its permissions
     }
-    m.buf = std::make_unique<FdBuf>(m.fd);
+    m.buf = std::make_unique<Impl::FdBuf>(m.fd);
     m.stream = std::make_unique<std::ostream>(m.buf.get());
 }
 
