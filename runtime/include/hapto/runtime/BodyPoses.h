@@ -7,14 +7,16 @@
 /// sequence odd, stores the fields, makes it even again; a reader copies the fields between two
 /// equal even sequence reads and retries otherwise (a retry happens only when a publication
 /// raced it; publications come once per dynamics step). The fields are relaxed atomics, so the
-/// protocol is data-race free as C++ defines it (ThreadSanitizer agrees) and costs plain loads
-/// and stores on x86-64. Impulses are summed in fixed point (int64, kImpulseQuantumNs per unit)
-/// by atomic fetch_add and taken by exchange with zero: every servo tick's contribution lands in
-/// exactly one dynamics step whatever the two rates, and integer sums do not depend on the order
-/// in which threads add (the step mode's runs are byte-identical). The hands' torsional
-/// friction budgets (BodyCoupling.h) are summed the same way, as the six components of a
-/// symmetric tensor sum budget n n^T, which does not depend on a normal's sign: two hands
-/// pressing from opposite sides add their budgets about their common axis. Nothing here
+/// protocol is data-race free as C++ defines it and costs plain loads and stores on x86-64; two
+/// fences order them against the sequence. ThreadSanitizer does not model fences (GCC's -Wtsan),
+/// so under it the fields are stored with release and loaded with acquire instead, which orders
+/// at least as much and lets it check the protocol. Impulses are summed in fixed point (int64,
+/// kImpulseQuantumNs per unit) by atomic fetch_add and taken by exchange with zero: every servo
+/// tick's contribution lands in exactly one dynamics step whatever the two rates, and integer sums
+/// do not depend on the order in which threads add (the step mode's runs are byte-identical). The
+/// hands' torsional friction budgets (BodyCoupling.h) are summed the same way, as the six
+/// components of a symmetric tensor sum budget n n^T, which does not depend on a normal's sign: two
+/// hands pressing from opposite sides add their budgets about their common axis. Nothing here
 /// allocates after construction, locks or throws.
 
 #include "hapto/core/Geometry.h"
@@ -24,6 +26,14 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+
+// Under ThreadSanitizer the seqlock's fields carry the ordering instead of two fences (see
+// the design note above).
+#if defined(__SANITIZE_THREAD__)
+#define HAPTO_SEQLOCK_WITHOUT_FENCES 1
+#else
+#define HAPTO_SEQLOCK_WITHOUT_FENCES 0
+#endif
 
 namespace hapto {
 
@@ -60,14 +70,16 @@ public:
         Record& r = mRecords[i];
         const std::uint64_t s = r.sequence.load(std::memory_order_relaxed);
         r.sequence.store(s + 1, std::memory_order_relaxed);
+#if !HAPTO_SEQLOCK_WITHOUT_FENCES
         std::atomic_thread_fence(std::memory_order_release);
+#endif
         const std::array<double, kFields> f = pack(pose);
         for (std::size_t k = 0; k < kFields; ++k) {
-            r.fields[k].store(f[k], std::memory_order_relaxed);
+            r.fields[k].store(f[k], kFieldStore);
         }
-        r.timeNs.store(pose.timeNs, std::memory_order_relaxed);
-        r.step.store(pose.step, std::memory_order_relaxed);
-        r.sleeping.store(pose.sleeping, std::memory_order_relaxed);
+        r.timeNs.store(pose.timeNs, kFieldStore);
+        r.step.store(pose.step, kFieldStore);
+        r.sleeping.store(pose.sleeping, kFieldStore);
         r.sequence.store(s + 2, std::memory_order_release);
     }
 
@@ -82,13 +94,15 @@ public:
             }
             std::array<double, kFields> f{};
             for (std::size_t k = 0; k < kFields; ++k) {
-                f[k] = r.fields[k].load(std::memory_order_relaxed);
+                f[k] = r.fields[k].load(kFieldLoad);
             }
             BodyPose pose = unpack(f);
-            pose.timeNs = r.timeNs.load(std::memory_order_relaxed);
-            pose.step = r.step.load(std::memory_order_relaxed);
-            pose.sleeping = r.sleeping.load(std::memory_order_relaxed);
+            pose.timeNs = r.timeNs.load(kFieldLoad);
+            pose.step = r.step.load(kFieldLoad);
+            pose.sleeping = r.sleeping.load(kFieldLoad);
+#if !HAPTO_SEQLOCK_WITHOUT_FENCES
             std::atomic_thread_fence(std::memory_order_acquire);
+#endif
             if (r.sequence.load(std::memory_order_relaxed) == s1) {
                 return pose;
             }
@@ -169,6 +183,12 @@ public:
 
 private:
     static constexpr std::size_t kFields = 16;
+    /// How a record's fields are stored and loaded: relaxed between the fences, or release and
+    /// acquire where the fences are left out (HAPTO_SEQLOCK_WITHOUT_FENCES).
+    static constexpr std::memory_order kFieldStore =
+        HAPTO_SEQLOCK_WITHOUT_FENCES ? std::memory_order_release : std::memory_order_relaxed;
+    static constexpr std::memory_order kFieldLoad =
+        HAPTO_SEQLOCK_WITHOUT_FENCES ? std::memory_order_acquire : std::memory_order_relaxed;
     struct alignas(64) Record {
         std::atomic<std::uint64_t> sequence{0};
         std::array<std::atomic<double>, kFields> fields{};
