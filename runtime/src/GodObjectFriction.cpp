@@ -7,16 +7,24 @@
 /// contact. While the anchor lies within atan(mu_s) (atan(mu_d) once slipping) of the
 /// frictionless contact normal, seen from the goal, and still rests on a surface, the proxy
 /// stays there (stuck). Otherwise it slips: the goal is shifted back along the surface toward
-/// the anchor by mu_d x penetration (never past the anchor) and the same solver runs again from
-/// the same start, so the friction path is swept like every other move and the proxy trails
-/// the frictionless proxy by exactly that much.
+/// the anchor by mu_d x penetration (never past the anchor) and the same solver goes on from
+/// the frictionless proxy, with the planes it rests on there, so the friction path is swept
+/// like every other move and the proxy trails the frictionless proxy by exactly that much.
+/// Going on from there, not from the tick's start, the second solve steps back a fraction of a
+/// millimetre instead of retracing the whole way (and does not find again, in a pass of its
+/// own, the planes it starts on); its ball (the shifted goal's, as far as the frictionless
+/// proxy) mostly lies inside the first solve's, so the near list built for that one serves it
+/// too.
 ///
 /// Invariant. With several contacts the smallest friction coefficients among the touched
 /// materials apply (conservative); a goal with no contact behind it has no friction. The
-/// second solve starts where the first did, so it never crosses a surface either.
+/// second solve starts where the first ended, outside every skin that did not hold the tick's
+/// start, so it never crosses a surface either (an item that held the start and not the
+/// frictionless proxy now stops it: stricter, never looser); the planes it starts with only
+/// hold it back, and it drops each as it slides off, as any solve does.
 ///
 /// Cost. One scan of the near list for the anchor's contact, and at most one more solve (the
-/// near list is rebuilt only when its ball does not cover the shifted goal). No allocation.
+/// near list is rebuilt only when its ball does not cover the shifted goal's). No allocation.
 
 #include "GodObjectParts.h"
 
@@ -70,10 +78,10 @@ GodObjectRenderer::friction(const Scene& scene, const CandidateSet& candidates, 
     const double lagLen = glm::length(lagT);
     if (lagLen > 1e-15 && muDynamic > 0.0) {
         // Shift the goal back along the surface by mu_d x penetration (never past the anchor)
-        // and solve again: the proxy trails by exactly that much.
+        // and go on from the frictionless proxy: the proxy trails by exactly that much.
         const Vec3 g2 = goal + lagT * (std::min(muDynamic * penetration, lagLen) / lagLen);
-        ensureNear(scene, candidates, g2, glm::length(start - g2), tested);
-        f.solve = solve(scene, candidates, start, g2);
+        ensureNear(scene, candidates, g2, glm::length(free.proxy - g2), tested);
+        f.solve = solve(scene, candidates, free.proxy, g2, &free);
         f.iterations += f.solve.iterations;
     }
     return f;

@@ -19,7 +19,8 @@
 /// passes. Force = k (proxy - goal). Friction is a cone test on top: the previous proxy (or
 /// the first touch point) is kept while it lies within atan(mu) of the frictionless contact
 /// normal; otherwise the goal is shifted back along the surface by mu_d x penetration and the
-/// same solver runs again, so the friction path is swept like every other move.
+/// same solver goes on from the frictionless proxy, so the friction path is swept like every
+/// other move.
 ///
 /// Invariant. At the end of every pass the proxy lies outside every candidate object that did
 /// not already contain it at the start of the sweep: a sweep never crosses a surface, whatever

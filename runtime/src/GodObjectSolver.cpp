@@ -12,7 +12,8 @@
 /// unless another object covers them, a mesh's neighbouring triangles there), so pressing into
 /// an edge keeps the proxy on the edge. Planes whose item no longer touches the proxy (it slid
 /// off a face, or along a sphere's tangent plane) are dropped and the sweep toward the goal
-/// repeats, for at most maxIterations passes.
+/// repeats, for at most maxIterations passes. A solve may go on from where another ended, with
+/// the planes that one rests on there (the friction solve from the frictionless one).
 ///
 /// Invariant. At the end of every pass the proxy lies outside the shrunk skin of every near
 /// item that did not already contain it at the start of the sweep: a sweep never crosses a
@@ -133,8 +134,12 @@ bool GodObjectRenderer::covered(const Scene& scene, const CandidateSet& candidat
 
 GodObjectRenderer::Solve GodObjectRenderer::solve(const Scene& scene,
                                                   const CandidateSet& candidates, const Vec3& start,
-                                                  const Vec3& goal) noexcept {
+                                                  const Vec3& goal, const Solve* from) noexcept {
     Solve s;
+    if (from != nullptr) {
+        s.planes = from->planes;
+        s.planeCount = from->planeCount;
+    }
     Vec3 p = start;
     visit(p);
     for (std::uint32_t it = 0; it < mConfig.maxIterations; ++it) {

@@ -22,18 +22,18 @@ constexpr double kStepK = 1000.0; // N/m
 constexpr double kStepR = 0.05;   // the sphere's radius (m)
 constexpr double kStepSkin = GodObjectRenderer::kSkinM;
 
-/// A frictionless closed icosphere about the origin, and every item as the candidates (the
-/// brute-force index).
+/// A closed icosphere about the origin (frictionless unless told), and every item as the
+/// candidates (the brute-force index).
 struct FacetSphereRig {
     Scene scene;
     std::vector<std::uint32_t> items;
-    explicit FacetSphereRig(int subdivisions)
+    explicit FacetSphereRig(int subdivisions, double muStatic = 0.0, double muDynamic = 0.0)
         : scene(Aabb{Vec3(-0.06), Vec3(0.06)}, {[&] {
                     SceneObject o =
                         makeMesh(1, Vec3(0.0), test::makeIcosphere(subdivisions, kStepR));
                     o.material.stiffness = kStepK;
-                    o.material.staticFriction = 0.0;
-                    o.material.dynamicFriction = 0.0;
+                    o.material.staticFriction = muStatic;
+                    o.material.dynamicFriction = muDynamic;
                     return o;
                 }()}),
           items(test::indexedItems(scene)) {}
@@ -92,15 +92,18 @@ TEST_CASE("a proxy sliding over a fine closed mesh never enters it at any point 
     // A 20 480-triangle sphere of 5 cm (edges about 1.6 mm), a device 1 mm inside circling at
     // 0.5 or 1.5 mm per tick: the proxy crosses an edge every few ticks or several per tick.
     // Every point it visits (each solver pass's end) is outside the skin less the 1 nm the
-    // swept test shrinks it by, by brute force over every facet plane.
+    // swept test shrinks it by, by brute force over every facet plane. With friction the
+    // proxy slips (mu_d 0.2 of 1 mm is less than a tick's step), so every tick also solves
+    // again from the frictionless proxy toward the goal shifted back: that path too.
     const double step = GENERATE(0.0005, 0.0015);
-    INFO("step " << step << " m per tick");
-    const FacetSphereRig rig(5);
+    const double muDynamic = GENERATE(0.0, 0.2);
+    INFO("step " << step << " m per tick, mu_d " << muDynamic);
+    const FacetSphereRig rig(5, 1.5 * muDynamic, muDynamic);
     const CandidateSet c = rig.all();
     GodObjectRenderer r;
     const double polar = 0.4;
     r.reset(underSphere(-0.005, polar, 0.0));
-    int held = 0, ticks = 0, inside = 0, offSurface = 0;
+    int held = 0, ticks = 0, inside = 0, offSurface = 0, slipped = 0;
     for (int i = 1; i <= 400; ++i) {
         const double u = std::min(1.0, i / 60.0); // in along a radius, then round the circle
         const double a = i > 60 ? (i - 60) * step / ((kStepR - 0.001) * std::sin(polar)) : 0.0;
@@ -115,6 +118,7 @@ TEST_CASE("a proxy sliding over a fine closed mesh never enters it at any point 
         if (i > 62) { // past the approach
             ++ticks;
             held += out.contactCount > 0 ? 1 : 0;
+            slipped += r.visitedPath(1).empty() ? 0 : 1;
             CHECK(heightOverMesh(rig.mesh(), out.proxy) >= kStepSkin - 2e-9);
             CHECK(out.force == kStepK * (out.proxy - underSphere(-0.005 + u * 0.006, polar, a)));
         }
@@ -122,9 +126,11 @@ TEST_CASE("a proxy sliding over a fine closed mesh never enters it at any point 
     // Points of the path may lie in the air over a facet plane's extension (a pass that slid
     // off a facet's edge, before the next pass falls onto the next facet): counted, not checked.
     INFO(held << " of " << ticks << " held; " << offSurface
-              << " visited points 0.1 um or more above the surface");
+              << " visited points 0.1 um or more above the surface; " << slipped
+              << " ticks solved again for friction");
     CHECK(inside == 0);
     CHECK(held == ticks);
+    CHECK((muDynamic > 0.0 ? slipped > ticks / 2 : slipped == 0));
 }
 
 TEST_CASE("a device held still inside a fine closed mesh rests on the facet that "

@@ -6,6 +6,8 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include <cmath>
+
 using namespace hapto;
 using hapto::test::pressFrom;
 using hapto::test::RenderRig;
@@ -116,6 +118,39 @@ TEST_CASE("sliding on a rotated face in any direction: friction opposes the moti
         const Vec3 rest = out.force - glm::dot(out.force, n) * n - glm::dot(out.force, dir) * dir;
         CHECK(glm::length(rest) == Approx(0.0).margin(kFrictionTol));
     }
+}
+
+TEST_CASE("sliding along a box's convex edge pressed into it: the proxy stays on the edge and "
+          "trails by mu_d x penetration") {
+    // The top-front edge of a 10 cm cube (along x at y = z = 5 cm), the device pressed
+    // kFrictionD into it along the diagonal and drawn along it: the proxy rests on both faces
+    // (Zilles & Salisbury), and once it slips it is kMuD x kFrictionD behind the device.
+    const RenderRig rig({makeBox(1, Vec3(0.0), Vec3(0.05), Quat(1, 0, 0, 0), rough())});
+    GodObjectRenderer r;
+    const double in = 0.05 - kFrictionD / std::sqrt(2.0);
+    pressFrom(r, rig, Vec3(0.0, 0.06, 0.06), Vec3(0.0, in, in));
+    const double step = 1e-4; // m per tick: 0.1 m/s
+    const double skin = GodObjectRenderer::kSkinM;
+    const double penetration = std::sqrt(2.0) * (0.05 + skin - in);
+    int slid = 0;
+    for (int i = 1; i <= 100; ++i) {
+        const double x = step * i;
+        const RenderOutput out =
+            r.update(rig.scene, rig.all(), Vec3(x, in, in), Vec3(0.1, 0.0, 0.0), 1e-3);
+        REQUIRE(out.contactCount == 2);
+        CHECK(out.proxy.y == Approx(0.05 + skin).margin(1e-12));
+        CHECK(out.proxy.z == Approx(0.05 + skin).margin(1e-12));
+        if (out.sliding) {
+            ++slid;
+            CHECK(out.proxy.x == Approx(x - kMuD * penetration).margin(1e-9));
+            const double normal = std::hypot(out.force.y, out.force.z);
+            CHECK(normal == Approx(kFrictionK * penetration).margin(kFrictionTol));
+            CHECK(out.force.x == Approx(-kMuD * normal).margin(kFrictionTol));
+        } else {
+            CHECK(out.proxy.x == Approx(0.0).margin(1e-12)); // stuck where it first held
+        }
+    }
+    CHECK(slid > 80);
 }
 
 TEST_CASE("friction sliding across the seam of two boxes has no snag") {

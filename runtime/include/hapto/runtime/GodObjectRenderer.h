@@ -268,8 +268,10 @@ private:
     // The proxy solve (GodObjectSolver.cpp).
     /// Solves toward `goal` from `start`, adding start and each pass's end to the visited
     /// points.
+    /// Moves the proxy from `start` toward `goal`; `from`, when given, is a solve that ended at
+    /// `start`, whose planes (those the proxy rests on there) this one starts with.
     Solve solve(const Scene& scene, const CandidateSet& candidates, const Vec3& start,
-                const Vec3& goal) noexcept;
+                const Vec3& goal, const Solve* from = nullptr) noexcept;
     void visit(const Vec3& p) noexcept {
         if (mVisitedCount < kMaxVisited) {
             mVisited[mVisitedCount++] = p;
