@@ -85,7 +85,7 @@ namespace hapto {
 
 using namespace godobject;
 
-static_assert(sizeof(GodObjectRenderer) == 12288, "update the size in GodObjectRenderer.h");
+static_assert(sizeof(GodObjectRenderer) == 12416, "update the size in GodObjectRenderer.h");
 static_assert(alignof(GodObjectRenderer) == 64);
 
 namespace {
@@ -119,6 +119,7 @@ void GodObjectRenderer::reset(const Vec3& devicePosition) noexcept {
     mState.hasLastDevice = finite(devicePosition);
     mState.slipping = false;
     mState.contactCount = 0;
+    mState.restCount = 0;
     mNearRadius = -1.0;
     mNearCount = 0;
     mTriangleCount = 0;
@@ -169,9 +170,15 @@ RenderOutput GodObjectRenderer::update(const Scene& scene, const CandidateSet& c
     }
     ensureNear(scene, candidates, goal, glm::length(mState.proxy - goal), tested);
     const Vec3 start = startOfTick(scene, candidates, goal, tested);
-    const Solve free = solve(scene, candidates, start, goal);
+    const Solve resting = restingPlanes(scene, start);
+    const Solve free = solve(scene, candidates, start, goal, &resting);
     mVisitedSecond = mVisitedCount;
     const Friction f = friction(scene, candidates, start, goal, free, tested);
+    mState.restCount = static_cast<std::uint8_t>(f.solve.planeCount);
+    for (std::uint32_t i = 0; i < f.solve.planeCount; ++i) {
+        mState.restItems[i] = f.solve.planes[i].item;
+        mState.restNormals[i] = f.solve.planes[i].normal;
+    }
 
     const double stiffness = takeContacts(scene, f.solve, f.stuck, devicePosition, out);
     out.proxy = f.solve.proxy;
@@ -339,6 +346,7 @@ void GodObjectRenderer::finishTick(const Scene& scene, const CandidateSet& candi
         out.proxy = finite(start) ? start : goal;
         out.contactCount = 0;
         out.sliding = false;
+        mState.restCount = 0;
     }
     mState.proxy = out.proxy;
     mState.contactCount = out.contactCount;

@@ -13,7 +13,9 @@
 /// an edge keeps the proxy on the edge. Planes whose item no longer touches the proxy (it slid
 /// off a face, or along a sphere's tangent plane) are dropped and the sweep toward the goal
 /// repeats, for at most maxIterations passes. A solve may go on from where another ended, with
-/// the planes that one rests on there (the friction solve from the frictionless one).
+/// the planes that one rests on there: the friction solve from the frictionless one, and a
+/// tick's first solve from the last tick's end (restingPlanes), so neither spends a pass
+/// meeting again at t = 0 the surfaces its start rests on.
 ///
 /// Invariant. At the end of every pass the proxy lies outside the shrunk skin of every near
 /// item that did not already contain it at the start of the sweep: a sweep never crosses a
@@ -256,6 +258,69 @@ void GodObjectRenderer::addBoxEdgePlanes(const Scene& scene, const CandidateSet&
             s.addPlane({n, offset, hit.item});
         }
     }
+}
+
+std::uint32_t GodObjectRenderer::cachedTriangle(std::uint32_t item) const noexcept {
+    for (std::uint32_t k = 0; k < mTriangleCount; ++k) {
+        if (mTriangleData[k].item == item) {
+            return k;
+        }
+    }
+    return kNotCached;
+}
+
+GodObjectRenderer::Solve GodObjectRenderer::restingPlanes(const Scene& scene,
+                                                          const Vec3& start) const noexcept {
+    // The planes the last tick ended on, taken again from the scene as it is now: a triangle's
+    // face, the box face with the same normal, a sphere's tangent plane at the start; each
+    // only while the start touches its item (dropSlidOff's test). So a surface that moved,
+    // changed or went away gives no plane, and every plane given is one the first pass would
+    // meet at t = 0 (it only holds the proxy back; the sweeps decide what it enters).
+    Solve s;
+    if (start != mState.proxy) {
+        return s; // carried or pushed out: its planes are found by the solve
+    }
+    for (std::uint32_t i = 0; i < mState.restCount; ++i) {
+        const std::uint32_t item = mState.restItems[i];
+        if (!validItem(scene, item) || skipItem(scene, item)) {
+            continue;
+        }
+        Plane plane{Vec3(0.0), 0.0, item, kNotCached};
+        if (isTriangleItem(item)) {
+            plane.near = cachedTriangle(item);
+            const WorldFace f =
+                plane.near != kNotCached ? mTriangleData[plane.near].face : faceAt(scene, item);
+            plane.normal = f.normal;
+            plane.offset = f.offset + kSkinM;
+        } else {
+            const RenderBody& o = bodyAt(scene, item);
+            if (o.shape == Shape::Sphere) {
+                const Vec3 out = start - o.center;
+                const double len = glm::length(out);
+                if (!(len > 0.0)) {
+                    continue;
+                }
+                plane.normal = out / len;
+                plane.offset = glm::dot(plane.normal, o.center) + o.halfExtents.x + kSkinM;
+            } else if (o.shape == Shape::Box) {
+                for (int j = 0; j < 3; ++j) {
+                    for (const double side : {-1.0, 1.0}) {
+                        const Vec3 n = side * o.axes[j];
+                        if (glm::dot(n, mState.restNormals[i]) > 1.0 - 1e-12) {
+                            plane.normal = n;
+                            plane.offset = glm::dot(n, o.center) + o.halfExtents[j] + kSkinM;
+                        }
+                    }
+                }
+            }
+        }
+        if (plane.normal == Vec3(0.0) || glm::dot(plane.normal, start) - plane.offset > kOnM ||
+            distanceToSkinOf(scene, item, plane.near, start) > kOnM) {
+            continue;
+        }
+        s.addPlane(plane);
+    }
+    return s;
 }
 
 bool GodObjectRenderer::dropSlidOff(const Scene& scene, Solve& s, const Vec3& p) const noexcept {

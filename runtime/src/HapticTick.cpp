@@ -565,7 +565,7 @@ bool BodyCoupling::handBack(double dtS) noexcept {
     return ok;
 }
 
-static_assert(sizeof(HapticTick) == 21184, "update the size in HapticTick.h");
+static_assert(sizeof(HapticTick) == 21312, "update the size in HapticTick.h");
 static_assert(alignof(HapticTick) == 64);
 
 } // namespace hapto

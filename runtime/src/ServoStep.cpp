@@ -31,7 +31,7 @@ bool nonFinite(const DeviceState& s) noexcept {
 
 } // namespace
 
-static_assert(sizeof(ServoStep) == 21696, "update the size in ServoStep.h");
+static_assert(sizeof(ServoStep) == 21824, "update the size in ServoStep.h");
 
 void ServoStep::setTiming(std::uint64_t period, int limit, double lateWakeupFraction,
                           std::uint64_t stallTimeoutNs) noexcept {

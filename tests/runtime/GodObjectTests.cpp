@@ -350,6 +350,72 @@ TEST_CASE("a proxy reset inside an object passes out of it without force") {
     checkVec(out.force, Vec3(0.0, kK * kD, 0.0), kTol);
 }
 
+TEST_CASE("a proxy held on a face, an edge, a corner, a sphere or a facet starts each tick on "
+          "the planes it rests on: one pass a tick, the same force") {
+    // The first solve starts with the last tick's planes the proxy still touches, so a held
+    // tick does not spend a pass meeting them again at t = 0. Each hand is pressed in along
+    // the normal it is held by (`out`, from outside).
+    const Quat none(1, 0, 0, 0);
+    const auto [name, object, hand, out, contacts] =
+        GENERATE_REF(table<const char*, SceneObject, Vec3, Vec3, std::uint8_t>(
+            {{"face", makeBox(1, Vec3(0.0), Vec3(0.05), none, stiff()), Vec3(0.01, 0.05 - kD, 0.0),
+              Vec3(0, 1, 0), 1},
+             {"edge", makeBox(1, Vec3(0.0), Vec3(0.05), none, stiff()),
+              Vec3(0.01, 0.05 - kD, 0.05 - kD), Vec3(0, 1, 1), 2},
+             {"corner", makeBox(1, Vec3(0.0), Vec3(0.05), none, stiff()), Vec3(0.05 - kD), Vec3(1),
+              3},
+             {"sphere", makeSphere(1, Vec3(0.0), 0.05, stiff()), Vec3(0.0, 0.05 - kD, 0.0),
+              Vec3(0, 1, 0), 1},
+             {"facet", makeMesh(1, Vec3(0.0), test::boxMesh(Vec3(0.05)), none, stiff()),
+              Vec3(0.01, 0.05 - kD, 0.0), Vec3(0, 1, 0), 1}}));
+    INFO(name);
+    const RenderRig rig({object});
+    GodObjectRenderer r;
+    const RenderOutput pressed = pressFrom(r, rig, hand + 0.01 * glm::normalize(out), hand);
+    REQUIRE(pressed.contactCount == contacts);
+    for (int i = 0; i < 5; ++i) {
+        const RenderOutput held = r.update(rig.scene, rig.all(), hand, Vec3(0.0), 1e-3);
+        CHECK(held.iterations == 1);
+        CHECK(held.contactCount == contacts);
+        checkVec(held.force, pressed.force, 1e-12);
+        checkVec(held.proxy, pressed.proxy, 1e-15);
+    }
+}
+
+TEST_CASE("a surface changed, turned or taken away under a held proxy carries no plane into the "
+          "next tick") {
+    // The proxy rests on the top face (y = 5 cm) of a box with the hand 1 mm inside. Then the
+    // scene changes under it, the object keeping its id and centre: the planes the proxy starts
+    // the next tick with come from the scene as it is then, so no old face holds it.
+    const RenderRig before({makeBox(1, Vec3(0.0), Vec3(0.05), Quat(1, 0, 0, 0), stiff())});
+    const Vec3 hand(0.0, 0.049, 0.0);
+    const auto [name, object, force] = GENERATE(table<const char*, SceneObject, Vec3>(
+        {{"shrunk to 4 cm", makeBox(1, Vec3(0.0), Vec3(0.04), Quat(1, 0, 0, 0), stiff()),
+          Vec3(0.0)},
+         {"turned a little",
+          makeBox(1, Vec3(0.0), Vec3(0.05), someRotation(0.01, Vec3(0, 0, 1)), stiff()),
+          Vec3(kK * 0.001)},
+         {"a sphere of 4.5 cm", makeSphere(1, Vec3(0.0), 0.045, stiff()), Vec3(0.0)},
+         {"moved away", makeBox(1, Vec3(0.5), Vec3(0.05), Quat(1, 0, 0, 0), stiff()), Vec3(0.0)}}));
+    INFO(name);
+    GodObjectRenderer r;
+    REQUIRE(pressFrom(r, before, Vec3(0.0, 0.06, 0.0), hand).contactCount == 1);
+    const RenderRig after({object});
+    const RenderOutput out = r.update(after.scene, after.all(), hand, Vec3(0.0), 1e-3);
+    if (force == Vec3(0.0)) {
+        // Nothing at the hand any more: the proxy follows it, without force.
+        CHECK(out.contactCount == 0);
+        checkVec(out.force, Vec3(0.0), 1e-12);
+        checkVec(out.proxy, hand, 1e-12);
+    } else {
+        // The turned face still holds the hand, about 1 mm under it, along its own normal.
+        REQUIRE(out.contactCount == 1);
+        const Vec3 n = after.scene.object(0).obb().axes[1];
+        CHECK(glm::dot(out.force, n) == Approx(glm::length(out.force)).epsilon(1e-9));
+        CHECK(glm::length(out.force) == Approx(kK * 0.001).epsilon(0.05));
+    }
+}
+
 TEST_CASE("a touched object that moves pushes the proxy (and the hand) with it") {
     RenderRig rig({makeBox(1, Vec3(0.0), Vec3(0.05), Quat(1, 0, 0, 0), stiff())});
     GodObjectRenderer r;

@@ -19,11 +19,11 @@ namespace hapto {
 /// Ruspini et al. 1997) and Coulomb friction. One instance per device: it holds that device's
 /// proxy and scratch space, shares nothing, and never allocates after construction.
 ///
-/// Size: 12288 bytes (64-byte aligned; checked by a static_assert in the source file), of which
+/// Size: 12416 bytes (64-byte aligned; checked by a static_assert in the source file), of which
 /// 1280 are the near-object scratch list, 6912 the tick's copy of its first 32 candidate
 /// triangles (plane, corners, edges: 216 bytes each), 2048 the table of the candidates a near
 /// list has read (so an item two leaves list is read once) and 1608 the points the proxy
-/// visited (visitedPath). A tick solved again restores only the 296-byte State.
+/// visited (visitedPath). A tick solved again restores only the 384-byte State.
 class alignas(64) GodObjectRenderer {
 public:
     /// Constraint planes solved at once (a corner needs three).
@@ -139,6 +139,11 @@ public:
             Quat rotation{1, 0, 0, 0}; ///< Its orientation then.
         };
         std::array<ContactPose, kMaxContacts> contactPoses{}; ///< One per last tick's contact.
+        /// The planes the proxy rested on at the end of the last tick, as items and normals:
+        /// the next tick's first solve starts on those its start still touches (restingPlanes).
+        std::uint8_t restCount = 0;
+        std::array<std::uint32_t, kMaxContacts> restItems{};
+        std::array<Vec3, kMaxContacts> restNormals{};
     };
     /// The state that the next update() starts from. [servo]
     const State& state() const noexcept { return mState; }
@@ -291,6 +296,8 @@ private:
                  std::uint32_t self) const noexcept;
     /// Drops the planes whose item the proxy at p has slid off; true when one was dropped.
     bool dropSlidOff(const Scene& scene, Solve& s, const Vec3& p) const noexcept;
+    Solve restingPlanes(const Scene& scene, const Vec3& start) const noexcept;
+    std::uint32_t cachedTriangle(std::uint32_t item) const noexcept;
 
     // Friction (GodObjectFriction.cpp).
     Friction friction(const Scene& scene, const CandidateSet& candidates, const Vec3& start,

@@ -122,8 +122,8 @@ using TickStageStamps = std::array<std::uint64_t, 5>;
 /// device, used by one thread at a time. The caller owns the snapshot (it stays valid for the
 /// tick) and the device side: reading, the frames, and what to do with the force.
 ///
-/// Size: 21184 bytes, 64-byte aligned (checked by a static_assert in the source file), of
-/// which 12288 are the renderer, 1288 the effect set (8 effects of 160 bytes) and 7024 the
+/// Size: 21312 bytes, 64-byte aligned (checked by a static_assert in the source file), of
+/// which 12416 are the renderer, 1288 the effect set (8 effects of 160 bytes) and 7024 the
 /// coupling (BodyCoupling: the bodies placed for the tick, 16 entries, and their shares).
 ///
 /// A template over the algorithm, instantiated in HapticTick.cpp for each one (today

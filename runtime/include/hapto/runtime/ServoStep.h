@@ -116,7 +116,7 @@ struct ServoStepProbe {
 /// time. The fields are the servo's own: [control] before start() and while it does not run,
 /// [servo] (the thread that steps) while it runs.
 ///
-/// Size: 21696 bytes, 64-byte aligned (a static_assert in the source file), of which 21184 are
+/// Size: 21824 bytes, 64-byte aligned (a static_assert in the source file), of which 21312 are
 /// the HapticTick.
 struct alignas(64) ServoStep {
     // Fixed from construction (reader: from open).
