@@ -142,8 +142,8 @@ public:
         /// The planes the proxy rested on at the end of the last tick, as items and normals:
         /// the next tick's first solve starts on those its start still touches (restingPlanes).
         std::uint8_t restCount = 0;
-        std::array<std::uint32_t, kMaxContacts> restItems{};
-        std::array<Vec3, kMaxContacts> restNormals{};
+        std::array<std::uint32_t, kMaxContacts> restItems{}; ///< Each plane's item.
+        std::array<Vec3, kMaxContacts> restNormals{};        ///< Each plane's outward normal.
     };
     /// The state that the next update() starts from. [servo]
     const State& state() const noexcept { return mState; }
