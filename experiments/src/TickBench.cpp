@@ -12,6 +12,7 @@
 #include <cmath>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace hapto::experiments {
@@ -355,6 +356,43 @@ Quantiles quantilesOf(std::vector<double> ns) {
     q.p99 = quantileOfSorted(ns, 0.99);
     q.p999 = quantileOfSorted(ns, 0.999);
     return q;
+}
+
+TailWork tailWork(const std::vector<TickCounts>& counts, const std::vector<double>& ns, double q) {
+    if (counts.size() != ns.size()) {
+        throw std::invalid_argument("tailWork: " + std::to_string(counts.size()) +
+                                    " ticks' counts against " + std::to_string(ns.size()) +
+                                    " times");
+    }
+    if (!(q > 0.0 && q <= 1.0)) {
+        throw std::invalid_argument("tailWork: the quantile must be in (0, 1] (got " +
+                                    std::to_string(q) + ")");
+    }
+    TailWork w;
+    if (ns.empty()) {
+        return w;
+    }
+    std::vector<double> sorted = ns;
+    std::sort(sorted.begin(), sorted.end());
+    const double cut = quantileOfSorted(sorted, q);
+    for (std::size_t i = 0; i < ns.size(); ++i) {
+        if (ns[i] >= cut) {
+            const TickCounts& c = counts[i];
+            ++w.ticks;
+            w.solvedAgain += c.solves > 1 ? 1.0 : 0.0;
+            w.solves += c.solves;
+            w.passes += c.passes;
+            w.candidates += c.candidates;
+            w.extraLeaves += c.extraLeaves;
+        }
+    }
+    const double n = static_cast<double>(w.ticks);
+    w.solvedAgain /= n;
+    w.solves /= n;
+    w.passes /= n;
+    w.candidates /= n;
+    w.extraLeaves /= n;
+    return w;
 }
 
 } // namespace hapto::experiments

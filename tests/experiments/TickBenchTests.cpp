@@ -12,6 +12,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -175,6 +176,44 @@ TEST_CASE("a repeat folds in as each tick's least time, and work that differs is
     foldRepeat(first, again);
     CHECK(first.ownNs == std::vector<double>{450, 400, 450, 100});
     CHECK(first.workDiffered == 2);
+}
+
+TEST_CASE("the tail's work is the mean of the counts of the ticks at or above the quantile") {
+    // 2 000 ticks of times 0..1999 ns in a shuffled order: the nearest-rank p99.9 is the
+    // 1 998th smallest, 1997 ns, so the tail is the three ticks of 1997, 1998 and 1999 ns.
+    std::vector<double> ns(2000);
+    std::vector<TickCounts> counts(2000);
+    for (std::size_t i = 0; i < ns.size(); ++i) {
+        ns[i] = static_cast<double>((i * 7) % 2000); // 7 and 2000 coprime: a permutation
+        counts[i].solves = 1;
+        counts[i].passes = 1;
+        counts[i].candidates = 1;
+    }
+    const auto setTick = [&](double time, std::uint8_t solves, std::uint8_t passes,
+                             std::uint32_t candidates, std::uint8_t extra) {
+        const auto at =
+            static_cast<std::size_t>(std::find(ns.begin(), ns.end(), time) - ns.begin());
+        counts[at] = TickCounts{candidates, solves, passes, extra};
+    };
+    setTick(1997, 2, 4, 10, 1);
+    setTick(1998, 1, 5, 20, 2);
+    setTick(1999, 3, 6, 30, 3);
+    setTick(1996, 9, 9, 99, 9); // just below the cut: not in the tail
+    const TailWork w = tailWork(counts, ns, 0.999);
+    CHECK(w.ticks == 3);
+    CHECK(w.solvedAgain == Approx(2.0 / 3.0));
+    CHECK(w.solves == Approx(2.0));
+    CHECK(w.passes == Approx(5.0));
+    CHECK(w.candidates == Approx(20.0));
+    CHECK(w.extraLeaves == Approx(2.0));
+
+    // Ties at the cut are all in the tail; no ticks, no tail; bad input is refused.
+    const TailWork flat = tailWork(counts, std::vector<double>(2000, 5.0), 0.999);
+    CHECK(flat.ticks == 2000);
+    CHECK(tailWork({}, {}, 0.999).ticks == 0);
+    CHECK_THROWS_AS(tailWork(counts, std::vector<double>(3, 1.0), 0.999), std::invalid_argument);
+    CHECK_THROWS_AS(tailWork(counts, ns, 0.0), std::invalid_argument);
+    CHECK_THROWS_AS(tailWork(counts, ns, std::nan("")), std::invalid_argument);
 }
 
 TEST_CASE("a warmed simulated hand is primed by the servo's step and starts on the surface",

@@ -438,6 +438,8 @@ struct MotionWork {
     /// The slowest tick's: by its own time with --repeats, else by CPU time when it was read,
     /// else on the wall.
     experiments::TickCounts worst;
+    /// The ticks at or above the p99.9 of the same times: what they did, on average.
+    experiments::TailWork tail;
 };
 
 MotionWork workOf(const TickRun& run) {
@@ -460,6 +462,7 @@ MotionWork workOf(const TickRun& run) {
                                                          : run.tickNs;
     const auto slowest = std::max_element(ns.begin(), ns.end());
     w.worst = run.counts[static_cast<std::size_t>(slowest - ns.begin())];
+    w.tail = experiments::tailWork(run.counts, ns, 0.999);
     return w;
 }
 
@@ -512,6 +515,13 @@ nlohmann::ordered_json motionJson(const experiments::MotionCase& c, const TickTa
             {"solves_max", w.maxSolves},
             {"candidates_max", w.maxCandidates},
             {"slowest_tick", countsJson(w.worst)},
+            {"p999_ticks",
+             {{"ticks", w.tail.ticks},
+              {"solved_again_fraction", w.tail.solvedAgain},
+              {"solves_mean", w.tail.solves},
+              {"passes_mean", w.tail.passes},
+              {"candidates_mean", w.tail.candidates},
+              {"extra_leaves_mean", w.tail.extraLeaves}}},
             {"gap_m", gapJson(run.gapM)}};
 }
 
@@ -545,17 +555,18 @@ std::string motionTimesRow(const experiments::MotionCase& c, const TickTarget& t
 std::string motionWorkRow(const experiments::MotionCase& c, const TickTarget& target,
                           const TickRun& run) {
     const MotionWork w = workOf(run);
-    char row[256];
-    std::snprintf(row, sizeof row,
-                  "%-8s %-15s %-10s | %5.0f%% %5.0f%% %6.2f %6.2f %7.1f %6.2f %5.2f %6.2f | %3u "
-                  "%6u | %2u %5u %3u %2u %2u\n",
-                  std::string(experiments::tickMotionName(c.motion)).c_str(),
-                  target.spec.toString().c_str(), modeName(run), 100.0 * w.contact,
-                  100.0 * w.multiContact, w.solves, w.passes, w.candidates, w.extraLeaves,
-                  w.pullBacks, w.facetsEntered, w.maxSolves, w.maxCandidates,
-                  static_cast<unsigned>(w.worst.solves), w.worst.candidates,
-                  static_cast<unsigned>(w.worst.passes), static_cast<unsigned>(w.worst.extraLeaves),
-                  static_cast<unsigned>(w.worst.pullBacks));
+    char row[320];
+    std::snprintf(
+        row, sizeof row,
+        "%-8s %-15s %-10s | %5.0f%% %5.0f%% %6.2f %6.2f %7.1f %6.2f %5.2f %6.2f | %3u "
+        "%6u | %2u %5u %3u %2u %2u | %4zu %4.0f%% %4.2f %5.2f %6.1f %5.2f\n",
+        std::string(experiments::tickMotionName(c.motion)).c_str(), target.spec.toString().c_str(),
+        modeName(run), 100.0 * w.contact, 100.0 * w.multiContact, w.solves, w.passes, w.candidates,
+        w.extraLeaves, w.pullBacks, w.facetsEntered, w.maxSolves, w.maxCandidates,
+        static_cast<unsigned>(w.worst.solves), w.worst.candidates,
+        static_cast<unsigned>(w.worst.passes), static_cast<unsigned>(w.worst.extraLeaves),
+        static_cast<unsigned>(w.worst.pullBacks), w.tail.ticks, 100.0 * w.tail.solvedAgain,
+        w.tail.solves, w.tail.passes, w.tail.candidates, w.tail.extraLeaves);
     return row;
 }
 
@@ -574,7 +585,9 @@ void printMotionHeader(const experiments::TickBenchSettings& common,
     std::printf("counts:  per tick, means: solves, passes (solver passes of the last solve), "
                 "candidates, extra leaves, pull-backs, facets entered; max: the largest solves "
                 "and candidates of any tick; slowest (by own time, else cpu, else wall): that "
-                "tick's solves, candidates, passes, extra leaves, pull-backs\n");
+                "tick's solves, candidates, passes, extra leaves, pull-backs; tail (by the same "
+                "time): the ticks at or above its p99.9, how many, the share solved more than "
+                "once, and their mean solves, passes, candidates, extra leaves\n");
 }
 
 /// The motions' two tables (times, work), the motions whose work differed between repeats,
@@ -590,9 +603,11 @@ void printMotionTables(const std::vector<std::string>& timeRows,
     for (const std::string& row : timeRows) {
         std::printf("%s", row.c_str());
     }
-    std::printf("\n%-8s %-15s %-10s | %6s %6s %6s %6s %7s %6s %5s %6s | %10s | %s\n", "motion",
-                "index", "mode", "contact", "2+", "solves", "passes", "cand.", "extra", "pull",
-                "facets", "max s/cand", "slowest s cand pa ex pb");
+    std::printf("\n%-8s %-15s %-10s | %6s %6s %6s %6s %7s %6s %5s %6s | %10s | %s | %4s %5s %4s "
+                "%5s %6s %5s\n",
+                "motion", "index", "mode", "contact", "2+", "solves", "passes", "cand.", "extra",
+                "pull", "facets", "max s/cand", "slowest s cand pa ex pb", "tail", "2+", "s", "pa",
+                "cand.", "ex");
     for (const std::string& row : workRows) {
         std::printf("%s", row.c_str());
     }

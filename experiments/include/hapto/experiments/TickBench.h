@@ -214,4 +214,19 @@ double quantileOfSorted(const std::vector<double>& sorted, double q);
 /// The quantiles of `samples` (all zero when empty). [any thread]
 Quantiles quantilesOf(std::vector<double> samples);
 
+/// What a run's slowest ticks did: those whose time is at or above the nearest-rank quantile
+/// of the times (the p99.9 ticks, say), as means of their counts.
+struct TailWork {
+    std::size_t ticks = 0;  ///< Ticks at or above the quantile.
+    double solvedAgain = 0; ///< The share of them the renderer solved more than once.
+    double solves = 0;      ///< Their mean renderer solves.
+    double passes = 0;      ///< Their mean solver passes (of the last solve).
+    double candidates = 0;  ///< Their mean candidates.
+    double extraLeaves = 0; ///< Their mean extra leaves.
+};
+/// The tail of `ns` (a time per tick, as `counts` has counts) at or above its nearest-rank
+/// quantile `q`; all zero when there are no ticks. Throws std::invalid_argument when the two
+/// differ in length or q is not in (0, 1]. [any thread]
+TailWork tailWork(const std::vector<TickCounts>& counts, const std::vector<double>& ns, double q);
+
 } // namespace hapto::experiments
