@@ -296,7 +296,11 @@ private:
                  std::uint32_t self) const noexcept;
     /// Drops the planes whose item the proxy at p has slid off; true when one was dropped.
     bool dropSlidOff(const Scene& scene, Solve& s, const Vec3& p) const noexcept;
+    /// The planes the last tick ended on (State::restItems), taken again from the scene as it
+    /// is now and kept only while `start` touches their item; none when `start` is not where
+    /// the last tick left the proxy (carried or pushed out).
     Solve restingPlanes(const Scene& scene, const Vec3& start) const noexcept;
+    /// A triangle item's place in mTriangleData, or kNotCached.
     std::uint32_t cachedTriangle(std::uint32_t item) const noexcept;
 
     // Friction (GodObjectFriction.cpp).
