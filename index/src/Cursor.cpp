@@ -57,6 +57,14 @@ LocateResult Cursor::locate(const Vec3& p) noexcept {
     return r;
 }
 
+Aabb Cursor::cachedBox() const noexcept {
+    // locate() nudged an upper face on the bounds' top one ulp up; the closed box has it on
+    // the top itself, which is the smaller of the two.
+    const Vec3& top = mIndex->bounds().max;
+    return {mLo, Vec3(std::min(mHiOpen.x, top.x), std::min(mHiOpen.y, top.y),
+                      std::min(mHiOpen.z, top.z))};
+}
+
 SegmentWalk Cursor::firstLeafNotIn(const Vec3& a, const Vec3& b,
                                    std::span<const std::uint32_t> listed) const noexcept {
     Cursor walker = *this;
@@ -80,7 +88,7 @@ SegmentWalk Cursor::walkToFirstLeafNotIn(const Vec3& a, const Vec3& b,
             return {};
         }
         // Where the segment leaves this leaf's box: the nearest exit over the three slabs.
-        const Aabb box = mIndex->leafBounds(at.leaf);
+        const Aabb box = cachedBox();
         double exit = 1.0;
         for (int i = 0; i < 3; ++i) {
             if (d[i] > 0.0) {

@@ -62,7 +62,6 @@ Octree::Octree(const IndexSpec& spec, const Aabb& bounds, std::uint32_t items)
     const Vec3 size = bounds.max - bounds.min;
     for (int l = 0; l <= kMaxDepth + 1; ++l) {
         mStep[l] = Vec3(std::ldexp(size.x, -l), std::ldexp(size.y, -l), std::ldexp(size.z, -l));
-        mInvStep[l] = 1.0 / mStep[l];
     }
     mSplitLevels = splitLevels(bounds, spec.minLeafSize);
 }
@@ -134,20 +133,6 @@ bool Octree::holds(std::uint32_t node, const Vec3& p) const noexcept {
     return true;
 }
 
-std::uint32_t Octree::cellIndex(int level, double v, int axis) const noexcept {
-    const std::uint32_t last = (1u << level) - 1;
-    // A product with the inverse may land one cell off near a face; the comparisons below
-    // settle on the formula the cell boxes use.
-    const double t = std::floor((v - bounds().min[axis]) * mInvStep[level][axis]);
-    std::uint32_t i = static_cast<std::uint32_t>(t < 0.0 ? 0.0 : t > last ? last : t);
-    if (i > 0 && v < coord(level, i, axis)) {
-        --i;
-    } else if (i < last && v >= coord(level, i + 1, axis)) {
-        ++i;
-    }
-    return i;
-}
-
 std::span<const std::uint32_t> Octree::leafObjects(std::uint32_t node) const noexcept {
     const OctreeNode& n = mNodes[node];
     return {mSlots.data() + n.firstSlot(), n.slotCount()};
@@ -192,13 +177,26 @@ LocateResult Octree::followLinks(std::uint32_t leaf, const Vec3& p) const noexce
     // Cross faces only when that is never longer than climbing (the argument is in Cursor.h):
     // the point must lie in the 3x3x3 block of leaf-sized cells around the leaf, and a corner
     // crossing (3 axes) needs the common ancestor to be 2+ levels up.
+    // The point's cell q on each axis at the leaf's level (the cell whose faces hold it, the
+    // last one keeping the top face; the point is in the bounds), from the leaf's cell faces:
+    // at most two face positions an axis.
     const OctreeNode& from = mNodes[leaf];
     const int level = from.level();
+    const std::uint32_t last = (1u << level) - 1;
     std::uint32_t axesCrossed = 0, differ = 0;
     for (int a = 0; a < 3; ++a) {
-        const std::uint32_t q = cellIndex(level, p[a], a), c = from.cellAt(a, level);
-        if (q + 1 < c || q > c + 1) {
-            return climb(leaf, p);
+        const std::uint32_t c = from.cellAt(a, level);
+        std::uint32_t q = c;
+        if (p[a] < coord(level, c, a)) {
+            if (c == 0 || p[a] < coord(level, c - 1, a)) {
+                return climb(leaf, p);
+            }
+            q = c - 1;
+        } else if (c < last && p[a] >= coord(level, c + 1, a)) {
+            if (c + 1 < last && p[a] >= coord(level, c + 2, a)) {
+                return climb(leaf, p);
+            }
+            q = c + 1;
         }
         axesCrossed += q != c;
         differ |= q ^ c;

@@ -86,6 +86,8 @@ public:
 
 private:
     void forget() noexcept;
+    /// The cached leaf's closed box, as leafBounds gives it (after a locate inside the bounds).
+    Aabb cachedBox() const noexcept;
 
     Vec3 mLo{0.0};     // cached leaf box, lower corner (inclusive)
     Vec3 mHiOpen{0.0}; // upper corner (exclusive; nudged up on the bounds' faces)

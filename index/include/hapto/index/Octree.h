@@ -135,16 +135,14 @@ private:
         return bounds().min[axis] + static_cast<double>(i) * mStep[level][axis];
     }
     bool canSplit(int level) const noexcept { return level < mSplitLevels; }
-    std::uint32_t cellIndex(int level, double v, int axis) const noexcept;
     LocateResult descend(std::uint32_t node, const Vec3& p, std::uint32_t steps) const noexcept;
     LocateResult climb(std::uint32_t leaf, const Vec3& p) const noexcept;
     LocateResult followLinks(std::uint32_t leaf, const Vec3& p) const noexcept;
     void buildNodes(const Scene& scene, std::span<const std::uint32_t> items);
     friend class OctreeBuilder; // buildNodes' parts (Octree.cpp)
 
-    std::array<Vec3, kMaxDepth + 2> mStep{};    // cell size per level (m)
-    std::array<Vec3, kMaxDepth + 2> mInvStep{}; // 1 / mStep (1/m)
-    int mSplitLevels = 0;                       // splitLevels(bounds, MIN)
+    std::array<Vec3, kMaxDepth + 2> mStep{}; // cell size per level (m)
+    int mSplitLevels = 0;                    // splitLevels(bounds, MIN)
     std::vector<OctreeNode> mNodes;
     std::vector<std::uint32_t> mGroupParent; // per eight siblings (nodes 1 + 8g ...): parent
     std::vector<std::uint32_t> mSlots;
