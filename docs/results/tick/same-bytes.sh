@@ -15,7 +15,7 @@ mkdir -p "$dir" && cd "$dir"
 [ -f s4.json ] || "$old" scene mesh --triangles 20000 -o s4.json > /dev/null
 [ -f cubes.json ] || "$old" scene random --count 20000 --size 0.002 --workspace 0.05 \
   -o cubes.json > /dev/null
-[ -f p_cubes.csv ] || python3 - <<'PY'
+{ [ -f p_slow.csv ] && [ -f p_fast.csv ] && [ -f p_cubes.csv ]; } || python3 - <<'PY'
 import math, random
 random.seed(7)
 def sphere_path(name, n, step, depth_lo, depth_hi, radius=0.05):
