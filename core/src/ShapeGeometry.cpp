@@ -63,15 +63,11 @@ double sphereSignedDistance(const Vec3& center, double radius, const Vec3& p) no
 }
 
 double boxDistanceOutside(const Obb& box, const Vec3& p, double inflateM) noexcept {
-    const Vec3 l = box.toLocal(p);
-    const Vec3 h = box.halfExtents + Vec3(inflateM);
-    return glm::length(l - glm::clamp(l, -h, h));
+    return boxDistanceOutsideLocal(box.halfExtents, box.toLocal(p), inflateM);
 }
 
 bool boxStrictlyContains(const Obb& box, const Vec3& p, double inflateM) noexcept {
-    const Vec3 l = glm::abs(box.toLocal(p));
-    const Vec3 h = box.halfExtents + Vec3(inflateM);
-    return l.x < h.x && l.y < h.y && l.z < h.z;
+    return boxStrictlyContainsLocal(box.halfExtents, box.toLocal(p), inflateM);
 }
 
 bool sphereContains(const Vec3& center, double radius, const Vec3& p) noexcept {

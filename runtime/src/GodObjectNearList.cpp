@@ -39,11 +39,11 @@ using namespace godobject;
 
 namespace {
 
-/// Distance (m) from p to the object's skin, 0 inside.
+/// Distance (m) from p to the object's skin, 0 inside (a box's frame as in insideSkin).
 double distanceToSkin(const RenderBody& o, const Vec3& p) {
     return o.shape == Shape::Sphere
                ? std::max(0.0, sphereSignedDistance(o.center, o.halfExtents.x + kSkinM, p))
-               : boxDistanceOutside(o.obb(), p, kSkinM);
+               : boxDistanceOutsideLocal(o.halfExtents, o.toLocal(p), kSkinM);
 }
 
 /// True when a span before span s lists the item: it was decided there (the same test gives

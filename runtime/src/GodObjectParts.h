@@ -32,11 +32,12 @@ inline double length2(const Vec3& v) {
     return glm::dot(v, v);
 }
 
-/// True when p is inside the object's shrunk skin (strictly).
+/// True when p is inside the object's shrunk skin (strictly). An axis-aligned box's frame is
+/// p - centre (RenderBody::toLocal), which is what the rotation by the identity gives.
 inline bool insideSkin(const RenderBody& o, const Vec3& p) {
     return o.shape == Shape::Sphere
                ? sphereStrictlyContains(o.center, o.halfExtents.x + kSkinM - kShrinkM, p)
-               : boxStrictlyContains(o.obb(), p, kSkinM - kShrinkM);
+               : boxStrictlyContainsLocal(o.halfExtents, o.toLocal(p), kSkinM - kShrinkM);
 }
 
 /// A triangle's corners and edges (m, world) from its corners, for one not in the near list's

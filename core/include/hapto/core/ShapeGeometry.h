@@ -34,6 +34,22 @@ double sphereSignedDistance(const Vec3& center, double radius, const Vec3& p) no
 double boxDistanceOutside(const Obb& box, const Vec3& p, double inflateM = 0.0) noexcept;
 /// True when p lies strictly inside the box grown by `inflateM`. [servo]
 bool boxStrictlyContains(const Obb& box, const Vec3& p, double inflateM = 0.0) noexcept;
+/// boxDistanceOutside for a point already in the box's frame (`local`: Obb::toLocal's, or a
+/// caller's own that skips the rotation of an axis-aligned box). Inline: the renderer calls it
+/// once per plane and pass. [servo]
+inline double boxDistanceOutsideLocal(const Vec3& halfExtents, const Vec3& local,
+                                      double inflateM) noexcept {
+    const Vec3 h = halfExtents + Vec3(inflateM);
+    return glm::length(local - glm::clamp(local, -h, h));
+}
+/// boxStrictlyContains for a point already in the box's frame (as boxDistanceOutsideLocal).
+/// [servo]
+inline bool boxStrictlyContainsLocal(const Vec3& halfExtents, const Vec3& local,
+                                     double inflateM) noexcept {
+    const Vec3 l = glm::abs(local);
+    const Vec3 h = halfExtents + Vec3(inflateM);
+    return l.x < h.x && l.y < h.y && l.z < h.z;
+}
 /// True when p lies in the closed sphere: |p - center|^2 <= radius^2. [servo]
 bool sphereContains(const Vec3& center, double radius, const Vec3& p) noexcept;
 /// True when p lies strictly inside the sphere: |p - center|^2 < radius^2. [servo]
