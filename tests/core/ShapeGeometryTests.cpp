@@ -49,6 +49,33 @@ TEST_CASE("shape geometry: the sign of the signed distance is the inside test") 
     }
 }
 
+TEST_CASE("shape geometry: an axis-aligned box's tests on p - centre are its rotated tests, bit "
+          "for bit") {
+    // The renderer skips the rotation by the identity (RenderBody::toLocal); the answers must
+    // be the ones of the Obb path exactly (docs/DESIGN.md, "The render copy"): random points,
+    // and points on the faces, edges and corners and on the centre's own planes (zero local
+    // components, whose sign the product may change).
+    Cases c;
+    for (int n = 0; n < 4000; ++n) {
+        const Vec3 center = c.point(0.1);
+        const Vec3 half(c.uniform(0.005, 0.05), c.uniform(0.005, 0.05), c.uniform(0.005, 0.05));
+        const Obb box{center, half, Mat3(1.0)};
+        Vec3 local = c.point(0.1);
+        for (int a = 0; a < 3; ++a) {
+            const int pick = (n >> (2 * a)) % 4; // 0: random, 1: on the centre's plane, 2/3: faces
+            local[a] = pick == 1 ? 0.0 : pick == 2 ? half[a] : pick == 3 ? -half[a] : local[a];
+        }
+        const Vec3 p = center + local;
+        for (const double inflate : {0.0, 1e-4 - 1e-9, 0.01}) {
+            INFO("case " << n << ", inflate " << inflate);
+            REQUIRE(boxStrictlyContainsLocal(half, p - center, inflate) ==
+                    boxStrictlyContains(box, p, inflate));
+            REQUIRE(boxDistanceOutsideLocal(half, p - center, inflate) ==
+                    boxDistanceOutside(box, p, inflate));
+        }
+    }
+}
+
 TEST_CASE("shape geometry: the signed distance is the distance to the nearest surface point") {
     const Obb box{Vec3(0.0), Vec3(0.1, 0.2, 0.3), Mat3(1.0)};
     CHECK(boxSignedDistance(box, Vec3(0.0)) == Approx(-0.1));             // nearest face: x
