@@ -231,6 +231,45 @@ LocateResult Octree::followLinks(std::uint32_t leaf, const Vec3& p) const noexce
     return descend(node, p, steps);
 }
 
+void Octree::streamAhead(LeafStream& s, std::uint32_t leaf, const Vec3& p,
+                         const Vec3& direction) const noexcept {
+    // Each step reads only the node the step before prefetched: a leaf's items are prefetched
+    // and handed out and the leaf beyond it prefetched; an inner node's child on the point's
+    // side is (across a face the point lies on the near side, so that is the child touching
+    // the face, as descend picks it).
+    s.items = {};
+    if (s.pending != kNoNode) {
+        const OctreeNode& n = mNodes[s.pending];
+        if (n.isLeaf()) {
+            s.items = {mSlots.data() + n.firstSlot(), n.slotCount()};
+            prefetchItems(s.items);
+            s.pending = s.further > 0 ? n.neighbours[s.face] : kNoNode;
+            s.further -= s.further > 0 ? 1 : 0;
+        } else {
+            const int l = n.level() + 1;
+            std::uint32_t octant = 0;
+            for (int a = 0; a < 3; ++a) {
+                octant |= std::uint32_t(p[a] >= coord(l, 2 * n.cellAt(a, l - 1) + 1, a)) << a;
+            }
+            s.pending = n.firstChild() + octant;
+        }
+        if (s.pending != kNoNode) {
+            __builtin_prefetch(&mNodes[s.pending]);
+        }
+    }
+    const int face = LeafStream::faceAhead(direction);
+    if (leaf == s.from || leaf >= mNodes.size() || face < 0) {
+        return;
+    }
+    s.from = leaf;
+    s.pending = mNodes[leaf].neighbours[static_cast<std::size_t>(face)];
+    s.face = static_cast<std::uint8_t>(face);
+    s.further = LeafStream::kFurther;
+    if (s.pending != kNoNode) {
+        __builtin_prefetch(&mNodes[s.pending]);
+    }
+}
+
 LocateResult Octree::locateFrom(std::uint32_t leaf, const Vec3& p,
                                 CursorStrategy strategy) const noexcept {
     if (!inBounds(p)) {

@@ -25,6 +25,15 @@ SpatialIndex::SpatialIndex(const IndexSpec& spec, const Aabb& bounds, std::uint3
 
 SpatialIndex::~SpatialIndex() = default;
 
+void SpatialIndex::streamAhead(LeafStream&, std::uint32_t, const Vec3&,
+                               const Vec3&) const noexcept {}
+
+int LeafStream::faceAhead(const Vec3& direction) noexcept {
+    const Vec3 d = glm::abs(direction);
+    const int axis = d.x >= d.y && d.x >= d.z ? 0 : d.y >= d.z ? 1 : 2;
+    return direction[axis] > 0.0 ? 2 * axis + 1 : direction[axis] < 0.0 ? 2 * axis : -1;
+}
+
 bool SpatialIndex::inBounds(const Vec3& p) const noexcept {
     return p.x >= mBounds.min.x && p.x <= mBounds.max.x && p.y >= mBounds.min.y &&
            p.y <= mBounds.max.y && p.z >= mBounds.min.z && p.z <= mBounds.max.z;

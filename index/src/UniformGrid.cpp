@@ -286,6 +286,43 @@ std::span<const std::uint32_t> UniformGrid::leafObjects(std::uint32_t cell) cons
     return {mItems.data() + mCellStart[cell], mCellStart[cell + 1] - mCellStart[cell]};
 }
 
+std::uint32_t UniformGrid::across(std::uint32_t cell, int face) const noexcept {
+    const int axis = face / 2;
+    const std::uint32_t stride = axis == 0 ? 1 : axis == 1 ? mN : mN * mN;
+    const std::uint32_t at = (cell / stride) % mN;
+    if (face % 2 == 1) {
+        return at + 1 < mN ? cell + stride : kNoLeaf;
+    }
+    return at > 0 ? cell - stride : kNoLeaf;
+}
+
+void UniformGrid::streamAhead(LeafStream& s, std::uint32_t cell, const Vec3&,
+                              const Vec3& direction) const noexcept {
+    // The pending cell's range was prefetched the step before: its items are prefetched and
+    // handed out, and the cell beyond is prefetched while the stream goes further.
+    s.items = {};
+    if (s.pending != kNoLeaf) {
+        s.items = leafObjects(s.pending);
+        prefetchItems(s.items);
+        s.pending = s.further > 0 ? across(s.pending, s.face) : kNoLeaf;
+        s.further -= s.further > 0 ? 1 : 0;
+        if (s.pending != kNoLeaf) {
+            __builtin_prefetch(&mCellStart[s.pending]);
+        }
+    }
+    const int face = LeafStream::faceAhead(direction);
+    if (cell == s.from || cell >= cellCount() || face < 0) {
+        return;
+    }
+    s.from = cell;
+    s.pending = across(cell, face);
+    s.face = static_cast<std::uint8_t>(face);
+    s.further = LeafStream::kFurther;
+    if (s.pending != kNoLeaf) {
+        __builtin_prefetch(&mCellStart[s.pending]);
+    }
+}
+
 Aabb UniformGrid::leafBounds(std::uint32_t cell) const noexcept {
     const std::uint32_t x = cell % mN, y = (cell / mN) % mN, z = cell / (mN * mN);
     return {{coord(x, 0), coord(y, 1), coord(z, 2)},

@@ -6,6 +6,12 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <utility>
+#include <vector>
+
 using namespace hapto;
 using namespace hapto::test;
 
@@ -241,4 +247,85 @@ TEST_CASE("cursor walk: outside the bounds, zero length, and an unbound cursor f
     CHECK(inside.endBox.min == box.min);
     CHECK(inside.endBox.max == box.max);
     CHECK(Cursor().firstLeafNotIn(p, p, {}).covered());
+}
+
+TEST_CASE("a leaf stream along an axis-aligned walk hands out the items of every leaf the walk "
+          "enters before it enters it, and nothing new at rest, outside or over brute force") {
+    hapto::test::buildOnOneThread();
+    std::size_t enteredInAll = 0;
+    for (const auto& [name, scene] : testScenes()) {
+        for (const IndexSpec& spec : {IndexSpec::octree(2, 0.005), IndexSpec::octree(1, 0.001),
+                                      IndexSpec::grid(7), IndexSpec::brute()}) {
+            INFO(name << " " << spec.toString());
+            const auto index = buildIndex(scene, spec);
+            const Aabb b = index->bounds();
+            Random rng(23);
+            std::size_t entered = 0, early = 0, handedOut = 0;
+            for (int n = 0; n < 60; ++n) {
+                const int axis = n % 3;
+                Vec3 dir(0.0);
+                dir[axis] = (n / 3) % 2 == 0 ? 1.0 : -1.0;
+                Vec3 p = b.center() +
+                         0.4 * b.size() *
+                             Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+                Cursor cursor(*index);
+                LeafStream stream;
+                std::vector<std::span<const std::uint32_t>> handed;
+                std::uint32_t last = cursor.locate(p).leaf;
+                bool first = true; // the start may lie too near the first leaf's far face
+                for (int k = 0; k < 8000 && index->inBounds(p); ++k) {
+                    const LocateResult at = cursor.locate(p);
+                    if (at.leaf != last && std::exchange(first, false)) {
+                        // not counted
+                    } else if (at.leaf != last && !at.candidates.empty()) {
+                        ++entered;
+                        // The stream handed the leaf's own items out (the same span).
+                        early += std::any_of(handed.begin(), handed.end(), [&](const auto& h) {
+                            return h.data() == at.candidates.data() &&
+                                   h.size() == at.candidates.size();
+                        });
+                    }
+                    last = at.leaf;
+                    index->streamAhead(stream, at.leaf, p, dir);
+                    handed.push_back(stream.items);
+                    handedOut += !stream.items.empty();
+                    // A sixteenth of the leaf's smallest side a step: time for the stream to
+                    // go down to a finer neighbour, a level a step.
+                    const Vec3 side = index->leafBounds(at.leaf).size();
+                    p += dir * (std::min({side.x, side.y, side.z}) / 16);
+                }
+            }
+            if (spec.kind == IndexSpec::Kind::BruteForce) {
+                CHECK(handedOut == 0);
+                continue;
+            }
+            CHECK(entered > 0);
+            CHECK(early == entered);
+            enteredInAll += entered;
+
+            // At rest (no direction) and outside the bounds, nothing is asked for, and what
+            // was pending drains in a step a level.
+            LeafStream stream;
+            const Vec3 c = b.center();
+            const std::uint32_t leaf = index->locate(c).leaf;
+            index->streamAhead(stream, leaf, c, Vec3(1.0, 0.0, 0.0));
+            for (int k = 0; k < 30; ++k) {
+                index->streamAhead(stream, k % 2 == 0 ? leaf : kNoLeaf, c, Vec3(0.0));
+            }
+            CHECK(stream.items.empty());
+            CHECK(stream.pending == kNoLeaf);
+        }
+    }
+    CHECK(enteredInAll > 1000);
+}
+
+TEST_CASE("a leaf stream's face ahead is on the axis moved most along, -1 at rest or for NaN") {
+    CHECK(LeafStream::faceAhead(Vec3(1.0, 0.5, -0.5)) == 1);
+    CHECK(LeafStream::faceAhead(Vec3(-1.0, 0.5, -0.5)) == 0);
+    CHECK(LeafStream::faceAhead(Vec3(0.1, -0.3, 0.2)) == 2);
+    CHECK(LeafStream::faceAhead(Vec3(0.1, 0.2, -0.3)) == 4);
+    CHECK(LeafStream::faceAhead(Vec3(0.0, 0.0, 1e-9)) == 5);
+    CHECK(LeafStream::faceAhead(Vec3(0.5, 0.5, 0.0)) == 1); // a tie: the first axis
+    CHECK(LeafStream::faceAhead(Vec3(0.0)) == -1);
+    CHECK(LeafStream::faceAhead(Vec3(std::nan(""), 0.0, 0.0)) == -1);
 }

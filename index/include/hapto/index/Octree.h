@@ -103,6 +103,10 @@ public:
     std::span<const std::uint32_t> leafObjects(std::uint32_t node) const noexcept override;
     /// The closed box of any node (m). [servo]
     Aabb leafBounds(std::uint32_t node) const noexcept override { return nodeBounds(node); }
+    /// Across the face ahead, the neighbour (a step), down its children toward the point (a
+    /// step a level), its items and the leaf beyond (a step). [servo]
+    void streamAhead(LeafStream& stream, std::uint32_t leaf, const Vec3& point,
+                     const Vec3& direction) const noexcept override;
     /// Every leaf whose closed box overlaps `box`, depth-first from the root with a fixed-size
     /// stack (the depth is bounded by kMaxDepth). [servo]
     bool visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept override;

@@ -40,6 +40,35 @@ struct LocateResult {
                              ///< BruteForce: every item, as everywhere).
 };
 
+/// The leaves ahead of a moving point, brought into the cache one dependent read a step
+/// (SpatialIndex::streamAhead): a step reads only what the step before prefetched, so no
+/// step waits on memory. One per point followed (a HapticTick keeps one for its proxy).
+/// [servo]
+struct LeafStream {
+    /// Leaves the stream goes on past the first across the face ahead (two:
+    /// docs/results/tick-motions.md, "The leaves ahead").
+    static constexpr std::uint8_t kFurther = 2;
+    /// The node (grid: cell) whose line the last step prefetched; kNoLeaf: none.
+    std::uint32_t pending = kNoLeaf;
+    /// The item list of the leaf the last step reached, which it prefetched (empty: none).
+    std::span<const std::uint32_t> items{};
+    std::uint32_t from = kNoLeaf; ///< The leaf whose neighbour ahead was taken.
+    std::uint8_t face = 0;        ///< The face crossed: 2 axis + 1 upward.
+    std::uint8_t further = 0;     ///< Leaves still to go past the one pending.
+
+    /// The face ahead of a point moving along `direction`: on the axis it moves most along
+    /// (ties: the first), 2 axis + 1 when upward; -1 when it does not move (or NaN).
+    static int faceAhead(const Vec3& direction) noexcept;
+};
+
+/// Asks the cache for a leaf's item list (its first and last lines). A hint. [servo]
+inline void prefetchItems(std::span<const std::uint32_t> items) noexcept {
+    if (!items.empty()) {
+        __builtin_prefetch(items.data());
+        __builtin_prefetch(items.data() + (items.size() - 1));
+    }
+}
+
 /// An index that would need more memory than its spec allows (IndexSpec::maxBytes). Bad input:
 /// the `hapto` command exits with code 2; the message names the estimate, the limit and
 /// `--max-index-mb`.
@@ -83,6 +112,15 @@ public:
     /// The closed box of a leaf (m). A point belongs to the leaf whose box holds it, with
     /// ties on shared faces going to the upper leaf. [servo]
     virtual Aabb leafBounds(std::uint32_t leaf) const noexcept = 0;
+    /// One step of `stream` for a point at `point` in `leaf` moving along `direction`: the
+    /// node the last step prefetched is read (a leaf: its items prefetched and handed out in
+    /// stream.items, and the leaf beyond it prefetched while stream.further says so; an inner
+    /// node: its child on the point's side prefetched), and when `leaf` is new to the stream,
+    /// its neighbour across the face ahead on the axis the point moves most along is
+    /// prefetched instead. Hints only: no result depends on it. Default: nothing (brute force:
+    /// one leaf). [servo]
+    virtual void streamAhead(LeafStream& stream, std::uint32_t leaf, const Vec3& point,
+                             const Vec3& direction) const noexcept;
 
     /// Called by visitLeaves with the caller's context and a leaf; returns false to stop.
     using LeafVisitor = bool (*)(void* context, std::uint32_t leaf);

@@ -27,6 +27,10 @@ public:
     std::span<const std::uint32_t> leafObjects(std::uint32_t cell) const noexcept override;
     /// The closed box of a cell (m). [servo]
     Aabb leafBounds(std::uint32_t cell) const noexcept override;
+    /// The cell across the face ahead (its id is arithmetic), its item range, then its items
+    /// and the cell beyond (a step each). [servo]
+    void streamAhead(LeafStream& stream, std::uint32_t cell, const Vec3& point,
+                     const Vec3& direction) const noexcept override;
     /// Every cell of the range `box` covers inside the bounds, x fastest. [servo]
     bool visitLeaves(const Aabb& box, LeafVisitor visit, void* context) const noexcept override;
 
@@ -43,6 +47,8 @@ public:
 
 private:
     UniformGrid(const IndexSpec& spec, const Aabb& bounds, const Vec3& step, std::uint32_t items);
+    /// The cell across face `face` (2 axis + 1 upward) of `cell`, or kNoLeaf at the bounds.
+    std::uint32_t across(std::uint32_t cell, int face) const noexcept;
     double coord(std::uint32_t i, int axis) const noexcept {
         return bounds().min[axis] + static_cast<double>(i) * mStep[axis];
     }
