@@ -186,6 +186,10 @@ TickOutput BasicHapticTick<Algorithm>::tick(const WorldSnapshot& snapshot, const
         mCoupling.split(snapshot, out.render,
                         out.forceN - (externalForceN + out.effectsN + out.hookN), out.reactionN);
     }
+    // 6. The leaves ahead of the proxy, into the cache for the ticks to come (no output
+    // depends on it; DESIGN, "The leaves ahead").
+    mBoundIndex->streamAhead(mStream, mProxyCursor.leaf(), mRenderer.proxy(),
+                             mRenderer.proxy() - from);
     stamp(4);
     return out;
 }
@@ -201,6 +205,7 @@ void BasicHapticTick<Algorithm>::bind(const WorldSnapshot& snapshot, const Vec3&
         out.newSnapshot = !mFresh;
         mDeviceCursor.reset(*index);
         mProxyCursor.reset(*index);
+        mStream = {};
         mBoundIndex = index;
         mBoundVersion = snapshot.version;
     }

@@ -116,7 +116,9 @@ using TickStageStamps = std::array<std::uint64_t, 5>;
 ///   4. force effects and the hook: the device's EffectSet (springs, dampers, constant forces)
 ///      at the device point, then the application's per-tick hook, if any, are added to the
 ///      render force and the external force;
-///   5. safety: ForceSafety clamps, rate-limits and sanitises the sum.
+///   5. safety: ForceSafety clamps, rate-limits and sanitises the sum;
+///   6. the leaves ahead: one step of the index's LeafStream along the proxy's way, which
+///      prefetches the leaves the proxy is heading for (a hint: no output depends on it).
 /// It holds the two cursors, the renderer, the safety filter and the candidate set, sized at
 /// construction: tick() never allocates, locks, makes a syscall or throws. One instance per
 /// device, used by one thread at a time. The caller owns the snapshot (it stays valid for the
@@ -218,6 +220,7 @@ private:
     Algorithm mRenderer;  ///< The force algorithm.
     ForceSafety mSafety;
     CandidateSet mCandidates;                  ///< This tick's spans (views into the snapshot).
+    LeafStream mStream;                        ///< The leaves ahead of the proxy, prefetched.
     EffectSet mEffects;                        ///< Springs, dampers, constant forces.
     TickHook mHook;                            ///< The application's per-tick hook, or none.
     const SpatialIndex* mBoundIndex = nullptr; ///< The index the cursors are bound to.
