@@ -242,7 +242,9 @@ void Octree::streamAhead(LeafStream& s, std::uint32_t leaf, const Vec3& p,
         const OctreeNode& n = mNodes[s.pending];
         if (n.isLeaf()) {
             s.items = {mSlots.data() + n.firstSlot(), n.slotCount()};
-            prefetchItems(s.items);
+            if (!s.items.empty()) {
+                prefetchEnds(s.items.data(), s.items.size_bytes());
+            }
             s.pending = s.further > 0 ? n.neighbours[s.face] : kNoNode;
             s.further -= s.further > 0 ? 1 : 0;
         } else {
@@ -254,7 +256,7 @@ void Octree::streamAhead(LeafStream& s, std::uint32_t leaf, const Vec3& p,
             s.pending = n.firstChild() + octant;
         }
         if (s.pending != kNoNode) {
-            __builtin_prefetch(&mNodes[s.pending]);
+            prefetchEnds(&mNodes[s.pending], sizeof(OctreeNode));
         }
     }
     const int face = LeafStream::faceAhead(direction);
@@ -266,7 +268,7 @@ void Octree::streamAhead(LeafStream& s, std::uint32_t leaf, const Vec3& p,
     s.face = static_cast<std::uint8_t>(face);
     s.further = LeafStream::kFurther;
     if (s.pending != kNoNode) {
-        __builtin_prefetch(&mNodes[s.pending]);
+        prefetchEnds(&mNodes[s.pending], sizeof(OctreeNode));
     }
 }
 

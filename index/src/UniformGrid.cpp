@@ -303,11 +303,13 @@ void UniformGrid::streamAhead(LeafStream& s, std::uint32_t cell, const Vec3&,
     s.items = {};
     if (s.pending != kNoLeaf) {
         s.items = leafObjects(s.pending);
-        prefetchItems(s.items);
+        if (!s.items.empty()) {
+            prefetchEnds(s.items.data(), s.items.size_bytes());
+        }
         s.pending = s.further > 0 ? across(s.pending, s.face) : kNoLeaf;
         s.further -= s.further > 0 ? 1 : 0;
         if (s.pending != kNoLeaf) {
-            __builtin_prefetch(&mCellStart[s.pending]);
+            prefetchEnds(&mCellStart[s.pending], 2 * sizeof(std::uint32_t));
         }
     }
     const int face = LeafStream::faceAhead(direction);
@@ -319,7 +321,7 @@ void UniformGrid::streamAhead(LeafStream& s, std::uint32_t cell, const Vec3&,
     s.face = static_cast<std::uint8_t>(face);
     s.further = LeafStream::kFurther;
     if (s.pending != kNoLeaf) {
-        __builtin_prefetch(&mCellStart[s.pending]);
+        prefetchEnds(&mCellStart[s.pending], 2 * sizeof(std::uint32_t));
     }
 }
 

@@ -61,12 +61,13 @@ struct LeafStream {
     static int faceAhead(const Vec3& direction) noexcept;
 };
 
-/// Asks the cache for a leaf's item list (its first and last lines). A hint. [servo]
-inline void prefetchItems(std::span<const std::uint32_t> items) noexcept {
-    if (!items.empty()) {
-        __builtin_prefetch(items.data());
-        __builtin_prefetch(items.data() + (items.size() - 1));
-    }
+/// Asks the cache for the line of the first and of the last of `bytes` bytes at `at` (all of
+/// a node or a cell's range, which may straddle two lines; a long item list's ends). A hint.
+/// [servo]
+inline void prefetchEnds(const void* at, std::size_t bytes) noexcept {
+    const char* p = static_cast<const char*>(at);
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + (bytes - 1));
 }
 
 /// An index that would need more memory than its spec allows (IndexSpec::maxBytes). Bad input:
