@@ -182,8 +182,7 @@ public:
     /// null (the default) reads no clock. [control] before the ticks it is for
     void timeStages(StageStamps* stamps) noexcept { mStamps = stamps; }
 
-    /// The force of the last tick is not sent (a fault rule commanded zero): the next force
-    /// grows from zero at the safety filter's rate. [servo]
+    /// The last force was not sent (a fault's zero): the next ramps up as after reset(). [servo]
     void zeroForce() noexcept { mSafety.reset(); }
 
     /// The proxy (m, world). [servo]
