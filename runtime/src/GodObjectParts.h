@@ -27,6 +27,8 @@ constexpr double kNearMarginM = 1e-3; ///< Extra radius of the near ball for obj
 constexpr double kTriangleNearMarginM = 1e-6; ///< Extra radius of the near ball for triangles (m).
 constexpr double kFrictionCover = 1.0; ///< Near ball also covers a friction lag up to mu_d = 1.
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Render copies a near list asks the cache for ahead of reading them (prefetchBodies).
+constexpr std::uint32_t kPrefetchBodies = 64;
 
 inline double length2(const Vec3& v) {
     return glm::dot(v, v);

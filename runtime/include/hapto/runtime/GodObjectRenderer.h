@@ -250,6 +250,10 @@ private:
     /// buildNear) within the list's ball.
     void addNearSpans(const Scene& scene, const CandidateSet& candidates,
                       std::uint32_t& tested) noexcept;
+    /// Asks the cache for the render copies of the objects in those spans (up to
+    /// kPrefetchBodies), before they are read. A hint.
+    void prefetchBodies(const Scene& scene, const CandidateSet& candidates,
+                        std::size_t count) const noexcept;
     /// True when `candidates` begins with the spans the near list has read (extendNextUpdate).
     bool extendsNearSpans(const CandidateSet& candidates) const noexcept;
     /// Lists a candidate triangle (the tick's k-th) if it is within the near ball.
