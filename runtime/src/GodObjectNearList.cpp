@@ -24,10 +24,10 @@
 /// empties it without clearing; past kSeenFull items, a binary search of the earlier, sorted
 /// leaf lists); two dot products reject most triangles by their plane; a corner
 /// well inside the ball spares the closest-point test. The render copies of the objects new
-/// spans name are asked for all at once before the pass reads them (prefetchBodies), so a leaf
-/// new to the cache costs about one miss, not one per object. A tick solved again over more spans
-/// (extendNextUpdate) reads only the new ones: the spans are read in order, so the list so
-/// extended is the one a build over all of them gives. No allocation.
+/// spans name are asked for all at once before the pass reads them (prefetchBodies): the misses
+/// of a leaf new to the cache overlap. A tick solved again over more spans (extendNextUpdate)
+/// reads only the new ones: the spans are read in order, so the list so extended is the one a
+/// build over all of them gives. No allocation.
 
 #include "GodObjectParts.h"
 
