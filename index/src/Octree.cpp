@@ -242,9 +242,7 @@ void Octree::streamAhead(LeafStream& s, std::uint32_t leaf, const Vec3& p,
         const OctreeNode& n = mNodes[s.pending];
         if (n.isLeaf()) {
             s.items = {mSlots.data() + n.firstSlot(), n.slotCount()};
-            if (!s.items.empty()) {
-                prefetchEnds(s.items.data(), s.items.size_bytes());
-            }
+            prefetchItems(s.items);
             s.pending = s.further > 0 ? n.neighbours[s.face] : kNoNode;
             s.further -= s.further > 0 ? 1 : 0;
         } else {

@@ -303,9 +303,7 @@ void UniformGrid::streamAhead(LeafStream& s, std::uint32_t cell, const Vec3&,
     s.items = {};
     if (s.pending != kNoLeaf) {
         s.items = leafObjects(s.pending);
-        if (!s.items.empty()) {
-            prefetchEnds(s.items.data(), s.items.size_bytes());
-        }
+        prefetchItems(s.items);
         s.pending = s.further > 0 ? across(s.pending, s.face) : kNoLeaf;
         s.further -= s.further > 0 ? 1 : 0;
         if (s.pending != kNoLeaf) {

@@ -74,14 +74,6 @@ bool walkPaths(Cursor walker, const Algorithm& renderer, Listed&& listed,
     return true;
 }
 
-/// A leaf just listed: its item list is asked for now, so that the walk on to the next leaf
-/// overlaps the miss the near list would wait on. A hint. [servo]
-void listedNew(std::span<const std::uint32_t> items) noexcept {
-    if (!items.empty()) {
-        prefetchEnds(items.data(), items.size_bytes());
-    }
-}
-
 /// Tells the renderer that its next update() solves this tick again over more candidate
 /// spans, when it can use that (GodObjectRenderer::extendNextUpdate). [servo]
 template <ForceAlgorithm Algorithm> void solveAgainNext(Algorithm& renderer) noexcept {
@@ -247,7 +239,9 @@ void BasicHapticTick<Algorithm>::listSlide(const detail::TickAim& aim, ListedLea
             break;
         }
         listed.leaves[listed.count++] = missed.at.leaf;
-        listedNew(missed.at.candidates);
+        // Its item list asked for now: the walk on to the next leaf overlaps the near list's
+        // miss on it (DESIGN, "The leaves ahead").
+        prefetchItems(missed.at.candidates);
         ++out.extraLeaves;
         a += missed.t * (slide - a); // inside the leaf just listed
     }
@@ -267,7 +261,7 @@ std::size_t BasicHapticTick<Algorithm>::listPaths(ListedLeaves& listed, bool& co
                 return false;
             }
             listed.leaves[listed.count++] = missed.at.leaf;
-            listedNew(missed.at.candidates);
+            prefetchItems(missed.at.candidates); // as in listSlide
             ++out.extraLeaves;
             ++added;
             return true;
